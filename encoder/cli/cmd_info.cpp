@@ -1,0 +1,147 @@
+// `vds info FILE`: header fields, budgets and the chunk list of a stream,
+// read with the client's own parser so the answer is what a client sees.
+#include <cinttypes>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "vds/container.h"
+#include "vds/enc/stream_writer.h"
+
+namespace vds::cli {
+namespace {
+
+struct InfoOptions {
+  std::string file;
+  uint64_t workspace = 64u << 20;
+  uint32_t chunk_buffer = 1u << 24;
+  bool summary = false;
+};
+
+struct ChunkRow {
+  uint64_t offset;
+  uint32_t type;
+  uint32_t size;
+  std::string note;
+};
+
+struct Collector {
+  StreamParser* parser = nullptr;
+  std::vector<ChunkRow> rows;
+  std::vector<std::string> meta;
+};
+
+const char* mode_name(StreamMode m) {
+  switch (m) {
+    case StreamMode::images: return "images";
+    case StreamMode::walkthrough: return "walkthrough";
+    case StreamMode::terrain: return "terrain";
+    case StreamMode::model: return "model";
+  }
+  return "?";
+}
+
+std::string q16(int32_t v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4f", static_cast<double>(v) / 65536.0);
+  return buf;
+}
+
+void run_info(const InfoOptions& o) {
+  const std::vector<uint8_t> bytes = enc::read_file(o.file);
+  if (o.chunk_buffer < kHeaderPayloadMax) throw Failure(kExitUsage, "--chunk-buffer must be at least 256");
+  if (o.workspace < o.chunk_buffer) throw Failure(kExitUsage, "--workspace must hold the chunk buffer");
+  // Untouched beyond the chunk buffer: the parser only measures what is left.
+  std::unique_ptr<uint8_t[]> memory(new uint8_t[o.workspace]);
+  Arena arena(memory.get(), o.workspace);
+
+  Collector col;
+  StreamParser parser;
+  col.parser = &parser;
+  ChunkSink sink;
+  sink.ctx = &col;
+  sink.on_chunk = [](void* ctx, uint32_t type, const uint8_t* payload, uint32_t size) {
+    auto* c = static_cast<Collector*>(ctx);
+    const uint64_t end = c->parser->bytes_consumed();
+    ChunkRow row{end - kChunkHeadBytes - size - kChunkTailBytes, type, size, ""};
+    if (type == chunk::kMeta) {
+      c->meta.emplace_back(reinterpret_cast<const char*>(payload), size);
+      row.note = "metadata";
+      c->rows.push_back(row);
+      return ChunkResult::consumed;
+    }
+    row.note = "not interpreted by this version (skipped)";
+    c->rows.push_back(row);
+    return ChunkResult::unknown;
+  };
+  Status s = parser.init(arena, o.chunk_buffer, sink);
+  if (s != Status::ok) throw Failure(kExitUsage, std::string("cannot start parser: ") + status_name(s));
+  s = parser.feed(bytes.data(), bytes.size());
+  if (s == Status::more_input) s = parser.finish();
+
+  if (parser.have_header()) {
+    const StreamHeader& h = parser.header();
+    std::printf("%s: vds stream, container %u.%u, %zu bytes\n", o.file.c_str(), h.version_major, h.version_minor,
+                bytes.size());
+    std::printf("  mode               %s%s\n", mode_name(h.mode),
+                (h.flags & kHeaderFlagInteractive) ? " (interactive: needs the back-channel)" : "");
+    std::printf("  frame size         %ux%u\n", h.width, h.height);
+    if (h.frame_period_us)
+      std::printf("  timing             %" PRIu32 " us per frame (%.3f frames/s)\n", h.frame_period_us,
+                  1e6 / static_cast<double>(h.frame_period_us));
+    else
+      std::printf("  timing             none\n");
+    std::printf("  frames             %" PRIu32 "%s\n", h.frame_count, h.frame_count ? "" : " (unknown or unbounded)");
+    if (h.focal_x_q16 || h.focal_y_q16)
+      std::printf("  camera             f=(%s, %s) px, centre=(%s, %s) px, near %s, far %s\n", q16(h.focal_x_q16).c_str(),
+                  q16(h.focal_y_q16).c_str(), q16(h.center_x_q16).c_str(), q16(h.center_y_q16).c_str(),
+                  q16(h.near_q16).c_str(), q16(h.far_q16).c_str());
+    else
+      std::printf("  camera             none\n");
+    std::printf("  budgets            max chunk payload %" PRIu32 " B, decoder workspace %" PRIu32
+                " B, vertices %" PRIu32 ", triangles %" PRIu32 "\n",
+                h.max_chunk_payload, h.workspace_bytes, h.max_vertices, h.max_triangles);
+    std::printf("  client needs       %" PRIu32 " B of workspace (chunk buffer + decoder)\n",
+                h.max_chunk_payload + h.workspace_bytes);
+  }
+  if (!o.summary && !col.rows.empty()) {
+    std::printf("  chunks:\n    %10s  %-6s %10s  %s\n", "offset", "type", "payload", "");
+    for (const ChunkRow& r : col.rows)
+      std::printf("    %10" PRIu64 "  %-6s %10" PRIu32 "  %s\n", r.offset, enc::fourcc_name(r.type).c_str(), r.size,
+                  r.note.c_str());
+  }
+  for (const std::string& m : col.meta) {
+    size_t start = 0;
+    while (start < m.size()) {
+      size_t nl = m.find('\n', start);
+      if (nl == std::string::npos) nl = m.size();
+      std::printf("  meta               %s\n", m.substr(start, nl - start).c_str());
+      start = nl + 1;
+    }
+  }
+  if (s != Status::ok) {
+    char where[64];
+    std::snprintf(where, sizeof where, " at byte %" PRIu64, parser.error_offset());
+    throw Failure(kExitBadInput, o.file + ": " + status_name(s) + where + ": " + parser.error_detail());
+  }
+  std::printf("  total              %" PRIu32 " chunks (HEAD and END included), %" PRIu32 " skipped as unknown\n",
+              parser.chunks(), parser.chunks_skipped());
+}
+
+}  // namespace
+
+void add_info(CLI::App& app) {
+  auto opts = std::make_shared<InfoOptions>();
+  CLI::App* sub = app.add_subcommand("info", "Print a stream's header, budgets and chunks; checks every CRC");
+  sub->add_option("FILE", opts->file, "vds stream")->required();
+  sub->add_option("--workspace", opts->workspace, "Workspace of the client to check against, bytes")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  sub->add_option("--chunk-buffer", opts->chunk_buffer, "Chunk buffer of the client to check against, bytes")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  sub->add_flag("--summary", opts->summary, "Header and totals only, no chunk list");
+  sub->callback([opts] { run_info(*opts); });
+}
+
+}  // namespace vds::cli

@@ -1,0 +1,27 @@
+// The `vds` command: each verb registers its options on a CLI11 subcommand
+// and runs when selected. Errors are thrown as vds::cli::Failure and printed
+// by main() as "vds VERB: message" with the failure's exit code.
+#pragma once
+#include <stdexcept>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace vds::cli {
+
+// Exit codes of every verb.
+enum Exit : int {
+  kExitOk = 0,
+  kExitBadInput = 1,  // a file that is missing, unreadable or not valid
+  kExitUsage = 2,     // wrong options
+};
+
+struct Failure : std::runtime_error {
+  Failure(int code, const std::string& what) : std::runtime_error(what), exit_code(code) {}
+  int exit_code;
+};
+
+void add_info(CLI::App& app);
+void add_pack(CLI::App& app);
+
+}  // namespace vds::cli

@@ -1,0 +1,34 @@
+// `vds <verb> [options]`: the command line of the vds encoder and tools.
+#include <cstdio>
+#include <exception>
+
+#include "commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"vds: stream texture-intensive 3D content to microcontroller-class clients"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "vds 0.1.0 (stream container 1.0)");
+  vds::cli::add_info(app);
+  vds::cli::add_pack(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return vds::cli::kExitUsage;
+  } catch (const vds::cli::Failure& e) {
+    const CLI::App* sub = app.get_subcommands().empty() ? nullptr : app.get_subcommands().front();
+    std::fprintf(stderr, "vds %s: %s\n", sub ? sub->get_name().c_str() : "", e.what());
+    return e.exit_code;
+  } catch (const std::exception& e) {
+    const CLI::App* sub = app.get_subcommands().empty() ? nullptr : app.get_subcommands().front();
+    std::fprintf(stderr, "vds %s: %s\n", sub ? sub->get_name().c_str() : "", e.what());
+    return vds::cli::kExitBadInput;
+  }
+  return vds::cli::kExitOk;
+}

@@ -1,0 +1,89 @@
+#!/usr/bin/env python3
+"""The `vds` command as a user meets it: help, pack, info, and clear errors
+(naming the file and what is wrong, non-zero exit, nothing on stdout that
+pretends success) for bad input."""
+import os
+import subprocess
+import sys
+
+VDS, TMP = sys.argv[1], sys.argv[2]
+os.makedirs(TMP, exist_ok=True)
+failures = []
+
+
+def run(*args):
+    r = subprocess.run([VDS, *args], capture_output=True, text=True)
+    return r.returncode, r.stdout, r.stderr
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        failures.append(what)
+
+
+code, out, err = run("--help")
+check(code == 0 and "info" in out and "pack" in out, "vds --help lists the verbs")
+code, out, err = run("info", "--help")
+check(code == 0 and "FILE" in out, "vds info --help")
+code, out, err = run()
+check(code == 2, "no verb is a usage error (exit 2)")
+
+payload = os.path.join(TMP, "payload.bin")
+with open(payload, "wb") as f:
+    f.write(bytes(range(256)) * 4)
+stream = os.path.join(TMP, "cli.vds")
+code, out, err = run("pack", "-o", stream, "--mode", "model", "--size", "320x240", "--fps", "20",
+                     "--max-chunk", "2048", "--workspace", "5000", "--chunk", f"DATA={payload}",
+                     "--meta", "title=cli test")
+check(code == 0 and os.path.exists(stream), "vds pack writes a stream")
+
+code, out, err = run("info", stream)
+check(code == 0, "vds info accepts the packed stream")
+check("mode               model" in out and "320x240" in out, "vds info prints mode and size")
+check("50000 us per frame" in out, "vds info prints timing")
+check("max chunk payload 2048 B" in out and "decoder workspace 5000 B" in out, "vds info prints budgets")
+check("DATA" in out and "1024" in out, "vds info lists the chunk and its size")
+check("title=cli test" in out, "vds info prints metadata")
+
+code, out, err = run("info", stream, "--workspace", "4096", "--chunk-buffer", "1024")
+check(code == 1 and "workspace too small" in err and stream in err,
+      "a client too small for the stream is refused with the reason")
+
+with open(stream, "rb") as f:
+    data = bytearray(f.read())
+bad = os.path.join(TMP, "corrupt.vds")
+data[40] ^= 0x10
+with open(bad, "wb") as f:
+    f.write(data)
+code, out, err = run("info", bad)
+check(code == 1 and "CRC mismatch" in err and bad in err and "at byte" in err, "corrupt stream: CRC error names file and offset")
+
+trunc = os.path.join(TMP, "truncated.vds")
+with open(stream, "rb") as f:
+    whole = f.read()
+with open(trunc, "wb") as f:
+    f.write(whole[:-3])
+code, out, err = run("info", trunc)
+check(code == 1 and "truncated" in err, "truncated stream is reported as truncated")
+
+notvds = os.path.join(TMP, "not.vds")
+with open(notvds, "wb") as f:
+    f.write(b"hello world, not a stream")
+code, out, err = run("info", notvds)
+check(code == 1 and "bad magic" in err, "a file that is not a stream says so")
+
+code, out, err = run("info", os.path.join(TMP, "missing.vds"))
+check(code == 1 and "cannot open" in err, "a missing file is named")
+
+before = os.path.getsize(stream)
+code, out, err = run("pack", "-o", stream, "--chunk", "TOOLONG=" + payload)
+check(code == 2 and "exactly 4 characters" in err and os.path.getsize(stream) == before,
+      "bad chunk type is a usage error and leaves the existing output untouched")
+code, out, err = run("pack", "-o", stream, "--size", "0x10")
+check(code == 2 and "--size" in err, "bad size is a usage error")
+code, out, err = run("pack", "-o", stream, "--max-chunk", "100", "--chunk", f"DATA={payload}")
+check(code == 1 and "do not fit" in err and os.path.getsize(stream) == before, "oversized chunk refused, output untouched")
+
+print(f"{len(failures)} failed" if failures else "all CLI checks passed")
+sys.exit(1 if failures else 0)
