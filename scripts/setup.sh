@@ -12,7 +12,9 @@ PACKAGES=(
   qemu-system-arm
   # host libraries
   libgtest-dev libgmock-dev libbenchmark-dev libusb-1.0-0-dev
-  libdraco-dev draco libcli11-dev libstb-dev libpng-dev
+  libdraco-dev draco libcli11-dev libstb-dev libpng-dev libassimp-dev libzip-dev
+  # anchors the benchmarks and conformance tests compare against
+  libjpeg-turbo-progs libturbojpeg0-dev
   # measurement and plots
   valgrind python3 python3-matplotlib python3-numpy
 )
