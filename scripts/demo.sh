@@ -27,6 +27,11 @@ SIZE_TABLE=$(python3 "$ROOT/tests/tools/check_freestanding.py" \
   --lib "transport_core=$ROOT/$BUILD/cm4/transport/libvds_transport_core.a")
 echo "$SIZE_TABLE"
 
+echo "demo: client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
+BOARDS=$(python3 "$ROOT/tests/tools/compare_boards.py" --host "$ROOT/$BUILD/firmware_sim/vds_fw_selftest_host" \
+  --qemu qemu-system-arm --elf "$ROOT/$BUILD/cm4/firmware_sim/vds_fw_selftest.elf")
+echo "$BOARDS" | grep -E '^(check|count|info|boards)' | sort -u
+
 {
   echo "# vds demo report"
   echo
@@ -38,6 +43,12 @@ echo "$SIZE_TABLE"
   echo
   echo '```'
   echo "$SIZE_TABLE"
+  echo '```'
+  echo
+  echo "Client self-test, host board vs Cortex-M4 board under QEMU (\`-icount shift=0\`):"
+  echo
+  echo '```'
+  echo "$BOARDS" | grep -E '^(check|count|info|boards)' | sort -u
   echo '```'
 } > "$OUT/report.md"
 echo "demo: report written to out/demo/report.md"
