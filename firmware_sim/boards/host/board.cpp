@@ -35,6 +35,15 @@ void exit(int code) {
   std::exit(code);
 }
 
+int32_t host_file_read(const char* path, uint32_t offset, uint8_t* buf, uint32_t max) {
+  FILE* f = std::fopen(path, "rb");
+  if (!f) return -1;
+  int32_t result = -1;
+  if (std::fseek(f, static_cast<long>(offset), SEEK_SET) == 0) result = static_cast<int32_t>(std::fread(buf, 1, max, f));
+  std::fclose(f);
+  return result;
+}
+
 size_t stack_high_water() { return 0; }
 
 }  // namespace vds::board

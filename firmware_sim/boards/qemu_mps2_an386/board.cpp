@@ -24,9 +24,14 @@ volatile uint32_t g_overflows = 0;
 volatile uint32_t g_timer_wraps = 0;
 
 enum : int {
+  kSysOpen = 0x01,
+  kSysClose = 0x02,
   kSysWrite0 = 0x04,
+  kSysRead = 0x06,
+  kSysSeek = 0x0A,
   kSysExitExtended = 0x20,
 };
+constexpr uint32_t kOpenModeReadBinary = 1;  // "rb" in the semihosting mode table
 constexpr uint32_t kAdpStoppedApplicationExit = 0x20026;
 
 int semihost(int op, const void* arg) {
@@ -106,6 +111,24 @@ uint64_t instructions() { return ticks() * kInstructionsPerTick; }
 uint32_t instruction_resolution() { return kInstructionsPerTick; }
 
 void log(const char* text) { semihost(kSysWrite0, text); }
+
+int32_t host_file_read(const char* path, uint32_t offset, uint8_t* buf, uint32_t max) {
+  uint32_t len = 0;
+  while (path[len]) ++len;
+  const uint32_t open_args[3] = {reinterpret_cast<uint32_t>(path), kOpenModeReadBinary, len};
+  const int fd = semihost(kSysOpen, open_args);
+  if (fd < 0) return -1;
+  const uint32_t seek_args[2] = {static_cast<uint32_t>(fd), offset};
+  const uint32_t read_args[3] = {static_cast<uint32_t>(fd), reinterpret_cast<uint32_t>(buf), max};
+  const uint32_t close_args[1] = {static_cast<uint32_t>(fd)};
+  int32_t result = -1;
+  if (semihost(kSysSeek, seek_args) == 0) {
+    const int not_read = semihost(kSysRead, read_args);  // returns the bytes NOT read
+    if (not_read >= 0 && static_cast<uint32_t>(not_read) <= max) result = static_cast<int32_t>(max - static_cast<uint32_t>(not_read));
+  }
+  semihost(kSysClose, close_args);
+  return result;
+}
 
 void exit(int code) {
   const uint32_t block[2] = {kAdpStoppedApplicationExit, static_cast<uint32_t>(code)};

@@ -30,6 +30,11 @@ void log(const char* text);
 // Ends the program with `code` as the process / QEMU exit status.
 [[noreturn]] void exit(int code);
 
+// For benchmarks and tests only: reads up to `max` bytes at `offset` of a
+// file on the machine running the board (semihosting under QEMU, the file
+// system on the host board). Returns the bytes read, or -1.
+int32_t host_file_read(const char* path, uint32_t offset, uint8_t* buf, uint32_t max);
+
 // Stack high-water mark in bytes (the stack is painted at reset); 0 if the
 // board cannot tell.
 size_t stack_high_water();
