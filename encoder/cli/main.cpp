@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "vds 0.1.0 (stream container 1.0)");
   vds::cli::add_info(app);
   vds::cli::add_pack(app);
+  vds::cli::add_serve(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

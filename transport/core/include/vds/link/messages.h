@@ -1,0 +1,65 @@
+// vds link core: the messages the client application sends up the link
+// (docs/protocol.md, "Application messages"): a checksum record per
+// displayed frame on the checksums channel, a statistics snapshot on the
+// stats datagram channel, and the end-of-stream report on the control
+// channel. Fixed little-endian layouts, each opened by a type byte.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include "vds/status.h"
+
+namespace vds::link {
+
+enum class MessageType : uint8_t {
+  frame = 1,  // FrameRecord, checksums channel
+  stats = 2,  // ClientStats, stats channel
+  done = 3,   // DoneReport, control channel
+};
+
+// One displayed frame: its CRC-32C (RGB565 pixels, little-endian, rows top
+// to bottom) and the instructions each stage took on boards that count them.
+struct FrameRecord {
+  uint32_t index;
+  uint32_t crc;
+  uint32_t parse_instructions;   // container parsing and chunk verification
+  uint32_t decode_instructions;  // entropy decoding, inverse transform, colour conversion
+  uint32_t display_instructions; // band output and the frame CRC
+  uint32_t received_ms;          // when its last byte arrived (board clock)
+  uint8_t late;                  // 1 if it missed its presentation time
+};
+constexpr size_t kFrameRecordBytes = 1 + 6 * 4 + 1;
+
+struct ClientStats {
+  uint32_t uptime_ms;
+  uint32_t stream_bytes;          // stream bytes received and parsed
+  uint32_t frames_shown;
+  uint32_t late_frames;
+  uint32_t workspace_high_water;  // bytes of the workspace ever used
+  uint32_t workspace_budget;
+  uint32_t stack_high_water;      // 0 when the board cannot tell
+  uint32_t link_retransmissions;  // the device's own resends
+  uint32_t link_dropped;          // frames the device's link layer dropped
+  uint32_t instruction_resolution;  // 0: the board counts no instructions
+};
+constexpr size_t kClientStatsBytes = 1 + 10 * 4;
+
+// Sent once, after the END chunk or the first error.
+struct DoneReport {
+  int32_t status;  // vds::Status of the stream
+  uint32_t frames_shown;
+  uint32_t stream_bytes;
+  uint32_t stream_crc;  // CRC-32C of every stream byte received
+};
+constexpr size_t kDoneReportBytes = 1 + 4 * 4;
+
+size_t encode(const FrameRecord& m, uint8_t out[kFrameRecordBytes]);
+size_t encode(const ClientStats& m, uint8_t out[kClientStatsBytes]);
+size_t encode(const DoneReport& m, uint8_t out[kDoneReportBytes]);
+
+// Each returns malformed for a wrong type byte or a short message.
+Status decode(const uint8_t* p, size_t n, FrameRecord* m);
+Status decode(const uint8_t* p, size_t n, ClientStats* m);
+Status decode(const uint8_t* p, size_t n, DoneReport* m);
+
+}  // namespace vds::link

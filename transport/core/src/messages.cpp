@@ -1,0 +1,100 @@
+// Encoding of the client's upward application messages (vds/link/messages.h).
+#include "vds/link/messages.h"
+
+namespace vds::link {
+namespace {
+
+void put32(uint8_t*& p, uint32_t v) {
+  for (int i = 0; i < 4; ++i) *p++ = static_cast<uint8_t>(v >> (8 * i));
+}
+uint32_t get32(const uint8_t*& p) {
+  const uint32_t v = static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 |
+                     static_cast<uint32_t>(p[2]) << 16 | static_cast<uint32_t>(p[3]) << 24;
+  p += 4;
+  return v;
+}
+bool opens(const uint8_t* p, size_t n, size_t want, MessageType t) {
+  return p != nullptr && n >= want && p[0] == static_cast<uint8_t>(t);
+}
+
+}  // namespace
+
+size_t encode(const FrameRecord& m, uint8_t out[kFrameRecordBytes]) {
+  uint8_t* p = out;
+  *p++ = static_cast<uint8_t>(MessageType::frame);
+  put32(p, m.index);
+  put32(p, m.crc);
+  put32(p, m.parse_instructions);
+  put32(p, m.decode_instructions);
+  put32(p, m.display_instructions);
+  put32(p, m.received_ms);
+  *p++ = m.late;
+  return kFrameRecordBytes;
+}
+
+size_t encode(const ClientStats& m, uint8_t out[kClientStatsBytes]) {
+  uint8_t* p = out;
+  *p++ = static_cast<uint8_t>(MessageType::stats);
+  put32(p, m.uptime_ms);
+  put32(p, m.stream_bytes);
+  put32(p, m.frames_shown);
+  put32(p, m.late_frames);
+  put32(p, m.workspace_high_water);
+  put32(p, m.workspace_budget);
+  put32(p, m.stack_high_water);
+  put32(p, m.link_retransmissions);
+  put32(p, m.link_dropped);
+  put32(p, m.instruction_resolution);
+  return kClientStatsBytes;
+}
+
+size_t encode(const DoneReport& m, uint8_t out[kDoneReportBytes]) {
+  uint8_t* p = out;
+  *p++ = static_cast<uint8_t>(MessageType::done);
+  put32(p, static_cast<uint32_t>(m.status));
+  put32(p, m.frames_shown);
+  put32(p, m.stream_bytes);
+  put32(p, m.stream_crc);
+  return kDoneReportBytes;
+}
+
+Status decode(const uint8_t* p, size_t n, FrameRecord* m) {
+  if (m == nullptr || !opens(p, n, kFrameRecordBytes, MessageType::frame)) return Status::malformed;
+  ++p;
+  m->index = get32(p);
+  m->crc = get32(p);
+  m->parse_instructions = get32(p);
+  m->decode_instructions = get32(p);
+  m->display_instructions = get32(p);
+  m->received_ms = get32(p);
+  m->late = *p;
+  return Status::ok;
+}
+
+Status decode(const uint8_t* p, size_t n, ClientStats* m) {
+  if (m == nullptr || !opens(p, n, kClientStatsBytes, MessageType::stats)) return Status::malformed;
+  ++p;
+  m->uptime_ms = get32(p);
+  m->stream_bytes = get32(p);
+  m->frames_shown = get32(p);
+  m->late_frames = get32(p);
+  m->workspace_high_water = get32(p);
+  m->workspace_budget = get32(p);
+  m->stack_high_water = get32(p);
+  m->link_retransmissions = get32(p);
+  m->link_dropped = get32(p);
+  m->instruction_resolution = get32(p);
+  return Status::ok;
+}
+
+Status decode(const uint8_t* p, size_t n, DoneReport* m) {
+  if (m == nullptr || !opens(p, n, kDoneReportBytes, MessageType::done)) return Status::malformed;
+  ++p;
+  m->status = static_cast<int32_t>(get32(p));
+  m->frames_shown = get32(p);
+  m->stream_bytes = get32(p);
+  m->stream_crc = get32(p);
+  return Status::ok;
+}
+
+}  // namespace vds::link

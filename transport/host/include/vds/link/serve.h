@@ -1,0 +1,52 @@
+// Serving a stream file over a link: what `vds serve` runs. The host end
+// streams the file on the stream channel, starting over whenever a new
+// session begins (the client lost its state); over the loopback an
+// in-process client (the freestanding core's receiving end plus the stream
+// container parser) receives and verifies it. The client's DoneReport on
+// the control channel (vds/link/messages.h) confirms byte count and CRC.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "vds/link/link.h"
+#include "vds/link/loopback.h"
+
+namespace vds::link {
+
+struct ServeOptions {
+  std::string link = "loopback";  // loopback | pty:PATH | tcp:HOST:PORT | tcp-listen:PORT | usb:VID:PID
+  uint32_t baud = 115200;
+  FaultConfig faults;        // loopback only: faults on both directions (seeds differ per direction)
+  uint32_t timeout_s = 0;    // real links: give up after this many seconds (0: wait forever)
+  uint32_t nonce_seed = 0;   // 0: from the clock
+};
+
+struct ServeReport {
+  uint64_t bytes = 0;         // stream size
+  uint32_t stream_crc = 0;    // CRC-32C of the stream
+  bool simulated = false;     // loopback: times are simulated
+  double seconds = 0;         // from session start to the client's receipt (or last ack)
+  double goodput = 0;         // bytes / seconds / (baud / 10)
+  uint32_t sessions = 0;      // sessions the host established
+  // The client's end-of-stream report (DoneReport on the control channel,
+  // vds/link/messages.h): arrived, stream ok, and byte count and CRC match.
+  bool receipt = false;
+  bool report_seen = false;
+  int32_t report_status = 0;
+  uint64_t receipt_bytes = 0;
+  uint32_t receipt_crc = 0;
+  uint32_t frame_records = 0;  // FrameRecords received on the checksums channel
+  uint32_t client_chunks = 0;  // loopback: chunks the client's parser verified
+  LinkStats host;
+  LinkStats client;  // loopback only
+  uint16_t final_frame_payload = 0;
+};
+
+// Throws BackendError for link failures, std::runtime_error for a stream
+// the client refuses or a timeout.
+ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions& options,
+                         const std::function<void(const std::string&)>& log = {});
+
+}  // namespace vds::link

@@ -1,0 +1,211 @@
+// Serving a stream over a link (`vds serve`), with an in-process verifying
+// client for the loopback link.
+#include "vds/link/serve.h"
+
+#include <chrono>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+
+#include "vds/container.h"
+#include "vds/crc32c.h"
+#include "vds/link/backend.h"
+#include "vds/link/messages.h"
+#include "vds/link/sim.h"
+
+namespace vds::link {
+
+namespace {
+
+// Host side: writes the stream, restarting it with each new session, and
+// collects the client's end-of-stream report.
+struct Server {
+  explicit Server(const std::vector<uint8_t>& s) : stream(s) {}
+  const std::vector<uint8_t>& stream;
+  uint64_t written = 0;
+  uint32_t epoch = 0;
+  uint64_t started_ms = 0;
+  uint8_t ctl[kDoneReportBytes] = {};
+  size_t ctl_len = 0;
+  uint8_t sums[kFrameRecordBytes] = {};
+  size_t sums_len = 0;
+  bool receipt = false;
+  DoneReport report{};
+  uint32_t frame_records = 0;
+  std::function<void(const std::string&)> log;
+
+  void pump(Link& h, uint64_t now) {
+    if (!h.established()) return;
+    if (h.session_epoch() != epoch) {
+      if (epoch != 0 && log) log("session " + std::to_string(h.session_epoch()) + ": the client lost the session, sending the stream again");
+      epoch = h.session_epoch();
+      written = 0;
+      ctl_len = sums_len = 0;
+      receipt = false;
+      frame_records = 0;
+      started_ms = now;
+    }
+    while (written < stream.size()) {
+      size_t acc = 0;
+      if (h.write(channel::kStream, stream.data() + written, stream.size() - written, &acc) != Status::ok || acc == 0)
+        break;
+      written += acc;
+    }
+    // Frame records (checksums channel) are counted; the DoneReport
+    // (control channel) ends the transfer.
+    size_t n = 0;
+    while (h.read(channel::kChecksums, sums + sums_len, kFrameRecordBytes - sums_len, &n) == Status::ok && n != 0) {
+      sums_len += n;
+      if (sums_len == kFrameRecordBytes) {
+        FrameRecord fr{};
+        if (decode(sums, sums_len, &fr) == Status::ok) ++frame_records;
+        sums_len = 0;
+      }
+    }
+    while (!receipt && h.read(channel::kControl, ctl + ctl_len, kDoneReportBytes - ctl_len, &n) == Status::ok && n != 0) {
+      ctl_len += n;
+      if (ctl_len == kDoneReportBytes) {
+        receipt = decode(ctl, ctl_len, &report) == Status::ok;
+        ctl_len = 0;
+      }
+    }
+  }
+  bool acked(Link& h) const { return h.established() && written == stream.size() && h.unacked(channel::kStream) == 0; }
+};
+
+// The loopback client: link core + container parser, as firmware would
+// run them, plus the end-of-stream report.
+struct Client {
+  std::vector<uint64_t> ws;
+  Arena arena;
+  StreamParser parser;
+  uint32_t epoch = 0;
+  uint64_t got = 0;
+  uint32_t crc = 0;
+  bool sent_receipt = false;
+  Status status = Status::more_input;
+  uint32_t chunks = 0;
+  size_t budget;
+
+  explicit Client(size_t workspace) : ws((workspace + 7) / 8), arena(ws.data(), ws.size() * 8), budget(workspace) {}
+  void restart() {
+    arena = Arena(ws.data(), ws.size() * 8);
+    const uint32_t cap = static_cast<uint32_t>(budget / 2);
+    status = parser.init(arena, cap, ChunkSink{}) == Status::ok ? Status::more_input : Status::workspace_too_small;
+    got = 0;
+    crc = 0;
+    sent_receipt = false;
+  }
+  void pump(Link& d) {
+    if (d.session_epoch() != epoch) {
+      epoch = d.session_epoch();
+      restart();
+    }
+    uint8_t buf[1024];
+    size_t n = 0;
+    while (d.read(channel::kStream, buf, sizeof buf, &n) == Status::ok && n != 0) {
+      crc = crc32c_update(crc, buf, n);
+      got += n;
+      if (status == Status::more_input) status = parser.feed(buf, n);
+    }
+    if (status == Status::ok && !sent_receipt && d.established() && d.writable(channel::kControl) >= kDoneReportBytes) {
+      const DoneReport rep{static_cast<int32_t>(status), 0, static_cast<uint32_t>(got), crc};
+      uint8_t msg[kDoneReportBytes];
+      encode(rep, msg);
+      size_t acc = 0;
+      sent_receipt = d.write(channel::kControl, msg, sizeof msg, &acc) == Status::ok && acc == sizeof msg;
+    }
+    chunks = parser.chunks();
+  }
+};
+
+uint32_t seed_from_clock() {
+  return static_cast<uint32_t>(std::chrono::steady_clock::now().time_since_epoch().count()) | 1u;
+}
+
+}  // namespace
+
+ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions& o,
+                         const std::function<void(const std::string&)>& log) {
+  ServeReport rep;
+  rep.bytes = stream.size();
+  rep.stream_crc = crc32c(stream.data(), stream.size());
+  const uint32_t seed = o.nonce_seed != 0 ? o.nonce_seed : seed_from_clock();
+  Server srv(stream);
+  srv.log = log;
+
+  if (o.link == "loopback") {
+    // Size the client's workspace from the stream's own header.
+    StreamHeader hdr{};
+    if (stream.size() < kPreambleBytes + kChunkHeadBytes + kHeaderPayloadV1 ||
+        header_from_bytes(stream.data() + kPreambleBytes + kChunkHeadBytes, kHeaderPayloadV1, stream[4], stream[5],
+                          &hdr) != Status::ok)
+      throw std::runtime_error("not a vds stream (no valid header)");
+    const size_t chunk = hdr.max_chunk_payload > kHeaderPayloadMax ? hdr.max_chunk_payload : kHeaderPayloadMax;
+    Client cli(2 * chunk + hdr.workspace_bytes + 64);
+    FaultConfig up = o.faults;
+    up.seed = o.faults.seed + 0x5EED;
+    LinkSim sim(o.baud, o.faults, up, host_config(seed), device_config(seed + 1));
+    rep.simulated = true;
+    // Simulated time is free; still bound it so a broken link cannot spin forever.
+    const uint64_t limit_ms = 1000ull * (60 + stream.size() * 10 * 200 / o.baud);
+    while (sim.now_ms() < limit_ms) {
+      srv.pump(sim.host(), sim.now_ms());
+      sim.step();
+      cli.pump(sim.device());
+      if (is_error(cli.status))
+        throw std::runtime_error(std::string("the client refused the stream: ") + status_name(cli.status) + " (" +
+                                 cli.parser.error_detail() + ")");
+      if (srv.receipt && srv.acked(sim.host())) break;
+    }
+    if (!srv.receipt) throw std::runtime_error("the transfer did not finish within " + std::to_string(limit_ms / 1000) + " simulated seconds");
+    rep.seconds = static_cast<double>(sim.now_ms() - srv.started_ms) / 1000.0;
+    rep.client = sim.device().stats();
+    rep.client_chunks = cli.chunks;
+    rep.host = sim.host().stats();
+    rep.sessions = sim.host().session_epoch();
+    rep.final_frame_payload = sim.host().frame_payload();
+  } else {
+    std::unique_ptr<Backend> b = open_backend(o.link, o.baud);
+    if (log) log("link " + b->describe() + " open; waiting for the client");
+    const LinkConfig hc = host_config(seed);
+    std::vector<uint64_t> ws((link_workspace_size(hc) + 7) / 8);
+    Arena arena(ws.data(), ws.size() * 8);
+    Link host;
+    if (host.init(hc, arena) != Status::ok) throw std::runtime_error("link init failed");
+    Pump pump(host, *b);
+    const uint32_t t0 = monotonic_ms();
+    uint32_t acked_at = 0;
+    bool announced = false;
+    for (;;) {
+      const uint32_t now = monotonic_ms();
+      srv.pump(host, now);
+      pump.step(now, 1);
+      if (host.established() && !announced) {
+        announced = true;
+        if (log) log("session established (client nonce " + std::to_string(host.peer_nonce()) + ")");
+      }
+      if (srv.acked(host) && acked_at == 0) acked_at = now;
+      // All acknowledged: wait briefly for the report (a client may not send one).
+      if (srv.receipt || (acked_at != 0 && now - acked_at > 2000)) break;
+      if (o.timeout_s != 0 && now - t0 > o.timeout_s * 1000u)
+        throw std::runtime_error(std::string(host.established() ? "the transfer did not finish" : "no client answered") +
+                                 " within " + std::to_string(o.timeout_s) + " s on " + b->describe());
+    }
+    rep.seconds = static_cast<double>(monotonic_ms() - static_cast<uint32_t>(srv.started_ms)) / 1000.0;
+    rep.host = host.stats();
+    rep.sessions = host.session_epoch();
+    rep.final_frame_payload = host.frame_payload();
+  }
+  rep.report_seen = srv.receipt;
+  rep.report_status = srv.report.status;
+  rep.receipt_bytes = srv.report.stream_bytes;
+  rep.receipt_crc = srv.report.stream_crc;
+  rep.receipt = srv.receipt && srv.report.status == static_cast<int32_t>(Status::ok) &&
+                srv.report.stream_bytes == static_cast<uint32_t>(stream.size()) && srv.report.stream_crc == rep.stream_crc;
+  rep.frame_records = srv.frame_records;
+  if (rep.seconds > 0) rep.goodput = static_cast<double>(stream.size()) / rep.seconds / (o.baud / 10.0);
+  return rep;
+}
+
+}  // namespace vds::link
