@@ -51,7 +51,7 @@
 // Progressive mesh decoder: largest vertex degree (ring size) it handles.
 // Streams declaring a larger one are refused (unsupported_feature).
 //   16..1024: 16 bytes of workspace per unit (two ring scratches of vertex
-//             and corner indices) plus about 20 bytes of stack per unit
+//             and corner indices) plus about 25 bytes of stack per unit
 //             while a split is decoded (candidate scores, ring prefix sums,
 //             face scores); the split ranking costs O(degree^2) compares
 //             per split in the worst case.
@@ -61,9 +61,11 @@
 
 // Renderer (vds/render.h): which formats have span loops compiled in. Each
 // is a bit mask; a frame that asks for a format left out gets
-// Status::unsupported_feature. Every texture format costs about 3 KiB of
-// Cortex-M4 .text per output x depth format pair (nearest and bilinear,
-// repeat and clamp, vertex and view mapping); docs/renderer.md has the table.
+// Status::unsupported_feature. Each texture x output x depth combination
+// is a set of span loops (nearest and bilinear, repeat and clamp, with and
+// without apron, vertex and view mapping): on Cortex-M4 (-O2) everything
+// costs about 82 KiB of .text, rgb565 texture + rgb565 output + 16-bit depth
+// alone about 23 KiB (bench/results/render.md). Speed is the same either way.
 //   textures: 1 rgb565, 2 xrgb8888, 4 ycbcr420 (default 7: all)
 //   outputs:  1 rgb565, 2 rgb888 (default 3)
 //   depth:    1 16-bit, 2 32-bit (default 3)

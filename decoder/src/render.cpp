@@ -1,0 +1,482 @@
+// The renderer's frame and band driver (vds/render.h): validation, the
+// projected-vertex cache, band clearing, per-triangle trivial rejection and
+// the choice between the direct path and clipping, and the display callback.
+#include "vds/render.h"
+
+#include <cstring>
+
+#include "render_internal.h"
+#include "vds/config.h"
+#include "vds/render_raster.h"
+
+namespace vds {
+
+namespace {
+
+using detail::CachedVertex;
+using detail::ClipVertex;
+using detail::ScreenVertex;
+
+constexpr size_t kAlignSlack = 3;  // every allocation is 4-byte aligned at most
+
+bool format_compiled(PixelFormat f) {
+  const int bit = 1 << static_cast<int>(f);
+  return static_cast<uint8_t>(f) <= 1 && (VDS_CONFIG_RENDER_OUTPUT_FORMATS & bit) != 0;
+}
+bool depth_compiled(DepthFormat d) {
+  const int bit = 1 << static_cast<int>(d);
+  return static_cast<uint8_t>(d) <= 1 && (VDS_CONFIG_RENDER_DEPTH_FORMATS & bit) != 0;
+}
+
+Status check_config(const RenderConfig& c) {
+  if (c.width < 1 || c.width > kRenderMaxSize || c.height < 1 || c.height > kRenderMaxSize) {
+    return Status::invalid_argument;
+  }
+  if (c.band_height < 1 || c.band_height > c.height) return Status::invalid_argument;
+  if (static_cast<uint8_t>(c.format) > 1 || static_cast<uint8_t>(c.depth) > 1) return Status::invalid_argument;
+  if (!format_compiled(c.format) || !depth_compiled(c.depth)) return Status::unsupported_feature;
+  if (c.vertex_cache > 65536 || c.triangle_cache > (1u << 24)) return Status::invalid_argument;
+  if (c.target) {
+    const uint32_t row = static_cast<uint32_t>(c.width) * static_cast<uint32_t>(bytes_per_pixel(c.format));
+    if (c.target_stride < row) return Status::invalid_argument;
+    if (c.format == PixelFormat::rgb565 &&
+        ((reinterpret_cast<uintptr_t>(c.target) & 1) != 0 || (c.target_stride & 1) != 0)) {
+      return Status::invalid_argument;
+    }
+  }
+  return Status::ok;
+}
+
+Status check_texture(const Texture* t) {
+  if (!t || !t->texels) return Status::malformed;
+  if (static_cast<uint8_t>(t->format) > 2 || static_cast<uint8_t>(t->address) > 1) return Status::invalid_argument;
+  if (!(VDS_CONFIG_RENDER_TEXTURE_FORMATS & (1 << static_cast<int>(t->format)))) return Status::unsupported_feature;
+  if (t->width < 1 || t->width > kTextureMaxSize || t->height < 1 || t->height > kTextureMaxSize) {
+    return Status::invalid_argument;
+  }
+  if (t->stride < t->width) return Status::invalid_argument;
+  if (t->apron && (t->format == TexFormat::ycbcr420 || t->stride < static_cast<uint32_t>(t->width) + 1)) {
+    return Status::invalid_argument;
+  }
+  if (t->format == TexFormat::ycbcr420) {
+    if (!t->cb || !t->cr) return Status::malformed;
+    if (t->chroma_stride < static_cast<uint32_t>((t->width + 1) / 2)) return Status::invalid_argument;
+  }
+  return Status::ok;
+}
+
+Status check_list(const DrawList& list) {
+  if (list.num_positions > 65536) return Status::malformed;
+  if (list.num_positions && !list.positions) return Status::invalid_argument;
+  if (list.num_meshes && !list.meshes) return Status::invalid_argument;
+  for (uint32_t i = 0; i < list.num_meshes; ++i) {
+    const Mesh& m = list.meshes[i];
+    if (static_cast<uint8_t>(m.shading) > 3 || static_cast<uint8_t>(m.filter) > 1 || static_cast<uint8_t>(m.cull) > 2) {
+      return Status::invalid_argument;
+    }
+    if (m.num_triangles == 0) continue;
+    if (!m.indices || m.num_triangles > 0x7FFFFFFFu / 3) return Status::malformed;
+    const uint32_t count = m.num_triangles * 3;
+    for (uint32_t k = 0; k < count; ++k) {
+      if (m.indices[k] >= list.num_positions) return Status::malformed;
+    }
+    if (m.shading == Shading::gouraud && !m.colors) return Status::malformed;
+    if (m.shading == Shading::texture && !m.uvs) return Status::malformed;
+    if (m.shading == Shading::texture || m.shading == Shading::view_mapped) {
+      const Status st = check_texture(m.texture);
+      if (st != Status::ok) return st;
+    }
+  }
+  return Status::ok;
+}
+
+int num_attribs(Shading s) {
+  switch (s) {
+    case Shading::gouraud: return 3;
+    case Shading::texture: return 2;
+    default: return 0;
+  }
+}
+
+// n words of value v, eight per iteration (the compiler turns these into
+// paired or multiple stores: about 0.2 instructions per byte on Cortex-M4).
+void fill_words(uint32_t* p, uint32_t v, size_t n) {
+  for (; n >= 8; n -= 8, p += 8) {
+    p[0] = v;
+    p[1] = v;
+    p[2] = v;
+    p[3] = v;
+    p[4] = v;
+    p[5] = v;
+    p[6] = v;
+    p[7] = v;
+  }
+  for (; n; --n) *p++ = v;
+}
+
+// Fills bytes [p, p + n) with the 4-byte pattern `v` (its low byte first in
+// memory order of a little- or big-endian word store alike, since every use
+// repeats the pattern with a period dividing 4 bytes); unaligned ends by bytes.
+void fill_pattern(uint8_t* p, uint32_t v, size_t n) {
+  uint8_t b[4];
+  std::memcpy(b, &v, 4);
+  size_t k = 0;
+  for (; k < n && (reinterpret_cast<uintptr_t>(p + k) & 3u) != 0; ++k) p[k] = b[k & 3];
+  // The pattern continues at phase k & 3: rotate the word to match.
+  uint8_t r[4] = {b[k & 3], b[(k + 1) & 3], b[(k + 2) & 3], b[(k + 3) & 3]};
+  uint32_t w;
+  std::memcpy(&w, r, 4);
+  const size_t words = (n - k) / 4;
+  fill_words(reinterpret_cast<uint32_t*>(p + k), w, words);
+  for (size_t i = k + words * 4; i < n; ++i) p[i] = b[i & 3];
+}
+
+// Fills the band with the clear colour and zeroes its depth.
+void clear_band(const detail::BandTarget& b, uint32_t rgb) {
+  const int32_t rows = b.y1 - b.y0;
+  const size_t row_bytes = static_cast<size_t>(b.width) * static_cast<size_t>(bytes_per_pixel(b.format));
+  if (b.format == PixelFormat::rgb565) {
+    const uint16_t c = static_cast<uint16_t>(((((rgb >> 16) & 255) * 249 + 1014) >> 11) << 11 |
+                                             ((((rgb >> 8) & 255) * 253 + 505) >> 10) << 5 |
+                                             (((rgb & 255) * 249 + 1014) >> 11));
+    uint32_t v;
+    const uint16_t two[2] = {c, c};
+    std::memcpy(&v, two, 4);
+    if (b.color_stride == row_bytes) {
+      fill_pattern(b.color, v, row_bytes * static_cast<size_t>(rows));
+    } else {
+      for (int32_t r = 0; r < rows; ++r) fill_pattern(b.color + static_cast<uint32_t>(r) * b.color_stride, v, row_bytes);
+    }
+  } else {
+    // Three bytes per pixel: the first row by pixels, the others copied.
+    uint8_t* first = b.color;
+    for (int32_t x = 0; x < b.width; ++x) {
+      first[3 * x] = static_cast<uint8_t>(rgb >> 16);
+      first[3 * x + 1] = static_cast<uint8_t>(rgb >> 8);
+      first[3 * x + 2] = static_cast<uint8_t>(rgb);
+    }
+    for (int32_t r = 1; r < rows; ++r) std::memcpy(b.color + static_cast<uint32_t>(r) * b.color_stride, first, row_bytes);
+  }
+  fill_pattern(static_cast<uint8_t*>(b.depth), 0,
+               static_cast<size_t>(rows) * static_cast<size_t>(b.width) * static_cast<size_t>(bytes_per_depth(b.depth_format)));
+}
+
+}  // namespace
+
+namespace detail {
+
+// State of one frame: the camera, the vertex cache and the per-triangle logic.
+struct RenderFrame {
+  Renderer& r;
+  const DrawList& list;
+  FrameCamera fc;
+  uint32_t cached = 0;
+
+  // Camera-space vertex i (no attributes).
+  ClipVertex camera_vertex(uint32_t i) const {
+    const Vec3<Q16_16> p = camera_transform(*fc.cam, list.positions[i]);
+    ClipVertex v{};
+    v.x = p.x.raw();
+    v.y = p.y.raw();
+    v.z = p.z.raw();
+    return v;
+  }
+
+  // Outcode of vertex i and, unless the result has kNoProjection, its
+  // screen position and q. Every vertex in front of the near plane whose
+  // projection fits is projected, clipped or not: its position then bounds
+  // the rows a clipped triangle can reach (clipping at the far plane and the
+  // guard band only cuts the triangle's own screen image).
+  uint8_t project(uint32_t i, CachedVertex* out) const {
+    const ClipVertex v = camera_vertex(i);
+    uint8_t oc = outcode(fc, v);
+    if (oc & kOutNear) return static_cast<uint8_t>(oc | kNoProjection);
+    const Vec3<Q16_16> p{Q16_16::from_raw(v.x), Q16_16::from_raw(v.y), Q16_16::from_raw(v.z)};
+    if (!camera_project(*fc.cam, p, &out->x, &out->y)) return static_cast<uint8_t>(oc | kNoProjection);
+    out->q = depth_q(fc, v.z);
+    return oc;
+  }
+
+  void fill_cache() {
+    const uint32_t n = list.num_positions < r.cfg_.vertex_cache ? list.num_positions : r.cfg_.vertex_cache;
+    for (uint32_t i = 0; i < n; ++i) r.cache_outcode_[i] = project(i, &r.cache_[i]);
+    cached = n;
+  }
+
+  // The band range of every triangle the triangle cache holds, from the same
+  // test draw_mesh applies per band: [1, 0] (empty) for a triangle outside a
+  // clip plane, [0, last band] when its vertices are not all projected.
+  void fill_triangle_bands() {
+    const uint32_t cap = r.cfg_.triangle_cache;
+    const int32_t bh = r.cfg_.band_height;
+    const uint16_t last_band = static_cast<uint16_t>((r.cfg_.height - 1) / bh);
+    uint32_t g = 0;
+    for (uint32_t mi = 0; mi < list.num_meshes && g < cap; ++mi) {
+      const Mesh& m = list.meshes[mi];
+      for (uint32_t t = 0; t < m.num_triangles && g < cap; ++t, ++g) {
+        const uint16_t* idx = m.indices + 3 * t;
+        uint16_t first = 0, last = last_band;
+        if (idx[0] < cached && idx[1] < cached && idx[2] < cached) {
+          const uint8_t o0 = r.cache_outcode_[idx[0]], o1 = r.cache_outcode_[idx[1]], o2 = r.cache_outcode_[idx[2]];
+          if (o0 & o1 & o2 & kOutAll) {
+            first = 1;
+            last = 0;
+          } else if (!((o0 | o1 | o2) & kNoProjection)) {
+            const int32_t y0 = r.cache_[idx[0]].y, y1 = r.cache_[idx[1]].y, y2 = r.cache_[idx[2]].y;
+            const int32_t margin = (o0 | o1 | o2) ? 256 : 0;
+            const int32_t lo = (y0 < y1 ? (y0 < y2 ? y0 : y2) : (y1 < y2 ? y1 : y2)) - margin;
+            const int32_t hi = (y0 > y1 ? (y0 > y2 ? y0 : y2) : (y1 > y2 ? y1 : y2)) + margin;
+            // Rows [raster_row(lo), raster_row(hi)), clamped to the screen.
+            int32_t r0 = raster_row(lo), r1 = raster_row(hi);
+            r0 = r0 < 0 ? 0 : r0;
+            r1 = r1 > r.cfg_.height ? r.cfg_.height : r1;
+            if (r0 >= r1) {
+              first = 1;
+              last = 0;
+            } else {
+              first = static_cast<uint16_t>(r0 / bh);
+              last = static_cast<uint16_t>((r1 - 1) / bh);
+            }
+          }
+        }
+        r.tri_bands_[2 * g] = first;
+        r.tri_bands_[2 * g + 1] = last;
+      }
+    }
+  }
+
+  uint8_t fetch(uint32_t i, CachedVertex* out) {
+    if (i < cached) {
+      *out = r.cache_[i];
+      return r.cache_outcode_[i];
+    }
+    ++r.stats_.reprojected;
+    return project(i, out);
+  }
+
+  static void attributes(const Mesh& m, uint32_t i, int32_t* a) {
+    if (m.shading == Shading::texture) {
+      a[0] = m.uvs[i].u.raw();
+      a[1] = m.uvs[i].v.raw();
+      a[2] = 0;
+    } else if (m.shading == Shading::gouraud) {
+      const uint32_t c = m.colors[i];
+      a[0] = static_cast<int32_t>(((c >> 16) & 255) << 8);  // Q8.8
+      a[1] = static_cast<int32_t>(((c >> 8) & 255) << 8);
+      a[2] = static_cast<int32_t>((c & 255) << 8);
+    } else {
+      a[0] = a[1] = a[2] = 0;
+    }
+  }
+
+  // Draws mesh m into the band; `first_tri` is the running index of its first
+  // triangle (for the triangle cache), `band_index` the band's number.
+  void draw_mesh(const BandTarget& band, const Mesh& m, uint32_t first_tri, uint16_t band_index) {
+    const MaterialCtx mat{&m, num_attribs(m.shading)};
+    const uint32_t tcap = r.cfg_.triangle_cache;
+    const uint16_t* const tb = r.tri_bands_;
+    // A triangle misses the band when raster_row(ymax) <= y0 or
+    // raster_row(ymin) >= y1, i.e. ymax <= 256 y0 + 128 or ymin >= 256 y1 - 127.
+    const int32_t miss_below = band.y0 * 256 + 128;
+    const int32_t miss_above = band.y1 * 256 - 127;
+    const CachedVertex* const cache = r.cache_;
+    const uint8_t* const cache_oc = r.cache_outcode_;
+    const uint32_t n_cached = cached;
+    for (uint32_t t = 0; t < m.num_triangles; ++t) {
+      const uint32_t g = first_tri + t;
+      if (g < tcap && (band_index < tb[2 * g] || band_index > tb[2 * g + 1])) continue;
+      const uint16_t* idx = m.indices + 3 * t;
+      CachedVertex cv[3];
+      uint8_t oc[3];
+      if (idx[0] < n_cached && idx[1] < n_cached && idx[2] < n_cached) {
+        // The common case, kept short: every triangle is visited once per band.
+        oc[0] = cache_oc[idx[0]];
+        oc[1] = cache_oc[idx[1]];
+        oc[2] = cache_oc[idx[2]];
+        if (oc[0] & oc[1] & oc[2] & kOutAll) continue;
+        if (!((oc[0] | oc[1] | oc[2]) & kNoProjection)) {
+          const int32_t y0 = cache[idx[0]].y, y1 = cache[idx[1]].y, y2 = cache[idx[2]].y;
+          const int32_t lo = y0 < y1 ? (y0 < y2 ? y0 : y2) : (y1 < y2 ? y1 : y2);
+          const int32_t hi = y0 > y1 ? (y0 > y2 ? y0 : y2) : (y1 > y2 ? y1 : y2);
+          // Clipped vertices are rounded on their own, so a clipped
+          // triangle's bound is widened by a pixel (the picture must not
+          // depend on which band a triangle is tested against).
+          const int32_t margin = (oc[0] | oc[1] | oc[2]) ? 256 : 0;
+          if (hi + margin <= miss_below || lo - margin >= miss_above) continue;
+        }
+        cv[0] = cache[idx[0]];
+        cv[1] = cache[idx[1]];
+        cv[2] = cache[idx[2]];
+      } else {
+        for (int k = 0; k < 3; ++k) oc[k] = fetch(idx[k], &cv[k]);
+        if (oc[0] & oc[1] & oc[2] & kOutAll) continue;
+        if (!((oc[0] | oc[1] | oc[2]) & kNoProjection)) {
+          int32_t lo = cv[0].y, hi = cv[0].y;
+          for (int k = 1; k < 3; ++k) {
+            lo = cv[k].y < lo ? cv[k].y : lo;
+            hi = cv[k].y > hi ? cv[k].y : hi;
+          }
+          const int32_t margin = (oc[0] | oc[1] | oc[2]) ? 256 : 0;
+          if (hi + margin <= miss_below || lo - margin >= miss_above) continue;
+        }
+      }
+      const uint8_t any = static_cast<uint8_t>(oc[0] | oc[1] | oc[2]);
+      // The clipper's scratch array is free once it has run, and the direct
+      // path needs no clipping: one store serves both (a small stack).
+      union Scratch {
+        ClipVertex clip[kMaxPolyVerts];
+        ScreenVertex screen[kMaxPolyVerts];
+      } scratch;
+      if (any == 0) {
+        ScreenVertex* sv = scratch.screen;
+        for (int k = 0; k < 3; ++k) {
+          sv[k].x = cv[k].x;
+          sv[k].y = cv[k].y;
+          sv[k].q = cv[k].q;
+          attributes(m, idx[k], sv[k].a);
+        }
+        draw_polygon(band, mat, sv, 3, r.stats_);
+        continue;
+      }
+      ++r.stats_.clipped;
+      ClipVertex in[3], out[kMaxPolyVerts];
+      for (int k = 0; k < 3; ++k) {
+        in[k] = camera_vertex(idx[k]);
+        attributes(m, idx[k], in[k].a);
+      }
+      const int n = clip_polygon(fc, static_cast<uint8_t>(any & kOutAll), in, 3, out, scratch.clip, mat.num_attribs);
+      if (n < 3) continue;
+      ScreenVertex* sv = scratch.screen;
+      bool ok = true;
+      for (int k = 0; k < n && ok; ++k) {
+        const Vec3<Q16_16> p{Q16_16::from_raw(out[k].x), Q16_16::from_raw(out[k].y), Q16_16::from_raw(out[k].z)};
+        ok = camera_project(*fc.cam, p, &sv[k].x, &sv[k].y);
+        sv[k].q = depth_q(fc, out[k].z);
+        for (int j = 0; j < kMaxAttribs; ++j) sv[k].a[j] = out[k].a[j];
+      }
+      if (ok) draw_polygon(band, mat, sv, n, r.stats_);
+    }
+  }
+};
+
+}  // namespace detail
+
+Status texture_fill_apron(Texture& t, void* texels) {
+  if (!texels || texels != t.texels || t.width < 1 || t.height < 1 || t.width > kTextureMaxSize ||
+      t.height > kTextureMaxSize || t.stride < static_cast<uint32_t>(t.width) + 1) {
+    return Status::invalid_argument;
+  }
+  const bool repeat = detail::texture_repeats(t);
+  const uint32_t w = t.width, h = t.height, s = t.stride;
+  auto fill = [&](auto* p) {
+    for (uint32_t y = 0; y < h; ++y) p[y * s + w] = p[y * s + (repeat ? 0 : w - 1)];
+    const uint32_t src = repeat ? 0 : h - 1;
+    for (uint32_t x = 0; x <= w; ++x) p[h * s + x] = p[src * s + x];
+  };
+  if (t.format == TexFormat::rgb565) {
+    fill(static_cast<uint16_t*>(texels));
+  } else if (t.format == TexFormat::xrgb8888) {
+    fill(static_cast<uint32_t*>(texels));
+  } else {
+    return Status::invalid_argument;
+  }
+  t.apron = true;
+  return Status::ok;
+}
+
+size_t render_workspace_size(const RenderConfig& cfg) {
+  if (check_config(cfg) != Status::ok) return 0;
+  const size_t w = cfg.width, bh = cfg.band_height;
+  size_t total = 0;
+  if (!cfg.target) total += w * bh * static_cast<size_t>(bytes_per_pixel(cfg.format)) + kAlignSlack;
+  total += w * bh * static_cast<size_t>(bytes_per_depth(cfg.depth)) + kAlignSlack;
+  if (cfg.vertex_cache) total += size_t{cfg.vertex_cache} * (sizeof(detail::CachedVertex) + 1) + kAlignSlack;
+  if (cfg.triangle_cache) total += size_t{cfg.triangle_cache} * 2 * sizeof(uint16_t) + kAlignSlack;
+  return total;
+}
+
+Status Renderer::init(const RenderConfig& cfg, Arena& arena) {
+  ready_ = false;
+  const Status st = check_config(cfg);
+  if (st != Status::ok) return st;
+  const size_t w = cfg.width, bh = cfg.band_height;
+  uint8_t* color = nullptr;
+  uint32_t stride = 0;
+  if (cfg.target) {
+    color = cfg.target;
+    stride = cfg.target_stride;
+  } else {
+    stride = static_cast<uint32_t>(w * static_cast<size_t>(bytes_per_pixel(cfg.format)));
+    color = static_cast<uint8_t*>(arena.alloc(stride * bh, 4));
+    if (!color) return Status::workspace_too_small;
+  }
+  void* depth = arena.alloc(w * bh * static_cast<size_t>(bytes_per_depth(cfg.depth)), 4);
+  if (!depth) return Status::workspace_too_small;
+  detail::CachedVertex* cache = nullptr;
+  uint8_t* oc = nullptr;
+  if (cfg.vertex_cache) {
+    cache = arena.alloc_array<detail::CachedVertex>(cfg.vertex_cache);
+    oc = arena.alloc_array<uint8_t>(cfg.vertex_cache);
+    if (!cache || !oc) return Status::workspace_too_small;
+  }
+  uint16_t* tri = nullptr;
+  if (cfg.triangle_cache) {
+    tri = arena.alloc_array<uint16_t>(size_t{cfg.triangle_cache} * 2);
+    if (!tri) return Status::workspace_too_small;
+  }
+  cfg_ = cfg;
+  color_ = color;
+  color_stride_ = stride;
+  depth_ = depth;
+  cache_ = cache;
+  cache_outcode_ = oc;
+  tri_bands_ = tri;
+  stats_ = RenderStats{};
+  ready_ = true;
+  return Status::ok;
+}
+
+Status Renderer::render(const Camera& cam, const DrawList& list, uint32_t clear_color, BandSink sink, void* ctx) {
+  if (!ready_) return Status::invalid_argument;
+  if (!sink && !cfg_.target) return Status::invalid_argument;
+  if (validate_camera(cam) != Status::ok) return Status::invalid_argument;
+  const Status st = check_list(list);
+  if (st != Status::ok) return st;
+
+  stats_ = RenderStats{};
+  for (uint32_t i = 0; i < list.num_meshes; ++i) stats_.triangles += list.meshes[i].num_triangles;
+
+  detail::RenderFrame frame{*this, list, {&cam, cam.near_z.raw(), cam.far_z.raw(), kRenderGuardBandPx}};
+  frame.fill_cache();
+  if (cfg_.triangle_cache) frame.fill_triangle_bands();
+
+  const int32_t height = cfg_.height;
+  for (int32_t y0 = 0; y0 < height; y0 += cfg_.band_height) {
+    const int32_t y1 = y0 + cfg_.band_height < height ? y0 + cfg_.band_height : height;
+    detail::BandTarget band{};
+    band.y0 = y0;
+    band.y1 = y1;
+    band.width = cfg_.width;
+    band.color = cfg_.target ? color_ + static_cast<size_t>(y0) * color_stride_ : color_;
+    band.color_stride = color_stride_;
+    band.depth = depth_;
+    band.format = cfg_.format;
+    band.depth_format = cfg_.depth;
+    clear_band(band, clear_color);
+    const uint16_t band_index = static_cast<uint16_t>(y0 / cfg_.band_height);
+    uint32_t first_tri = 0;
+    for (uint32_t i = 0; i < list.num_meshes; ++i) {
+      frame.draw_mesh(band, list.meshes[i], first_tri, band_index);
+      const uint32_t nt = list.meshes[i].num_triangles;
+      first_tri = nt > UINT32_MAX - first_tri ? UINT32_MAX : first_tri + nt;
+    }
+    if (sink) {
+      const Band out{band.color, color_stride_, static_cast<uint16_t>(y0), static_cast<uint16_t>(y1 - y0),
+                     cfg_.width, cfg_.format};
+      if (!sink(ctx, out)) return Status::aborted;
+    }
+  }
+  return Status::ok;
+}
+
+}  // namespace vds

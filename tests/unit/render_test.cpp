@@ -1,0 +1,518 @@
+// The client renderer (vds/render.h) against the double-precision reference
+// (vds/enc/ref_render.h) on the shared scenes, and its contract: band height
+// never changes the picture and nothing is written outside the band,
+// clipping, degenerate and hostile input, validation, and golden checksums
+// for comparing builds.
+#include "vds/render.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "../../decoder/src/render_internal.h"
+#include "vds/crc32c.h"
+#include "vds/enc/image_io.h"
+#include "vds/enc/ref_render.h"
+#include "vds/enc/scene.h"
+
+namespace vds {
+namespace {
+
+using enc::ClientFrame;
+using enc::ClientRenderSettings;
+using enc::ClientScene;
+using enc::Scene;
+
+const char* tex_name(TexFormat f) {
+  return f == TexFormat::rgb565 ? "rgb565" : f == TexFormat::xrgb8888 ? "xrgb8888" : "ycbcr420";
+}
+
+Scene view_mapped_cube() {
+  const Scene base = enc::make_cube_scene();
+  const enc::CameraD view_cam = enc::CameraD::look_at({2.8, 2.9, -4.8}, {0.2, 0.9, 0.3}, {0, 1, 0}, 240, 180, 55, 0.5, 60);
+  const enc::RefFrame view = enc::ref_render(base, view_cam, 240, 180);
+  std::vector<int> faces;
+  for (int i = 0; i < static_cast<int>(base.meshes.size()); ++i) faces.push_back(i);
+  return enc::make_view_mapped_scene(base, faces, view.image, view_cam);
+}
+
+std::vector<Scene> all_scenes() {
+  std::vector<Scene> v = enc::shared_scenes();
+  v.push_back(view_mapped_cube());
+  return v;
+}
+
+// ---------------------------------------------------------------------------
+// Accuracy
+// ---------------------------------------------------------------------------
+TEST(RenderAccuracy, SharedScenesReach45dBAgainstTheFloatReference) {
+  for (const Scene& base : all_scenes()) {
+    for (TexFormat tf : {TexFormat::xrgb8888, TexFormat::rgb565, TexFormat::ycbcr420}) {
+      const Scene sc = enc::client_textures(base, tf);
+      const enc::RefFrame ref = enc::ref_render(sc);
+      const ClientScene cs(sc, tf);
+      for (DepthFormat df : {DepthFormat::d32, DepthFormat::d16}) {
+        ClientRenderSettings st;
+        st.format = PixelFormat::rgb888;
+        st.depth = df;
+        const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, st);
+        ASSERT_EQ(fr.status, Status::ok);
+        const double p = enc::psnr(ref.image, fr.image);
+        EXPECT_GE(p, 45.0) << sc.name << " " << tex_name(tf) << (df == DepthFormat::d16 ? " d16" : " d32");
+        EXPECT_GT(fr.stats.pixels, 20000u) << sc.name;  // the scene is really drawn
+      }
+    }
+  }
+}
+
+TEST(RenderAccuracy, Rgb565OutputMatchesTheRoundedReference) {
+  // With rgb565 output the client rounds once more (5-bit bilinear weights,
+  // 5/6/5 channels), so a 1-step difference in 5 bits costs 8 levels: the
+  // bound is lower than for rgb888.
+  for (const Scene& base : enc::shared_scenes()) {
+    const Scene sc = enc::client_textures(base, TexFormat::rgb565);
+    enc::Image ref = enc::ref_render(sc).image;
+    for (size_t i = 0; i < ref.pixels.size(); ++i) {
+      const uint32_t v = ref.pixels[i];
+      const bool green = i % 3 == 1;
+      const uint32_t q = green ? (v * 253 + 505) >> 10 : (v * 249 + 1014) >> 11;
+      ref.pixels[i] = static_cast<uint8_t>(green ? (q << 2 | q >> 4) : (q << 3 | q >> 2));
+    }
+    const ClientScene cs(sc, TexFormat::rgb565);
+    ClientRenderSettings st;
+    st.format = PixelFormat::rgb565;
+    const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, st);
+    ASSERT_EQ(fr.status, Status::ok);
+    EXPECT_GE(enc::psnr(ref, fr.image), 40.0) << sc.name;
+  }
+}
+
+TEST(RenderAccuracy, PerPixelReciprocalWithinStatedBound) {
+  // -2^-31 <= y / (2^62 / (w << clz(w))) - 1 < 2^-18 over every table
+  // interval, sampled densely, and at the ends of the range.
+  std::vector<uint32_t> ws = {1, 2, 3, 0x7FFFFFFFu, 0x40000000u, 0x40000001u, 0x3FFFFFFFu};
+  for (uint32_t k = 0; k < 256; ++k)
+    for (uint32_t t = 0; t < (1u << 23); t += 9973) ws.push_back((1u << 31) + (k << 23) + t);
+  for (uint32_t w : ws) {
+    int z = 0;
+    const int32_t y = detail::span_reciprocal(w, &z);
+    ASSERT_EQ(z, __builtin_clz(w));
+    const long double exact = std::ldexp(1.0L, 62) / (static_cast<long double>(w) * std::ldexp(1.0L, z));
+    const long double rel = y / exact - 1;
+    ASSERT_LT(rel, std::ldexp(1.0L, -18)) << w;
+    ASSERT_GE(rel, -std::ldexp(1.0L, -31)) << w;
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Bands
+// ---------------------------------------------------------------------------
+TEST(RenderBands, AnyBandHeightAndCacheSizesGiveTheSameFrame) {
+  for (const Scene& base : {enc::make_cube_scene(), enc::make_room_scene(), enc::make_golden_scene()}) {
+    const ClientScene cs(base, TexFormat::rgb565);
+    for (PixelFormat of : {PixelFormat::rgb565, PixelFormat::rgb888}) {
+      std::vector<uint8_t> first;
+      for (int band : {1, 7, 16, 180}) {
+        for (uint32_t cache : {0u, 5u, 65536u}) {
+          ClientRenderSettings st;
+          st.format = of;
+          st.band_height = band;
+          st.vertex_cache = cache;
+          st.triangle_cache = cache == 5u ? 9u : cache;  // some triangles cached, some not
+          const ClientFrame fr = enc::render_client(cs, 240, 180, st);
+          ASSERT_EQ(fr.status, Status::ok);
+          if (first.empty()) {
+            first = fr.bytes;
+          } else {
+            ASSERT_EQ(fr.bytes, first) << base.name << " band " << band << " cache " << cache;
+          }
+        }
+      }
+    }
+  }
+}
+
+// Renders into a caller frame with guard rows and columns around it; the sink
+// checks at every band that rows not yet drawn still hold the sentinel and
+// rows of finished bands have not changed since.
+TEST(RenderBands, NothingIsWrittenOutsideTheCurrentBand) {
+  const Scene sc = enc::make_room_scene(120, 90);
+  const ClientScene cs(sc, TexFormat::xrgb8888);
+  for (PixelFormat of : {PixelFormat::rgb565, PixelFormat::rgb888}) {
+    for (uint16_t band : {1, 7, 16, 90}) {
+      const int w = 120, h = 90, bpp = bytes_per_pixel(of);
+      const int guard = 8;
+      const uint32_t stride = static_cast<uint32_t>((w + 2 * guard) * bpp);
+      std::vector<uint8_t> mem(static_cast<size_t>(h + 2 * guard) * stride, 0xA5);
+      uint8_t* frame = mem.data() + guard * stride + guard * bpp;
+      RenderConfig cfg;
+      cfg.width = w;
+      cfg.height = h;
+      cfg.band_height = band;
+      cfg.format = of;
+      cfg.depth = DepthFormat::d16;
+      cfg.target = frame;
+      cfg.target_stride = stride;
+      std::vector<uint8_t> ws(render_workspace_size(cfg));
+      Arena arena(ws.data(), ws.size());
+      Renderer r;
+      ASSERT_EQ(r.init(cfg, arena), Status::ok);
+      struct Check {
+        std::vector<uint8_t>* mem;
+        std::vector<uint8_t> done;  // copy of the frame after the last band
+        uint8_t* frame;
+        uint32_t stride;
+        int w, h, bpp, guard;
+        int expect_y = 0;
+        int failures = 0;
+      } ck{&mem, mem, frame, stride, w, h, bpp, guard};
+      auto sink = [](void* p, const Band& b) {
+        auto* c = static_cast<Check*>(p);
+        if (b.y != c->expect_y || b.pixels != c->frame + static_cast<size_t>(b.y) * c->stride) ++c->failures;
+        const size_t base = static_cast<size_t>(c->guard) * c->stride;
+        for (int row = -c->guard; row < c->h + c->guard; ++row) {
+          const size_t off = base + static_cast<ptrdiff_t>(row) * static_cast<ptrdiff_t>(c->stride);
+          for (uint32_t k = 0; k < c->stride; ++k) {
+            const bool in_band = row >= b.y && row < b.y + b.height && k >= static_cast<uint32_t>(c->guard * c->bpp) &&
+                                 k < static_cast<uint32_t>((c->guard + c->w) * c->bpp);
+            if (in_band) continue;
+            // Everything else equals its state after the previous band.
+            if ((*c->mem)[off + k] != c->done[off + k]) ++c->failures;
+          }
+        }
+        c->done = *c->mem;
+        c->expect_y = b.y + b.height;
+        return true;
+      };
+      ASSERT_EQ(r.render(cs.camera(), cs.list(), cs.clear_color(), sink, &ck), Status::ok);
+      EXPECT_EQ(ck.failures, 0) << "band " << band;
+      EXPECT_EQ(ck.expect_y, h);
+      // The guard area is untouched.
+      for (int row = 0; row < h + 2 * guard; ++row)
+        for (uint32_t k = 0; k < stride; ++k) {
+          const bool inside = row >= guard && row < guard + h && k >= static_cast<uint32_t>(guard * bpp) &&
+                              k < static_cast<uint32_t>((guard + w) * bpp);
+          if (!inside) ASSERT_EQ(mem[static_cast<size_t>(row) * stride + k], 0xA5);
+        }
+    }
+  }
+}
+
+TEST(RenderBands, SinkReturningFalseAborts) {
+  const ClientScene cs(enc::make_cube_scene(), TexFormat::rgb565);
+  RenderConfig cfg;
+  cfg.width = 240;
+  cfg.height = 180;
+  cfg.band_height = 16;
+  std::vector<uint8_t> ws(render_workspace_size(cfg));
+  Arena arena(ws.data(), ws.size());
+  Renderer r;
+  ASSERT_EQ(r.init(cfg, arena), Status::ok);
+  int calls = 0;
+  auto sink = [](void* p, const Band&) { return ++*static_cast<int*>(p) < 3; };
+  EXPECT_EQ(r.render(cs.camera(), cs.list(), 0, sink, &calls), Status::aborted);
+  EXPECT_EQ(calls, 3);
+}
+
+// ---------------------------------------------------------------------------
+// Clipping
+// ---------------------------------------------------------------------------
+// Texture coordinates are 24 texels per unit, or `uv_scale`: they must stay
+// within the Q16.16 range (+-32768 texels).
+Scene single_triangle(enc::Vec3d a, enc::Vec3d b, enc::Vec3d c, double uv_scale = 24, Cull cull = Cull::none) {
+  Scene s;
+  s.width = 160;
+  s.height = 120;
+  s.clear_color = 0x000000;
+  s.textures.push_back({});
+  s.textures[0].image = enc::make_checker_texture(64, 8, 0xF0E0D0, 0x304050);
+  enc::MeshD m;
+  m.shading = Shading::texture;
+  m.texture = 0;
+  m.cull = cull;
+  for (const enc::Vec3d& p : {a, b, c}) m.indices.push_back(s.add_vertex(p, {p.x * uv_scale + 7, p.z * uv_scale - 3}));
+  s.meshes.push_back(m);
+  s.camera = enc::CameraD::look_at({0, 1.5, 0}, {0, 0.5, 4}, {0, 1, 0}, 160, 120, 70, 0.25, 50);
+  return s;
+}
+
+void expect_matches_reference(const Scene& sc, double min_psnr) {
+  const Scene q = enc::client_textures(sc, TexFormat::xrgb8888);
+  const enc::RefFrame ref = enc::ref_render(q);
+  const ClientScene cs(q, TexFormat::xrgb8888);
+  ClientRenderSettings st;
+  for (int band : {1, 16, sc.height}) {
+    st.band_height = band;
+    const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, st);
+    ASSERT_EQ(fr.status, Status::ok);
+    EXPECT_GE(enc::psnr(ref.image, fr.image), min_psnr) << "band " << band;
+  }
+}
+
+TEST(RenderClip, TriangleBehindTheCameraDrawsNothing) {
+  const Scene sc = single_triangle({-1, 0, -3}, {1, 0, -3}, {0, 2, -2});
+  const ClientScene cs(sc, TexFormat::rgb565);
+  const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, {});
+  ASSERT_EQ(fr.status, Status::ok);
+  EXPECT_EQ(fr.stats.pixels, 0u);
+  for (uint8_t v : fr.image.pixels) ASSERT_EQ(v, 0);
+}
+
+TEST(RenderClip, NearPlaneAndGuardBandClippingMatchTheReference) {
+  // Crossing the near plane (one and two vertices behind the camera).
+  expect_matches_reference(single_triangle({-3, 0, -2}, {3, 0, -2}, {0, 0, 9}), 45);
+  expect_matches_reference(single_triangle({-3, 0, 6}, {3, 0, 6}, {0, 0.2, -5}), 45);
+  // Far beyond the guard band on both sides, and beyond the far plane.
+  expect_matches_reference(single_triangle({-4000, 0, 3}, {4000, 0, 3}, {0, 1, 200}, 4), 45);
+  // Vertex very close to the camera plane, off to the side.
+  expect_matches_reference(single_triangle({-8, 1.49, 0.001}, {2, 0, 5}, {-1, 3, 8}), 45);
+}
+
+TEST(RenderClip, RoomWithTheCameraAgainstAWall) {
+  Scene sc = enc::make_room_scene(160, 120);
+  sc.camera = enc::CameraD::look_at({-3.93, 1.2, 0.3}, {3.0, 0.9, 0.9}, {0, 1, 0}, 160, 120, 80, 0.05, 20);
+  expect_matches_reference(sc, 45);
+}
+
+// ---------------------------------------------------------------------------
+// Degenerate and hostile input
+// ---------------------------------------------------------------------------
+TEST(RenderDegenerate, ZeroAreaAndTinyTrianglesDrawNothing) {
+  Scene s;
+  s.width = 64;
+  s.height = 48;
+  enc::MeshD m;
+  m.shading = Shading::flat;
+  m.color = 0xFFFFFF;
+  m.cull = Cull::none;
+  auto tri = [&](enc::Vec3d a, enc::Vec3d b, enc::Vec3d c) {
+    for (const enc::Vec3d& p : {a, b, c}) m.indices.push_back(s.add_vertex(p));
+  };
+  tri({0, 0, 5}, {0, 0, 5}, {0, 0, 5});          // a point
+  tri({-1, -1, 5}, {0, 0, 5}, {1, 1, 5});        // collinear
+  tri({-1, 0, 5}, {1, 0, 5}, {1, 0, 5});         // two equal vertices
+  tri({-1, 0, 4}, {0, 0, 5}, {1, 0, 6});         // edge-on plane through the camera ray
+  // A sliver between pixel centres: covers no centre.
+  tri({0.001, 0.001, 5}, {0.004, 0.001, 5}, {0.001, 0.004, 5});
+  s.meshes.push_back(m);
+  s.camera = enc::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 64, 48, 60, 0.5, 50);
+  s.camera.cx = 32.25;  // pixel centres at +-1/4 pixel around the optical axis
+  s.camera.cy = 24.25;
+  const ClientScene cs(s, TexFormat::rgb565);
+  const ClientFrame fr = enc::render_client(cs, 64, 48, {});
+  ASSERT_EQ(fr.status, Status::ok);
+  EXPECT_EQ(fr.stats.pixels, 0u);
+}
+
+TEST(RenderDegenerate, HostileCoordinatesAreSafe) {
+  // Raw positions anywhere in Q16.16, around a valid camera: must not crash
+  // or trip the sanitizers; pictures are whatever the geometry gives.
+  std::mt19937 rng(99);
+  std::vector<Vec3<Q16_16>> pos(300);
+  const int32_t specials[] = {INT32_MIN, INT32_MAX, 0, 1, -1, 1 << 30, -(1 << 30), 65536, 6554};
+  for (auto& p : pos) {
+    auto pick = [&]() {
+      return (rng() & 3) == 0 ? specials[rng() % 9] : static_cast<int32_t>(rng());
+    };
+    p = {Q16_16::from_raw(pick()), Q16_16::from_raw(pick()), Q16_16::from_raw(pick())};
+  }
+  std::vector<uint16_t> idx(3 * 400);
+  for (auto& i : idx) i = static_cast<uint16_t>(rng() % pos.size());
+  std::vector<TexCoord> uvs(pos.size());
+  for (auto& t : uvs) t = {Q16_16::from_raw(static_cast<int32_t>(rng())), Q16_16::from_raw(static_cast<int32_t>(rng()))};
+  std::vector<uint32_t> cols(pos.size(), 0x123456);
+  std::vector<uint16_t> tex(17 * 9, 0x7BEF);
+  Texture t;
+  t.width = 16;
+  t.height = 8;
+  t.stride = 17;
+  t.texels = tex.data();
+  t.address = TexAddress::repeat;
+  Texture tc = t;
+  tc.address = TexAddress::clamp;
+  tc.apron = true;
+  Mesh meshes[5];
+  for (int k = 0; k < 5; ++k) {
+    meshes[k].indices = idx.data() + k * 240;
+    meshes[k].num_triangles = 80;
+    meshes[k].cull = Cull::none;
+    meshes[k].uvs = uvs.data();
+    meshes[k].colors = cols.data();
+    meshes[k].texture = (k & 1) ? &t : &tc;
+  }
+  meshes[0].shading = Shading::flat;
+  meshes[1].shading = Shading::gouraud;
+  meshes[2].shading = Shading::texture;
+  meshes[3].shading = Shading::texture;
+  meshes[3].filter = Filter::nearest;
+  meshes[4].shading = Shading::view_mapped;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) meshes[4].view_map.m[i][j] = static_cast<int32_t>(rng());
+  DrawList list{pos.data(), static_cast<uint32_t>(pos.size()), meshes, 5};
+  const Camera cam = enc::to_client(enc::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 80, 60, 60, 0.01, 40));
+  for (PixelFormat of : {PixelFormat::rgb565, PixelFormat::rgb888}) {
+    for (DepthFormat df : {DepthFormat::d16, DepthFormat::d32}) {
+      RenderConfig cfg;
+      cfg.width = 80;
+      cfg.height = 60;
+      cfg.band_height = 13;
+      cfg.format = of;
+      cfg.depth = df;
+      cfg.vertex_cache = 100;
+      std::vector<uint8_t> ws(render_workspace_size(cfg));
+      Arena arena(ws.data(), ws.size());
+      Renderer r;
+      ASSERT_EQ(r.init(cfg, arena), Status::ok);
+      EXPECT_EQ(r.render(cam, list, 0, [](void*, const Band&) { return true; }, nullptr), Status::ok);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// API and validation
+// ---------------------------------------------------------------------------
+TEST(RenderApi, ValidationStatuses) {
+  RenderConfig cfg;
+  cfg.width = 64;
+  cfg.height = 48;
+  cfg.band_height = 8;
+  EXPECT_GT(render_workspace_size(cfg), 0u);
+  std::vector<uint8_t> ws(render_workspace_size(cfg));
+  {
+    RenderConfig bad = cfg;
+    bad.band_height = 0;
+    Arena a(ws.data(), ws.size());
+    Renderer r;
+    EXPECT_EQ(r.init(bad, a), Status::invalid_argument);
+    EXPECT_EQ(render_workspace_size(bad), 0u);
+    bad = cfg;
+    bad.width = 4096;
+    EXPECT_EQ(r.init(bad, a), Status::invalid_argument);
+  }
+  {
+    Arena small(ws.data(), ws.size() - 64);
+    Renderer r;
+    EXPECT_EQ(r.init(cfg, small), Status::workspace_too_small);
+  }
+  Arena a(ws.data(), ws.size());
+  Renderer r;
+  const Camera cam = enc::to_client(enc::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 64, 48, 60, 0.5, 50));
+  auto sink = [](void*, const Band&) { return true; };
+  DrawList empty{};
+  EXPECT_EQ(r.render(cam, empty, 0, sink, nullptr), Status::invalid_argument);  // not initialised
+  ASSERT_EQ(r.init(cfg, a), Status::ok);
+  EXPECT_EQ(r.render(cam, empty, 0, sink, nullptr), Status::ok);
+  EXPECT_EQ(r.render(cam, empty, 0, nullptr, nullptr), Status::invalid_argument);  // no sink, no target
+  Camera bad_cam = cam;
+  bad_cam.near_z = Q16_16::from_raw(0);
+  EXPECT_EQ(r.render(bad_cam, empty, 0, sink, nullptr), Status::invalid_argument);
+  bad_cam = cam;
+  bad_cam.far_z = Q16_16::from_raw(cam.near_z.raw() * 5000);
+  EXPECT_EQ(r.render(bad_cam, empty, 0, sink, nullptr), Status::invalid_argument);
+
+  Vec3<Q16_16> pos[3] = {};
+  uint16_t idx[3] = {0, 1, 3};
+  Mesh m;
+  m.indices = idx;
+  m.num_triangles = 1;
+  DrawList list{pos, 3, &m, 1};
+  EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::malformed);  // index 3 >= 3
+  idx[2] = 2;
+  EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::ok);
+  m.shading = Shading::texture;
+  EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::malformed);  // no uvs, no texture
+  TexCoord uv[3] = {};
+  m.uvs = uv;
+  uint16_t texel = 0;
+  Texture t;
+  t.width = 1;
+  t.height = 1;
+  t.stride = 1;
+  t.texels = &texel;
+  m.texture = &t;
+  EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::ok);
+  t.stride = 0;
+  EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::invalid_argument);
+  t.stride = 1;
+  t.apron = true;  // needs stride >= 2
+  EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::invalid_argument);
+  EXPECT_EQ(texture_fill_apron(t, &texel), Status::invalid_argument);
+  t.apron = false;
+  m.shading = static_cast<Shading>(9);
+  EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::invalid_argument);
+}
+
+TEST(RenderApi, ApronAndPlainTexturesGiveTheSameFrame) {
+  for (const Scene& base : {enc::make_cube_scene(), enc::make_golden_scene()}) {
+    for (TexFormat tf : {TexFormat::rgb565, TexFormat::xrgb8888}) {
+      const ClientScene with(base, tf, true), without(base, tf, false);
+      for (PixelFormat of : {PixelFormat::rgb565, PixelFormat::rgb888}) {
+        ClientRenderSettings st;
+        st.format = of;
+        const ClientFrame a = enc::render_client(with, 240, 180, st);
+        const ClientFrame b = enc::render_client(without, 240, 180, st);
+        ASSERT_EQ(a.status, Status::ok);
+        EXPECT_EQ(a.bytes, b.bytes) << base.name << " " << tex_name(tf);
+      }
+    }
+  }
+}
+
+TEST(RenderApi, BandRenderingOf240x180In16LineBandsFitsIn16KiB) {
+  RenderConfig cfg;
+  cfg.width = 240;
+  cfg.height = 180;
+  cfg.band_height = 16;
+  cfg.format = PixelFormat::rgb565;
+  cfg.depth = DepthFormat::d16;
+  cfg.vertex_cache = 0;
+  const size_t total = render_workspace_size(cfg) + sizeof(Renderer);
+  EXPECT_LE(total, 16384u) << "workspace " << render_workspace_size(cfg) << " + Renderer " << sizeof(Renderer);
+  // And it really renders in exactly that much workspace.
+  std::vector<uint8_t> ws(render_workspace_size(cfg));
+  Arena a(ws.data(), ws.size());
+  Renderer r;
+  ASSERT_EQ(r.init(cfg, a), Status::ok);
+  const ClientScene cs(enc::make_room_scene(), TexFormat::rgb565);
+  EXPECT_EQ(r.render(cs.camera(), cs.list(), 0, [](void*, const Band&) { return true; }, nullptr), Status::ok);
+}
+
+// ---------------------------------------------------------------------------
+// Golden checksums: the golden scene is built with exact arithmetic only, so
+// these values hold for every correct build; the Cortex-M4 run
+// (bench/run_render.sh) must reproduce them. Changing the renderer's
+// arithmetic changes them on purpose: update them in the same change.
+// ---------------------------------------------------------------------------
+TEST(RenderGolden, FrameChecksums) {
+  const Scene sc = enc::make_golden_scene();
+  struct G {
+    TexFormat tex;
+    PixelFormat out;
+    DepthFormat depth;
+    int band;
+    uint32_t crc;
+  };
+  const G golden[] = {
+      {TexFormat::rgb565, PixelFormat::rgb565, DepthFormat::d16, 16, 0x65e743a9u},
+      {TexFormat::xrgb8888, PixelFormat::rgb888, DepthFormat::d32, 180, 0x078975ceu},
+      {TexFormat::ycbcr420, PixelFormat::rgb888, DepthFormat::d16, 7, 0xb09d0f47u},
+  };
+  for (const G& g : golden) {
+    const ClientScene cs(enc::client_textures(sc, g.tex), g.tex);
+    ClientRenderSettings st;
+    st.format = g.out;
+    st.depth = g.depth;
+    st.band_height = g.band;
+    const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, st);
+    ASSERT_EQ(fr.status, Status::ok);
+    EXPECT_EQ(crc32c(fr.bytes.data(), fr.bytes.size()), g.crc) << tex_name(g.tex) << std::hex;
+  }
+}
+
+}  // namespace
+}  // namespace vds
