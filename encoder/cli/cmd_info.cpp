@@ -8,6 +8,7 @@
 
 #include "commands.h"
 #include "vds/container.h"
+#include "vds/enc/mesh_encoder.h"
 #include "vds/enc/stream_writer.h"
 
 namespace vds::cli {
@@ -31,6 +32,7 @@ struct Collector {
   StreamParser* parser = nullptr;
   std::vector<ChunkRow> rows;
   std::vector<std::string> meta;
+  enc::MeshChunkSummary mesh;  // progressive mesh chunks: the per-level table
 };
 
 const char* mode_name(StreamMode m) {
@@ -69,6 +71,11 @@ void run_info(const InfoOptions& o) {
     if (type == chunk::kMeta) {
       c->meta.emplace_back(reinterpret_cast<const char*>(payload), size);
       row.note = "metadata";
+      c->rows.push_back(row);
+      return ChunkResult::consumed;
+    }
+    if (c->mesh.add(type, payload, size)) {
+      row.note = "progressive mesh";
       c->rows.push_back(row);
       return ChunkResult::consumed;
     }
@@ -112,6 +119,7 @@ void run_info(const InfoOptions& o) {
       std::printf("    %10" PRIu64 "  %-6s %10" PRIu32 "  %s\n", r.offset, enc::fourcc_name(r.type).c_str(), r.size,
                   r.note.c_str());
   }
+  if (!col.mesh.empty()) std::printf("%s", col.mesh.table().c_str());
   for (const std::string& m : col.meta) {
     size_t start = 0;
     while (start < m.size()) {

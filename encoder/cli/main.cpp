@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   vds::cli::add_info(app);
   vds::cli::add_pack(app);
   vds::cli::add_serve(app);
+  vds::cli::add_encode_mesh(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,372 @@
+// vds client library: progressive mesh decoder (Qin, Liu, Bao, Peng,
+// "Progressive geometry compression of meshes", 2002): a base mesh, then
+// levels of vertex splits whose removed vertices form an independent set,
+// each level coded as its split vertices (in index order), the split shapes
+// and the position corrections from a predictor. The stream format is in
+// docs/stream-format.md ("Progressive mesh chunks"), the algorithms in
+// docs/mesh-codec.md.
+//
+// Everything lives in the caller's workspace: positions are integers on the
+// stream's quantisation grid (0 .. 2^bits - 1 per axis), the connectivity a
+// corner table (Rossignac's "Corner Table", 2001): three vertex indices and
+// three opposite corners per triangle. After each complete level the arrays
+// hold a valid mesh the renderer can draw.
+//
+// MeshState is the mesh and its operations (ring walk, vertex split, the
+// predictors and the split ranking); the host encoder runs the same code to
+// reconstruct exactly what the client sees. MeshDecoder reads the chunks.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include "vds/arena.h"
+#include "vds/arith.h"
+#include "vds/bitreader.h"
+#include "vds/config.h"
+#include "vds/container.h"
+#include "vds/huffman.h"
+#include "vds/status.h"
+
+namespace vds {
+
+namespace chunk {
+constexpr uint32_t kMeshHeader = fourcc('M', 'S', 'H', 'H');  // mesh codec parameters, once, before MSHB
+constexpr uint32_t kMeshBase = fourcc('M', 'S', 'H', 'B');    // base mesh (one or more chunks)
+constexpr uint32_t kMeshLevel = fourcc('M', 'S', 'H', 'L');   // one refinement level (one or more chunks)
+}  // namespace chunk
+
+constexpr uint8_t kMeshCodecVersion = 1;
+// Largest vertex degree (ring size) the decoder handles; the stream's
+// MSHH declares its own maximum and is refused above this.
+constexpr uint32_t kMeshMaxDegree = VDS_CONFIG_MESH_MAX_DEGREE;
+constexpr uint32_t kMeshNone = 0xFFFFFFFFu;
+// Face elongation score offset, Q4 log2 units: 26/16 = 1.625, a squared
+// length ratio of about 3.1, between a well-shaped face (sides at the apex
+// against the base 2 : 1, log2 = 1) and one whose apex moved by about an
+// edge length (about 5 : 1, log2 = 2.3).
+constexpr int32_t kMeshElongationBias = 26;
+// Q4 log2 of x (16 per octave, linear between powers of two); 0 for 0.
+int32_t mesh_log2_q4(uint64_t x);
+
+enum class MeshCoder : uint8_t {
+  huffman = 0,  // the paper's coding: per-level canonical Huffman tables, sent as unary length deltas
+  arith = 1,    // context-adaptive binary arithmetic coding (vds/arith.h) with geometric contexts
+};
+
+enum class MeshPredictor : uint8_t {
+  laplacian = 0,      // the paper's eq. 13: w = 1/m Σ (u_j + L(u_j))
+  parallelogram = 1,  // ring centroid moved toward the mean parallelogram prediction by a per-level weight
+};
+
+// MSHH payload (docs/stream-format.md).
+struct MeshHeader {
+  uint8_t version = kMeshCodecVersion;
+  MeshCoder coder = MeshCoder::arith;
+  MeshPredictor predictor = MeshPredictor::parallelogram;
+  uint8_t bits = 10;        // quantisation bits per axis, 2..16
+  uint16_t levels = 0;      // refinement levels after the base
+  uint16_t max_degree = 0;  // largest ring while decoding, 3..kMeshMaxDegree
+  uint32_t base_vertices = 0;
+  uint32_t base_triangles = 0;
+  uint32_t vertices = 0;    // after the last level
+  uint32_t triangles = 0;
+  // Model-space placement, informative for hosts: position = origin + q·step
+  // as IEEE-754 binary32 bit patterns. The client never interprets them.
+  uint32_t origin_f32[3] = {0, 0, 0};
+  uint32_t step_f32 = 0;
+};
+constexpr uint32_t kMeshHeaderBytes = 40;
+void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderBytes]);
+Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out);
+
+// LEB128 unsigned varints as used in the mesh chunk headers (at most 5
+// bytes; overlong or > 32-bit encodings are malformed).
+Status read_varint(const uint8_t*& p, const uint8_t* end, uint32_t* out);
+
+// How a vertex split divides the split vertex u's fan (docs/mesh-codec.md,
+// "Vertex splits on the client"). The ring r_0..r_{d-1} of u runs counter-clockwise from
+// the corner MeshState keeps for u; for a boundary vertex it is the path
+// from one boundary neighbour to the other and has d - 1 faces. Faces
+// first .. first + count - 1 (modulo d for an interior u) move to the new
+// vertex v.
+enum class SplitKind : uint8_t {
+  interior = 0,  // v interior: wings F = r_first, L = r_{first+count}; two new faces
+  tail = 1,      // v on the boundary after u (boundary u only): F = r_first, count = d - 1 - first; one new face
+  head = 2,      // v on the boundary before u (boundary u only): first = 0, L = r_count; one new face
+};
+struct SplitChoice {
+  SplitKind kind = SplitKind::interior;
+  uint32_t first = 0;
+  uint32_t count = 0;
+};
+
+// The ring of a vertex as MeshState::ring() returns it.
+struct Ring {
+  uint32_t degree = 0;     // ring vertices
+  bool boundary = false;
+  uint32_t* vertex = nullptr;  // r_0 .. r_{degree-1}
+  uint32_t* corner = nullptr;  // corner of the vertex in face j (degree faces, degree - 1 on the boundary)
+  uint32_t faces() const { return boundary ? degree - 1 : degree; }
+};
+
+class MeshState {
+ public:
+  // Workspace for a mesh of up to max_vertices / max_triangles, alignment included.
+  static size_t workspace_bytes(uint32_t max_vertices, uint32_t max_triangles);
+
+  Status init(Arena& arena, uint32_t max_vertices, uint32_t max_triangles);
+  // Forgets the mesh (keeps the storage).
+  void clear(int bits);
+
+  // --- Building the base mesh -------------------------------------------------
+  Status add_vertex(const int32_t p[3]);
+  Status add_triangle(uint32_t a, uint32_t b, uint32_t c);
+  // Builds the opposite corners and checks the base is an oriented manifold
+  // (each edge in one face, or in two in opposite directions; one fan per
+  // vertex; degrees within max_degree): malformed otherwise. Uses scratch
+  // from `arena` (4 bytes per corner) and gives it back.
+  Status finish_base(Arena& arena, uint32_t max_degree);
+
+  // --- Queries ------------------------------------------------------------------
+  uint32_t vertex_count() const { return nv_; }
+  uint32_t triangle_count() const { return nt_; }
+  int bits() const { return bits_; }
+  const uint16_t* positions() const { return pos_; }  // x, y, z per vertex
+  const uint32_t* triangles() const { return corner_vertex_; }
+  const int32_t* opposites() const { return opposite_; }
+  uint32_t vertex_corner(uint32_t v) const { return vertex_corner_[v]; }
+  void position(uint32_t v, int32_t out[3]) const {
+    out[0] = pos_[3 * v];
+    out[1] = pos_[3 * v + 1];
+    out[2] = pos_[3 * v + 2];
+  }
+  // Sets a position; invalid_argument outside 0 .. 2^bits - 1.
+  Status set_position(uint32_t v, const int32_t p[3]);
+
+  // Ring of x into the state's scratch A (valid until the next ring() into
+  // the same scratch). malformed if the walk exceeds max_degree.
+  Status ring(uint32_t x, Ring* out, int scratch = 0);
+
+  // --- Vertex split ---------------------------------------------------------------
+  // Checks the choice against u's ring (malformed if impossible) and splits:
+  // the new vertex gets index vertex_count() (position 0 until set), new
+  // faces are appended (A = (v, L, u) then B = (v, u, F)).
+  Status split(uint32_t u, const SplitChoice& choice, uint32_t* new_vertex);
+  // The number of valid choices of each kind for a ring (for range checks).
+  static bool choice_valid(const Ring& r, const SplitChoice& c);
+
+  // --- Prediction -----------------------------------------------------------------
+  // Predicted position of v from its ring (all ring positions known, v's
+  // own ignored). `weight_q4` is the parallelogram weight (0..16 sixteenths).
+  Status predict(uint32_t v, MeshPredictor predictor, int weight_q4, int32_t out[3]);
+
+  // Split ranking on this mesh (mesh_candidate_scores).
+  uint32_t candidate_scores(const Ring& r, uint32_t u, SplitKind kind, uint32_t count, int64_t* score) const;
+  // Face elongation scores of u's fan (mesh_face_llr).
+  void face_llr(const Ring& r, uint32_t u, int32_t* llr) const;
+
+  uint32_t max_degree() const { return max_degree_; }
+  // Largest ring seen by ring() since clear() (the encoder declares it).
+  uint32_t max_degree_seen() const { return max_degree_seen_; }
+
+ private:
+  uint32_t next(uint32_t c) const { return c % 3 == 2 ? c - 2 : c + 1; }
+  uint32_t prev(uint32_t c) const { return c % 3 == 0 ? c + 2 : c - 1; }
+  void fix_vertex_corner(uint32_t x, uint32_t any_corner);
+  void link(int32_t a, int32_t b) {
+    if (a >= 0) opposite_[a] = b;
+    if (b >= 0) opposite_[b] = a;
+  }
+
+  uint16_t* pos_ = nullptr;
+  uint32_t* vertex_corner_ = nullptr;
+  uint32_t* corner_vertex_ = nullptr;
+  int32_t* opposite_ = nullptr;
+  uint32_t cap_v_ = 0, cap_t_ = 0;
+  uint32_t nv_ = 0, nt_ = 0;
+  int bits_ = 0;
+  uint32_t max_degree_ = kMeshMaxDegree;
+  uint32_t max_degree_seen_ = 0;
+  // Two ring scratches of kMeshMaxDegree + 1 entries (the Laplacian
+  // predictor walks the rings of ring vertices).
+  uint32_t* ring_vertex_[2] = {nullptr, nullptr};
+  uint32_t* ring_corner_[2] = {nullptr, nullptr};
+};
+
+// --- Split ranking (docs/mesh-codec.md, "Split ranking") ------------------------
+// Smaller score = likelier. Positions are x, y, z per vertex; `r` needs only
+// vertex, degree and boundary. Each candidate predicts v at the centroid of
+// its ring and scores the squared offset of u from the centroid of u's new
+// ring. mesh_candidate_scores: kind interior -> one score per valid `first`
+// for the given count; tail -> one per `first`; head -> one per `count`.
+// `common_scale` puts scores of different counts on one scale (Q4 offsets).
+// Writes at most kMeshMaxDegree scores and returns how many.
+uint32_t mesh_candidate_scores(const uint16_t* pos, const Ring& r, uint32_t u, SplitKind kind, uint32_t count,
+                               int64_t* score, bool common_scale = false);
+
+// --- Context modelling shared by the decoder and the encoder -------------------
+
+// Arithmetic-coder contexts of the mesh codec, one flat array (the encoder
+// records context indices and replays them); reset at MSHH. Groups:
+//   mark      split flag: degree class x earlier split neighbours x edge-length ratio class
+//   kind      boundary split vertex: interior / boundary new vertex, then tail / head
+//   arc       arc length (faces moving to the new vertex), by degree class, one per unary bin
+//   rank      rank of the true rotation among the candidates, by candidate count, per unary bin
+//   edge_rank the same for tail / head splits
+//   geo_zero  position correction is zero, by role (normal axis, tangent axes) x scale class
+//   geo_mag   its magnitude, by role x scale class, per unary bin
+//   base_*    base mesh: coordinate deltas, new-vertex flags, back references
+struct MeshContexts {
+  static constexpr uint32_t kMarkDegree = 7, kMarkNeighbours = 3, kMarkShape = 4;
+  static constexpr uint32_t kArcDegree = 10, kArcBins = 8;
+  static constexpr uint32_t kRankBins = 6, kRankClasses = 6;
+  static constexpr uint32_t kGeoRoles = 2, kGeoScales = 12, kGeoMagBins = 12;
+  static constexpr uint32_t kBaseMagBins = 12;
+
+  static constexpr uint32_t kMark = 0;
+  static constexpr uint32_t kKind = kMark + kMarkDegree * kMarkNeighbours * kMarkShape;
+  static constexpr uint32_t kArc = kKind + 2;
+  static constexpr uint32_t kRank = kArc + kArcDegree * kArcBins;
+  static constexpr uint32_t kEdgeRank = kRank + kRankClasses * kRankBins;
+  static constexpr uint32_t kGeoZero = kEdgeRank + kRankBins;
+  static constexpr uint32_t kGeoMag = kGeoZero + kGeoRoles * kGeoScales;
+  static constexpr uint32_t kBaseZero = kGeoMag + kGeoRoles * kGeoScales * kGeoMagBins;
+  static constexpr uint32_t kBaseMag = kBaseZero + 3;
+  static constexpr uint32_t kBaseNew = kBaseMag + 3 * kBaseMagBins;
+  static constexpr uint32_t kBaseRef = kBaseNew + 3;
+  static constexpr uint32_t kCount = kBaseRef + kBaseMagBins;
+
+  static constexpr uint32_t arc(uint32_t degree_class) { return kArc + degree_class * kArcBins; }
+  // Rotation rank contexts by the number of candidates n.
+  static constexpr uint32_t rank(uint32_t n) {
+    return kRank + (n <= 4 ? 0 : (n >= 9 ? kRankClasses - 1 : n - 4)) * kRankBins;
+  }
+  static constexpr uint32_t geo_zero(uint32_t role, uint32_t scale) { return kGeoZero + role * kGeoScales + scale; }
+  static constexpr uint32_t geo_mag(uint32_t role, uint32_t scale) {
+    return kGeoMag + (role * kGeoScales + scale) * kGeoMagBins;
+  }
+  static constexpr uint32_t base_mag(uint32_t axis) { return kBaseMag + axis * kBaseMagBins; }
+
+  ArithContext c[kCount];
+  void reset();
+};
+
+// Context of the split flag of vertex x (marks: bit per vertex, set for the
+// vertices before x that are split in this level). `ring` is x's ring.
+uint32_t mesh_mark_context(const MeshState& s, uint32_t x, const Ring& ring, const uint8_t* marks);
+// Geometry frame of a new vertex: which axis is closest to its ring's
+// normal, the normal's sign on it, and a scale class from the ring size.
+struct GeoFrame {
+  int normal_axis = 2;
+  bool flip = false;
+  uint32_t scale = 0;
+};
+GeoFrame mesh_geo_frame(const MeshState& s, uint32_t v, const Ring& ring);
+// Binarisation parameters shared with the encoder (docs/mesh-codec.md).
+constexpr uint32_t kMeshGeoCutoff = 12;  // position corrections: decode_signed(cutoff, k)
+constexpr int kMeshGeoEgK = 1;
+constexpr uint32_t kMeshBaseDeltaCutoff = 8;  // base coordinate deltas
+constexpr int kMeshBaseDeltaEgK = 2;
+constexpr uint32_t kMeshBaseRefCutoff = 8;  // base back references
+constexpr int kMeshBaseRefEgK = 2;
+// Huffman coder alphabets.
+constexpr uint32_t kMeshHuffEscape = 63;          // delta / correction symbols 0..62, 63 = escape + Exp-Golomb
+constexpr uint32_t kMeshHuffDeltaAlphabet = 64;
+constexpr uint32_t kMeshHuffGeoAlphabet = 64;
+constexpr uint32_t kMeshHuffShapeAlphabet = kMeshMaxDegree + 1;  // 0 tail, 1..max-1 arc length, max head
+constexpr uint32_t kMeshHuffPosAlphabet = kMeshMaxDegree;
+
+// --- Decoder ---------------------------------------------------------------------
+
+// Per-level numbers as decoded (for statistics and the renderer).
+struct MeshLevelInfo {
+  uint32_t level = 0;
+  uint32_t vertices_added = 0;
+  uint32_t triangles_added = 0;
+  uint32_t connectivity_bytes = 0;  // entropy-coded payload bytes, both substreams
+  uint32_t geometry_bytes = 0;
+};
+
+class MeshDecoder {
+ public:
+  // Workspace for streams of up to max_vertices / max_triangles (HEAD's
+  // budgets) whose base mesh has up to max_base_triangles (scratch used once
+  // to connect the base) with the given coder (Huffman adds its tables).
+  // An encoder writes this into HEAD.workspace_bytes.
+  static size_t workspace_bytes(uint32_t max_vertices, uint32_t max_triangles, uint32_t max_base_triangles,
+                                MeshCoder coder);
+
+  // Carves the mesh, the contexts and the split flags from `arena`; the
+  // Huffman tables and the base scratch are carved when MSHH / the base
+  // arrive (workspace_too_small then if the arena cannot hold them).
+  Status init(Arena& arena, uint32_t max_vertices, uint32_t max_triangles);
+
+  // True for the chunk types this decoder consumes.
+  static bool handles(uint32_t type) {
+    return type == chunk::kMeshHeader || type == chunk::kMeshBase || type == chunk::kMeshLevel;
+  }
+  // Consumes one verified chunk payload (MSHH, then MSHB chunks, then MSHL
+  // chunks level by level). The first error is latched and returned again.
+  Status consume(uint32_t type, const uint8_t* payload, uint32_t size);
+  // ok once every level of the header is in; truncated before that.
+  Status finish() const;
+
+  Status status() const { return status_; }
+  bool have_header() const { return have_header_; }
+  const MeshHeader& header() const { return header_; }
+  // The base is complete: the arrays hold a drawable mesh.
+  bool drawable() const { return base_done_; }
+  // Complete levels applied after the base.
+  uint32_t levels_done() const { return levels_done_; }
+  bool complete() const { return base_done_ && levels_done_ == header_.levels; }
+  const MeshState& mesh() const { return mesh_; }
+  // Numbers of the level completed last (level 0 = the base).
+  const MeshLevelInfo& last_level() const { return last_; }
+
+ private:
+  Status fail(Status s) {
+    if (status_ == Status::ok) status_ = s;
+    return status_;
+  }
+  Status on_header(const uint8_t* p, uint32_t size);
+  Status on_base(const uint8_t* p, uint32_t size);
+  Status on_level(const uint8_t* p, uint32_t size);
+  Status base_items(const uint8_t* data, uint32_t size, uint32_t first, uint32_t count);
+  Status level_items(const uint8_t* conn, uint32_t conn_size, const uint8_t* geom, uint32_t geom_size,
+                     uint32_t first, uint32_t count);
+  Status read_table(BitReader& br, HuffmanTable& table, uint32_t alphabet_max);
+  Status decode_split_arith(ArithDecoder& ad, uint32_t u, SplitChoice* ch);
+  Status decode_split_huffman(BitReader& br, uint32_t u, SplitChoice* ch);
+  Status decode_position_arith(ArithDecoder& ad, uint32_t v);
+  Status decode_position_huffman(BitReader& br, uint32_t v);
+  void start_level();
+
+  Arena* arena_ = nullptr;
+  MeshState mesh_;
+  MeshContexts* ctx_ = nullptr;
+  uint8_t* marks_ = nullptr;    // one bit per vertex: split vertices of the current level
+  uint8_t* lengths_ = nullptr;  // code lengths while a Huffman table is read
+  HuffmanTable huff_delta_, huff_shape_, huff_pos_, huff_geo_;
+  uint32_t cap_v_ = 0, cap_t_ = 0;
+  MeshHeader header_{};
+  Status status_ = Status::invalid_argument;
+  bool have_header_ = false;
+  bool base_done_ = false;
+  uint32_t base_items_ = 0;  // base items decoded
+  uint32_t base_next_ = 0;   // next base vertex a triangle may introduce
+  uint32_t levels_done_ = 0;
+  // The level being decoded.
+  bool in_level_ = false;
+  uint32_t items_ = 0;        // items decoded in this level
+  uint32_t pass_a_ = 0;       // items of pass A (split flags or index deltas)
+  uint32_t dv_ = 0, dt_ = 0;  // declared vertices and triangles added
+  uint32_t old_v_ = 0, old_t_ = 0;
+  uint32_t marked_ = 0;       // split vertices found in pass A
+  uint32_t last_mark_ = 0;    // Huffman: previous split vertex index
+  uint32_t cursor_ = 0;       // pass B: next vertex to test for a split flag
+  int weight_q4_ = 0;
+  MeshLevelInfo last_{};
+  MeshLevelInfo cur_{};
+};
+
+}  // namespace vds

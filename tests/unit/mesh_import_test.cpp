@@ -1,0 +1,229 @@
+// Mesh import and repair: each rule of vds/enc/mesh_import.h on a small
+// hand-made case with the exact counts it must report, a property test on
+// random triangle soups (the result is always manifold, never a throw), and
+// file round trips through assimp (OBJ, PLY) and libdraco (.drc).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <string>
+
+#include "mesh_test_meshes.h"
+#include "vds/enc/mesh_import.h"
+#include "vds/enc/stream_writer.h"
+
+namespace {
+
+using vds::enc::check_manifold;
+using vds::enc::Mesh;
+using vds::enc::MeshRepairReport;
+using vds::enc::repair_mesh;
+
+size_t count_boundary_edges(const Mesh& m) {
+  std::vector<std::pair<uint32_t, uint32_t>> e;
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) e.emplace_back(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
+  std::sort(e.begin(), e.end());
+  size_t n = 0;
+  for (size_t i = 0; i < e.size(); ++i) {
+    const bool prev = i > 0 && e[i] == e[i - 1];
+    const bool next = i + 1 < e.size() && e[i] == e[i + 1];
+    if (!prev && !next) ++n;
+  }
+  return n;
+}
+
+TEST(MeshImport, CleanMeshIsUnchanged) {
+  const Mesh g = vds::test::grid_mesh(6, 5);
+  MeshRepairReport r;
+  const Mesh m = repair_mesh(g, &r);
+  EXPECT_FALSE(r.repaired());
+  EXPECT_EQ(r.welded_vertices, 0u);
+  EXPECT_EQ(m.positions, g.positions);
+  EXPECT_EQ(m.triangles, g.triangles);
+  EXPECT_EQ(r.boundary_edges, 2u * (5 + 4));
+  EXPECT_EQ(r.components, 1u);
+  EXPECT_EQ(check_manifold(m), "");
+}
+
+TEST(MeshImport, WeldsIdenticalPositionsOnly) {
+  // Two triangles as a soup: six vertices, two pairs at identical positions
+  // (one written as -0.0), and one vertex a hair away that must stay.
+  Mesh s;
+  s.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 0, 0}, {1, 1, 0}, {-0.0, 1, 0}, {1e-12, 0, 0}};
+  s.triangles = {{0, 1, 2}, {3, 4, 5}, {6, 4, 1}};
+  MeshRepairReport r;
+  const Mesh m = repair_mesh(s, &r);
+  EXPECT_EQ(r.welded_vertices, 2u);
+  EXPECT_EQ(m.positions.size(), 5u);
+  EXPECT_EQ(m.triangles.size(), 3u);
+  EXPECT_EQ(check_manifold(m), "");
+}
+
+TEST(MeshImport, DropsDegenerateAndDuplicateFaces) {
+  Mesh s = vds::test::grid_mesh(3, 3);
+  s.triangles.push_back({0, 0, 1});                                               // repeated index
+  s.triangles.push_back(s.triangles[0]);                                          // duplicate
+  s.triangles.push_back({s.triangles[1][2], s.triangles[1][1], s.triangles[1][0]});  // reversed duplicate
+  s.positions.push_back(s.positions[4]);                                          // weld makes the next degenerate
+  s.triangles.push_back({4, 8, 9});
+  MeshRepairReport r;
+  const Mesh m = repair_mesh(s, &r);
+  EXPECT_EQ(r.degenerate_faces, 2u);
+  EXPECT_EQ(r.duplicate_faces, 2u);
+  EXPECT_EQ(r.welded_vertices, 1u);
+  EXPECT_EQ(m.triangles.size(), 8u);
+  EXPECT_EQ(check_manifold(m), "");
+}
+
+TEST(MeshImport, CutsNonManifoldEdge) {
+  // Three triangles on edge (0, 1): a "book" with three pages.
+  Mesh s;
+  s.positions = {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, -1, 0}, {0.5, 0, 1}};
+  s.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  MeshRepairReport r;
+  const Mesh m = repair_mesh(s, &r);
+  EXPECT_EQ(r.non_manifold_edges, 1u);
+  EXPECT_EQ(r.dropped_faces, 0u);
+  EXPECT_EQ(m.triangles.size(), 3u);
+  // Every page keeps its own copy of the edge's two vertices: 3 x 2 + 3 apexes.
+  EXPECT_EQ(m.positions.size(), 9u);
+  EXPECT_EQ(r.split_vertices, 4u);
+  EXPECT_EQ(r.components, 3u);
+  EXPECT_EQ(count_boundary_edges(m), 9u);
+  EXPECT_EQ(check_manifold(m), "");
+}
+
+TEST(MeshImport, SplitsNonManifoldVertex) {
+  // Two fans meeting in one vertex (a bow tie).
+  Mesh s;
+  s.positions = {{0, 0, 0}, {1, 0.5, 0}, {1, -0.5, 0}, {-1, 0.5, 0}, {-1, -0.5, 0}};
+  s.triangles = {{0, 2, 1}, {0, 3, 4}};
+  MeshRepairReport r;
+  const Mesh m = repair_mesh(s, &r);
+  EXPECT_EQ(r.split_vertices, 1u);
+  EXPECT_EQ(r.non_manifold_edges, 0u);
+  EXPECT_EQ(m.positions.size(), 6u);
+  EXPECT_EQ(m.positions[5], s.positions[0]);  // the copy keeps the position
+  EXPECT_EQ(check_manifold(m), "");
+}
+
+TEST(MeshImport, CutsOrientationConflict) {
+  // Two faces on edge (0, 1) in the same direction: cut apart, no face lost.
+  Mesh s;
+  s.positions = {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, -1, 0}};
+  s.triangles = {{0, 1, 2}, {0, 1, 3}};
+  MeshRepairReport r;
+  const Mesh m = repair_mesh(s, &r);
+  EXPECT_EQ(r.orientation_conflicts, 1u);
+  EXPECT_EQ(m.triangles.size(), 2u);
+  EXPECT_EQ(r.split_vertices, 2u);
+  EXPECT_EQ(check_manifold(m), "");
+}
+
+TEST(MeshImport, DropsNonFiniteOutOfRangeAndUnreferenced) {
+  Mesh s = vds::test::grid_mesh(3, 3);
+  s.positions[8][1] = std::numeric_limits<double>::quiet_NaN();  // corner vertex: one face uses it... two
+  s.positions.push_back({5, 5, 5});                              // nobody uses it
+  s.triangles.push_back({0, 1, 100});                            // index out of range
+  MeshRepairReport r;
+  const Mesh m = repair_mesh(s, &r);
+  EXPECT_EQ(r.non_finite_vertices, 1u);
+  EXPECT_EQ(r.faces_with_non_finite, 3u);  // the two faces on vertex 8 and the out-of-range one
+  EXPECT_EQ(r.unreferenced_vertices, 1u);
+  EXPECT_EQ(m.positions.size(), 8u);
+  EXPECT_EQ(m.triangles.size(), 6u);
+  for (const auto& p : m.positions)
+    for (double c : p) EXPECT_TRUE(std::isfinite(c));
+  EXPECT_EQ(check_manifold(m), "");
+}
+
+TEST(MeshImport, HoleKeepsBoundaries) {
+  const Mesh h = vds::test::with_hole(vds::test::grid_mesh(12, 12), 0.5, 0.5, 0.2);
+  MeshRepairReport r;
+  const Mesh m = repair_mesh(h, &r);
+  EXPECT_FALSE(r.repaired());
+  EXPECT_GT(r.boundary_edges, 2u * 22);  // outer rim plus the hole's rim
+  EXPECT_EQ(r.boundary_edges, count_boundary_edges(m));
+  EXPECT_EQ(check_manifold(m), "");
+}
+
+TEST(MeshImport, RandomSoupsAlwaysComeOutManifold) {
+  std::mt19937 rng(7);
+  for (int iter = 0; iter < 300; ++iter) {
+    Mesh s;
+    const int nv = 3 + static_cast<int>(rng() % 12);
+    std::uniform_int_distribution<int> coord(0, 3);
+    for (int i = 0; i < nv; ++i) s.positions.push_back({double(coord(rng)), double(coord(rng)), double(coord(rng))});
+    const int nf = 1 + static_cast<int>(rng() % 40);
+    for (int f = 0; f < nf; ++f)
+      s.triangles.push_back({static_cast<uint32_t>(rng() % (nv + 1)), static_cast<uint32_t>(rng() % nv),
+                             static_cast<uint32_t>(rng() % nv)});
+    MeshRepairReport r;
+    Mesh m;
+    ASSERT_NO_THROW(m = repair_mesh(s, &r)) << "soup " << iter;
+    ASSERT_EQ(check_manifold(m), "") << "soup " << iter;
+    EXPECT_EQ(r.output_faces, m.triangles.size());
+    EXPECT_EQ(r.output_vertices, m.positions.size());
+    EXPECT_LE(m.triangles.size(), s.triangles.size());
+  }
+}
+
+TEST(MeshImport, CheckManifoldNamesTheProblem) {
+  Mesh s;
+  s.positions = {{0, 0, 0}, {1, 0, 0}, {0.5, 1, 0}, {0.5, -1, 0}, {0.5, 0, 1}};
+  s.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  EXPECT_NE(check_manifold(s).find("3 faces"), std::string::npos);
+  s.positions.pop_back();
+  s.triangles = {{0, 1, 2}, {0, 1, 3}};
+  EXPECT_NE(check_manifold(s).find("same direction"), std::string::npos);
+  s.triangles = {{0, 1, 2}};
+  EXPECT_NE(check_manifold(s).find("unreferenced"), std::string::npos);
+}
+
+TEST(MeshImport, ObjPlyAndDracoFilesRoundTrip) {
+  const Mesh g = vds::test::with_hole(vds::test::grid_mesh(9, 7, 0.2), 0.5, 0.5, 0.15);
+  const std::string dir = VDS_TEST_TMP;
+  vds::enc::write_obj(dir + "/mesh_import.obj", g);
+  vds::enc::write_ply(dir + "/mesh_import.ply", g);
+  const std::vector<uint8_t> drc = vds::enc::encode_draco(g, 14, 10);
+  vds::enc::write_file(dir + "/mesh_import.drc", drc);
+  for (const char* ext : {".obj", ".ply", ".drc"}) {
+    MeshRepairReport r;
+    const Mesh m = vds::enc::import_mesh(dir + "/mesh_import" + ext, &r);
+    EXPECT_EQ(m.positions.size(), g.positions.size()) << ext;
+    EXPECT_EQ(m.triangles.size(), g.triangles.size()) << ext;
+    EXPECT_EQ(check_manifold(m), "") << ext;
+    // Same bounds (Draco to its 14-bit grid).
+    const auto a = vds::enc::mesh_bounds(g), b = vds::enc::mesh_bounds(m);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(a.min[k], b.min[k], 1e-3) << ext;
+      EXPECT_NEAR(a.max[k], b.max[k], 1e-3) << ext;
+    }
+  }
+  EXPECT_THROW(vds::enc::import_mesh(dir + "/no_such_mesh.obj"), std::runtime_error);
+  vds::enc::write_file(dir + "/not_a_mesh.drc", std::vector<uint8_t>{1, 2, 3});
+  EXPECT_THROW(vds::enc::import_mesh(dir + "/not_a_mesh.drc"), std::runtime_error);
+}
+
+TEST(MeshImport, QuantisationSpansTheGrid) {
+  const Mesh g = vds::test::grid_mesh(5, 5);
+  const auto q = vds::enc::make_quantisation(vds::enc::mesh_bounds(g), 10);
+  const auto qp = vds::enc::quantise(g, q);
+  int32_t mx = 0, mn = 1 << 20;
+  for (const auto& p : qp)
+    for (int32_t c : p) {
+      mx = std::max(mx, c);
+      mn = std::min(mn, c);
+    }
+  EXPECT_EQ(mn, 0);
+  EXPECT_EQ(mx, 1023);
+  for (size_t i = 0; i < qp.size(); ++i) {
+    const auto back = q.to_model(qp[i]);
+    for (int k = 0; k < 3; ++k) EXPECT_LE(std::fabs(back[k] - g.positions[i][k]), q.step / 2 + 1e-12);
+  }
+  EXPECT_THROW(vds::enc::make_quantisation(vds::enc::mesh_bounds(g), 17), std::invalid_argument);
+}
+
+}  // namespace
