@@ -25,5 +25,7 @@ void add_info(CLI::App& app);
 void add_pack(CLI::App& app);
 void add_serve(CLI::App& app);
 void add_encode_mesh(CLI::App& app);
+void add_encode_image(CLI::App& app);
+void add_decode_image(CLI::App& app);
 
 }  // namespace vds::cli

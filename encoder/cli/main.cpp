@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   vds::cli::add_pack(app);
   vds::cli::add_serve(app);
   vds::cli::add_encode_mesh(app);
+  vds::cli::add_encode_image(app);
+  vds::cli::add_decode_image(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
