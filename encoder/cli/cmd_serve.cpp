@@ -22,6 +22,7 @@ struct ServeArgs {
   double ber = 0;
   double frame_loss = 0;
   uint64_t seed = 1;
+  std::string crc_out;
 };
 
 void run_serve(const ServeArgs& a) {
@@ -59,6 +60,23 @@ void run_serve(const ServeArgs& a) {
     std::printf("  client             %u chunks verified, %u frames dropped (bad CRC %u)\n", r.client_chunks,
                 r.client.dropped(), r.client.bad_crc);
   if (r.frame_records != 0) std::printf("  frame records      %u\n", r.frame_records);
+  // What the client displayed: one line per frame, then its statistics.
+  for (const link::FrameRecord& f : r.frames)
+    std::printf("  frame %5u crc %08x parse %u decode %u display %u%s\n", f.index, f.crc, f.parse_instructions,
+                f.decode_instructions, f.display_instructions, f.late ? " late" : "");
+  if (r.have_stats)
+    std::printf("  client stats       %u frames shown, %u late, %u stream bytes, workspace %u of %u B, stack %u B\n",
+                r.stats.frames_shown, r.stats.late_frames, r.stats.stream_bytes, r.stats.workspace_high_water,
+                r.stats.workspace_budget, r.stats.stack_high_water);
+  if (!a.crc_out.empty()) {
+    std::string text;
+    for (const link::FrameRecord& f : r.frames) {
+      char line[16];
+      std::snprintf(line, sizeof line, "%08x\n", f.crc);
+      text += line;
+    }
+    enc::write_file(a.crc_out, std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
+  }
   if (r.receipt) {
     std::printf("  client report      %llu bytes, CRC-32C %08x: matches\n",
                 static_cast<unsigned long long>(r.receipt_bytes), r.receipt_crc);
@@ -84,6 +102,7 @@ void add_serve(CLI::App& app) {
   sub->add_option("--timeout", a->timeout, "Give up after this many seconds (real links; 0: never)");
   sub->add_option("--ber", a->ber, "Loopback: bit-error rate")->check(CLI::Range(0.0, 0.01));
   sub->add_option("--frame-loss", a->frame_loss, "Loopback: fraction of frames lost")->check(CLI::Range(0.0, 0.5));
+  sub->add_option("--crc-out", a->crc_out, "Write the CRC of every frame the client displayed, one hex line each");
   sub->add_option("--seed", a->seed, "Loopback: fault seed")->capture_default_str();
   sub->callback([a] { run_serve(*a); });
 }

@@ -25,6 +25,8 @@ void add_info(CLI::App& app);
 void add_pack(CLI::App& app);
 void add_serve(CLI::App& app);
 void add_encode_mesh(CLI::App& app);
+void add_encode_frames(CLI::App& app);
+void add_frames(CLI::App& app);
 void add_encode_image(CLI::App& app);
 void add_decode_image(CLI::App& app);
 

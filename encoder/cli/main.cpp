@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   vds::cli::add_pack(app);
   vds::cli::add_serve(app);
   vds::cli::add_encode_mesh(app);
+  vds::cli::add_encode_frames(app);
+  vds::cli::add_frames(app);
   vds::cli::add_encode_image(app);
   vds::cli::add_decode_image(app);
   try {

@@ -83,7 +83,7 @@ bool run_case(const Case& c, Entry e, uint32_t* blocks, uint64_t* spent, uint32_
 
 }  // namespace
 
-extern "C" int main() {
+extern "C" int vds_app_main() {
   vds::board::init();
   if (vds::board::instruction_resolution() == 0) {
     vds::board::log("m4 error: this board has no instruction counter\n");

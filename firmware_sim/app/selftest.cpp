@@ -87,8 +87,8 @@ void check_counter() {
 
 }  // namespace
 
-// extern "C": the firmware is compiled freestanding, where main is not special.
-extern "C" int main() {
+// The firmware's entry point, called by each board's start-up code.
+extern "C" int vds_app_main() {
   vds::board::init();
   vds::board::log("vds selftest\n");
   check_counter();

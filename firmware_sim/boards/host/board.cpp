@@ -1,26 +1,172 @@
-// The host-native board: the firmware in an ordinary process. The console
-// is stdout, the exit status the process's, the clock the steady clock.
-// There is no instruction counter (instructions() is 0); count on the host
-// with callgrind instead.
+// The host-native board: the client firmware in an ordinary process.
+// Its UART is any link backend (pty, TCP; see transport/host), paced at a
+// chosen baud rate; its display writes PNG frames, a Y4M video and a
+// contact sheet; its workspace budget is a run-time option. The console is
+// stderr. There is no instruction counter (count with callgrind instead).
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include "vds/board.h"
+#include "vds/enc/image_io.h"
+#include "vds/link/backend.h"
+#include "vds/link/fd_backends.h"
+
+extern "C" int vds_app_main();
 
 namespace vds::board {
 namespace {
-std::chrono::steady_clock::time_point g_start;
+
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+  std::string uart;            // backend spec, "pty-new", or "" (no UART)
+  uint32_t baud = 115200;      // 0: unpaced
+  std::string frames_dir;      // one PNG per frame
+  std::string y4m;             // the whole run as a Y4M video
+  std::string contact_sheet;   // thumbnails of every frame in one PNG
+  size_t workspace = 256 * 1024;
+  int contact_columns = 6;
+};
+
+Options g_opt;
+Clock::time_point g_start;
+std::unique_ptr<link::Backend> g_uart;
+
+// Pacing: a UART moves one byte per 10 bit times (start, 8 data, stop).
+double g_rx_credit = 0, g_tx_credit = 0;
+Clock::time_point g_last_pace;
+constexpr double kBitsPerByte = 10.0;
+constexpr double kMaxCreditBytes = 64.0;  // a UART FIFO's worth of burst
+
+void refill_credit() {
+  const Clock::time_point now = Clock::now();
+  const double seconds = std::chrono::duration<double>(now - g_last_pace).count();
+  g_last_pace = now;
+  const double bytes = seconds * g_opt.baud / kBitsPerByte;
+  g_rx_credit = std::min(g_rx_credit + bytes, kMaxCreditBytes);
+  g_tx_credit = std::min(g_tx_credit + bytes, kMaxCreditBytes);
 }
 
-void init() { g_start = std::chrono::steady_clock::now(); }
+// The display.
+uint16_t g_width = 0, g_height = 0;
+std::vector<uint8_t> g_rgb;  // RGB888 of the frame being drawn
+uint32_t g_frame_index = 0;
+std::vector<enc::Image> g_thumbs;
+std::ofstream g_y4m;
 
-size_t uart_read(uint8_t*, size_t) { return 0; }
-void uart_write(const uint8_t*, size_t) {}
+void to_rgb888(uint16_t p, uint8_t* out) {
+  // Replicate the high bits into the low ones so white stays 255.
+  const uint32_t r = (p >> 11) & 31, g = (p >> 5) & 63, b = p & 31;
+  out[0] = static_cast<uint8_t>((r << 3) | (r >> 2));
+  out[1] = static_cast<uint8_t>((g << 2) | (g >> 4));
+  out[2] = static_cast<uint8_t>((b << 3) | (b >> 2));
+}
+
+void write_y4m_frame(const enc::Image& img) {
+  if (!g_y4m.is_open()) {
+    g_y4m.open(g_opt.y4m, std::ios::binary | std::ios::trunc);
+    if (!g_y4m) throw std::runtime_error(g_opt.y4m + ": cannot open for writing");
+    g_y4m << "YUV4MPEG2 W" << img.width << " H" << img.height << " F20:1 Ip A1:1 C444\n";
+  }
+  // Full-range BT.601 (JFIF) Y'CbCr 4:4:4, the inverse of the client's conversion.
+  const size_t n = static_cast<size_t>(img.width) * img.height;
+  std::vector<uint8_t> planes(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    const double r = img.pixels[3 * i], g = img.pixels[3 * i + 1], b = img.pixels[3 * i + 2];
+    const auto clamp = [](double v) { return static_cast<uint8_t>(std::clamp(v + 0.5, 0.0, 255.0)); };
+    planes[i] = clamp(0.299 * r + 0.587 * g + 0.114 * b);
+    planes[n + i] = clamp(128 - 0.168736 * r - 0.331264 * g + 0.5 * b);
+    planes[2 * n + i] = clamp(128 + 0.5 * r - 0.418688 * g - 0.081312 * b);
+  }
+  g_y4m << "FRAME\n";
+  g_y4m.write(reinterpret_cast<const char*>(planes.data()), static_cast<std::streamsize>(planes.size()));
+}
+
+enc::Image thumbnail(const enc::Image& img, int scale) {
+  enc::Image t(std::max(1, img.width / scale), std::max(1, img.height / scale), 3);
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        int sum = 0;
+        for (int dy = 0; dy < scale; ++dy)
+          for (int dx = 0; dx < scale; ++dx) sum += img.at(std::min(img.width - 1, x * scale + dx), std::min(img.height - 1, y * scale + dy), c);
+        t.at(x, y, c) = static_cast<uint8_t>(sum / (scale * scale));
+      }
+  return t;
+}
+
+void write_contact_sheet() {
+  if (g_opt.contact_sheet.empty() || g_thumbs.empty()) return;
+  const int cols = std::min<int>(g_opt.contact_columns, static_cast<int>(g_thumbs.size()));
+  const int rows = (static_cast<int>(g_thumbs.size()) + cols - 1) / cols;
+  const int tw = g_thumbs[0].width, th = g_thumbs[0].height, gap = 4;
+  enc::Image sheet(cols * tw + (cols + 1) * gap, rows * th + (rows + 1) * gap, 3);
+  std::fill(sheet.pixels.begin(), sheet.pixels.end(), 40);
+  for (size_t i = 0; i < g_thumbs.size(); ++i) {
+    const int cx = gap + static_cast<int>(i % cols) * (tw + gap), cy = gap + static_cast<int>(i / cols) * (th + gap);
+    const enc::Image& t = g_thumbs[i];
+    for (int y = 0; y < std::min(th, t.height); ++y)
+      for (int x = 0; x < std::min(tw, t.width); ++x)
+        for (int c = 0; c < 3; ++c) sheet.at(cx + x, cy + y, c) = t.at(x, y, c);
+  }
+  enc::save_png(g_opt.contact_sheet, sheet);
+}
+
+}  // namespace
+
+void init() {
+  g_start = Clock::now();
+  g_last_pace = g_start;
+}
+
+size_t uart_read(uint8_t* buf, size_t max) {
+  if (!g_uart) return 0;
+  if (g_opt.baud) {
+    refill_credit();
+    max = std::min(max, static_cast<size_t>(g_rx_credit));
+    if (max == 0) return 0;
+  }
+  const size_t n = g_uart->read(buf, max, 0);
+  if (g_opt.baud) g_rx_credit -= static_cast<double>(n);
+  return n;
+}
+
+void uart_write(const uint8_t* data, size_t n) {
+  if (!g_uart) return;
+  size_t done = 0;
+  while (done < n) {
+    size_t take = n - done;
+    if (g_opt.baud) {
+      refill_credit();
+      take = std::min(take, static_cast<size_t>(g_tx_credit));
+    }
+    if (take) {
+      const size_t w = g_uart->write(data + done, take);
+      done += w;
+      if (g_opt.baud) g_tx_credit -= static_cast<double>(w);
+      if (w == take) continue;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+}
+
+void wait_for_event(uint32_t max_ms) {
+  std::this_thread::sleep_for(std::chrono::microseconds(std::min<uint32_t>(max_ms, 1) * 500));
+}
 
 uint32_t millis() {
-  return static_cast<uint32_t>(
-      std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - g_start).count());
+  return static_cast<uint32_t>(std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - g_start).count());
 }
 uint64_t instructions() { return 0; }
 uint32_t instruction_resolution() { return 0; }
@@ -35,6 +181,34 @@ void exit(int code) {
   std::exit(code);
 }
 
+void display_begin_frame(uint16_t width, uint16_t height) {
+  g_width = width;
+  g_height = height;
+  g_rgb.assign(static_cast<size_t>(width) * height * 3, 0);
+}
+
+void display_band(uint16_t y0, uint16_t rows, const uint16_t* rgb565, size_t stride_pixels) {
+  for (uint16_t r = 0; r < rows && y0 + r < g_height; ++r)
+    for (uint16_t x = 0; x < g_width; ++x)
+      to_rgb888(rgb565[r * stride_pixels + x], &g_rgb[(static_cast<size_t>(y0 + r) * g_width + x) * 3]);
+}
+
+void display_end_frame(uint32_t frame_crc) {
+  (void)frame_crc;
+  enc::Image img(g_width, g_height, 3);
+  img.pixels = g_rgb;
+  if (!g_opt.frames_dir.empty()) {
+    char name[32];
+    std::snprintf(name, sizeof name, "/frame%04u.png", g_frame_index);
+    enc::save_png(g_opt.frames_dir + name, img);
+  }
+  if (!g_opt.y4m.empty()) write_y4m_frame(img);
+  if (!g_opt.contact_sheet.empty()) g_thumbs.push_back(thumbnail(img, 2));
+  ++g_frame_index;
+}
+
+size_t workspace_budget() { return g_opt.workspace; }
+
 int32_t host_file_read(const char* path, uint32_t offset, uint8_t* buf, uint32_t max) {
   FILE* f = std::fopen(path, "rb");
   if (!f) return -1;
@@ -47,3 +221,37 @@ int32_t host_file_read(const char* path, uint32_t offset, uint8_t* buf, uint32_t
 size_t stack_high_water() { return 0; }
 
 }  // namespace vds::board
+
+int main(int argc, char** argv) {
+  using vds::board::g_opt;
+  CLI::App app{"vds client firmware on the host-native board"};
+  app.add_option("--uart", g_opt.uart,
+                 "UART: pty:PATH | pty-new (create a pair, print the other end) | tcp:HOST:PORT | tcp-listen:PORT");
+  app.add_option("--baud", g_opt.baud, "UART pace in baud, 10 bits per byte (0: unpaced)")->capture_default_str();
+  app.add_option("--frames", g_opt.frames_dir, "Directory for one PNG per displayed frame");
+  app.add_option("--y4m", g_opt.y4m, "Write the displayed frames as a Y4M video");
+  app.add_option("--contact-sheet", g_opt.contact_sheet, "Write thumbnails of all frames to this PNG");
+  app.add_option("--workspace", g_opt.workspace, "Workspace budget of the client, bytes")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (!g_opt.frames_dir.empty()) std::filesystem::create_directories(g_opt.frames_dir);
+    if (g_opt.uart == "pty-new") {
+      vds::link::PtyPair pair = vds::link::open_pty_pair();
+      std::fprintf(stderr, "uart: %s\n", pair.slave_path.c_str());
+      vds::board::g_uart = std::move(pair.master);
+    } else if (!g_opt.uart.empty()) {
+      vds::board::g_uart = vds::link::open_backend(g_opt.uart, g_opt.baud ? g_opt.baud : 115200);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vds board: %s\n", e.what());
+    return 2;
+  }
+  const int code = vds_app_main();
+  try {
+    vds::board::write_contact_sheet();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "vds board: %s\n", e.what());
+    return code ? code : 1;
+  }
+  return code;
+}

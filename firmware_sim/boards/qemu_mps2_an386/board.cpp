@@ -7,6 +7,10 @@
 #include <cstdint>
 
 #include "mps2_an386.h"
+
+#ifndef VDS_WORKSPACE_BYTES
+#error "VDS_WORKSPACE_BYTES (the client's workspace budget) must be set by the build"
+#endif
 #include "vds/board.h"
 
 namespace {
@@ -71,6 +75,9 @@ extern "C" void vds_uart0_rx_irq() {
   }
 }
 
+// A 1 kHz tick on timer 1 wakes wait_for_event, so link timers run.
+extern "C" void vds_timer1_irq() { timer1().intstat = 1; }
+
 extern "C" void vds_timer0_irq() {
   timer0().intstat = 1;
   g_timer_wraps = g_timer_wraps + 1;
@@ -83,9 +90,13 @@ void init() {
   timer0().reload = 0xFFFFFFFFu;
   timer0().value = 0xFFFFFFFFu;
   timer0().ctrl = kTimerEnable | (1u << 3);  // enable, interrupt on wrap
+  timer1().ctrl = 0;
+  timer1().reload = kTicksPerMs - 1;
+  timer1().value = kTicksPerMs - 1;
+  timer1().ctrl = kTimerEnable | (1u << 3);
   uart0().bauddiv = 16;
   uart0().ctrl = kUartTxEnable | kUartRxEnable | kUartRxIrqEnable;
-  nvic_iser0() = (1u << kUart0RxIrq) | (1u << 8);
+  nvic_iser0() = (1u << kUart0RxIrq) | (1u << kTimer0Irq) | (1u << kTimer1Irq);
   asm volatile("cpsie i" ::: "memory");
 }
 
@@ -105,6 +116,19 @@ void uart_write(const uint8_t* data, size_t n) {
     uart0().data = data[i];
   }
 }
+
+void wait_for_event(uint32_t max_ms) {
+  (void)max_ms;  // the UART interrupt or the next timer event ends the wait
+  if (g_head == g_tail) asm volatile("wfi" ::: "memory");
+}
+
+// No panel on this board: frames are checked by their CRC, which the
+// application sends to the host.
+void display_begin_frame(uint16_t, uint16_t) {}
+void display_band(uint16_t, uint16_t, const uint16_t*, size_t) {}
+void display_end_frame(uint32_t) {}
+
+size_t workspace_budget() { return VDS_WORKSPACE_BYTES; }
 
 uint32_t millis() { return static_cast<uint32_t>(ticks() / kTicksPerMs); }
 uint64_t instructions() { return ticks() * kInstructionsPerTick; }

@@ -32,8 +32,11 @@ constexpr uint32_t kTimerEnable = 1u << 0;
 
 inline CmsdkUart& uart0() { return *reinterpret_cast<CmsdkUart*>(0x40004000u); }
 inline CmsdkTimer& timer0() { return *reinterpret_cast<CmsdkTimer*>(0x40000000u); }
+inline CmsdkTimer& timer1() { return *reinterpret_cast<CmsdkTimer*>(0x40001000u); }
 
 constexpr uint32_t kUart0RxIrq = 0;  // TX is 1
+constexpr uint32_t kTimer0Irq = 8;
+constexpr uint32_t kTimer1Irq = 9;
 
 inline volatile uint32_t& nvic_iser0() { return *reinterpret_cast<volatile uint32_t*>(0xE000E100u); }
 

@@ -8,11 +8,12 @@ extern uint32_t __data_start, __data_end, __data_load, __bss_start, __bss_end;
 extern uint32_t __stack_limit, __stack_top;
 extern void (*__init_array_start[])();
 extern void (*__init_array_end[])();
-int main();
+int vds_app_main();
 [[noreturn]] void vds_reset_handler();
 [[noreturn]] void vds_reset_continue();
 void vds_uart0_rx_irq();
 void vds_timer0_irq();
+void vds_timer1_irq();
 }
 
 namespace vds::board {
@@ -52,7 +53,7 @@ extern "C" [[noreturn]] void vds_reset_continue() {
   for (uint32_t* dst = &__data_start; dst < &__data_end;) *dst++ = *src++;
   for (uint32_t* p = &__bss_start; p < &__bss_end;) *p++ = 0;
   for (void (**f)() = __init_array_start; f < __init_array_end; ++f) (*f)();
-  vds::board::exit(main());
+  vds::board::exit(vds_app_main());
 }
 
 namespace vds::board {
@@ -83,7 +84,8 @@ extern "C" [[gnu::section(".vectors"), gnu::used]] const Handler vds_vectors[16 
     vds_uart0_rx_irq,  // IRQ 0: UART0 RX
     unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq,
     vds_timer0_irq,  // IRQ 8: timer 0
-    unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq,
+    vds_timer1_irq,  // IRQ 9: timer 1
+    unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq,
     unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq,
     unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq, unused_irq,
 };

@@ -16,6 +16,10 @@ size_t uart_read(uint8_t* buf, size_t max);
 // Sends `n` bytes; blocks until the UART has taken them all.
 void uart_write(const uint8_t* data, size_t n);
 
+// Sleeps until something may have happened (a UART byte, a timer tick) or
+// `max_ms` passed. Busy boards may return at once.
+void wait_for_event(uint32_t max_ms);
+
 // Milliseconds since init (wraps after 49 days).
 uint32_t millis();
 // A monotonic count of executed instructions (QEMU -icount) or CPU cycles;
@@ -29,6 +33,17 @@ void log(const char* text);
 
 // Ends the program with `code` as the process / QEMU exit status.
 [[noreturn]] void exit(int code);
+
+// The display. Frames arrive as horizontal bands of RGB565 pixels, top to
+// bottom; the board shows, stores or discards them. `frame_crc` is the
+// CRC-32C the application computed over the frame (docs/firmware.md).
+void display_begin_frame(uint16_t width, uint16_t height);
+void display_band(uint16_t y0, uint16_t rows, const uint16_t* rgb565, size_t stride_pixels);
+void display_end_frame(uint32_t frame_crc);
+
+// The workspace budget of this run, bytes: the application must not use
+// more (a compile-time constant on hardware, an option on the host board).
+size_t workspace_budget();
 
 // For benchmarks and tests only: reads up to `max` bytes at `offset` of a
 // file on the machine running the board (semihosting under QEMU, the file

@@ -32,6 +32,9 @@ struct Server {
   bool receipt = false;
   DoneReport report{};
   uint32_t frame_records = 0;
+  std::vector<FrameRecord> frames;
+  bool have_stats = false;
+  ClientStats stats{};
   std::function<void(const std::string&)> log;
 
   void pump(Link& h, uint64_t now) {
@@ -43,6 +46,7 @@ struct Server {
       ctl_len = sums_len = 0;
       receipt = false;
       frame_records = 0;
+      frames.clear();
       started_ms = now;
     }
     while (written < stream.size()) {
@@ -58,10 +62,16 @@ struct Server {
       sums_len += n;
       if (sums_len == kFrameRecordBytes) {
         FrameRecord fr{};
-        if (decode(sums, sums_len, &fr) == Status::ok) ++frame_records;
+        if (decode(sums, sums_len, &fr) == Status::ok) {
+          ++frame_records;
+          frames.push_back(fr);
+        }
         sums_len = 0;
       }
     }
+    uint8_t st[kClientStatsBytes];
+    while (h.read_datagram(channel::kStats, st, sizeof st, &n) == Status::ok)
+      if (decode(st, n, &stats) == Status::ok) have_stats = true;
     while (!receipt && h.read(channel::kControl, ctl + ctl_len, kDoneReportBytes - ctl_len, &n) == Status::ok && n != 0) {
       ctl_len += n;
       if (ctl_len == kDoneReportBytes) {
@@ -204,6 +214,9 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
   rep.receipt = srv.receipt && srv.report.status == static_cast<int32_t>(Status::ok) &&
                 srv.report.stream_bytes == static_cast<uint32_t>(stream.size()) && srv.report.stream_crc == rep.stream_crc;
   rep.frame_records = srv.frame_records;
+  rep.frames = srv.frames;
+  rep.have_stats = srv.have_stats;
+  rep.stats = srv.stats;
   if (rep.seconds > 0) rep.goodput = static_cast<double>(stream.size()) / rep.seconds / (o.baud / 10.0);
   return rep;
 }

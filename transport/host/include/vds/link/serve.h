@@ -12,6 +12,7 @@
 
 #include "vds/link/link.h"
 #include "vds/link/loopback.h"
+#include "vds/link/messages.h"
 
 namespace vds::link {
 
@@ -38,6 +39,9 @@ struct ServeReport {
   uint64_t receipt_bytes = 0;
   uint32_t receipt_crc = 0;
   uint32_t frame_records = 0;  // FrameRecords received on the checksums channel
+  std::vector<FrameRecord> frames;  // those records, in order (the last session's)
+  bool have_stats = false;          // a ClientStats datagram arrived
+  ClientStats stats{};              // the newest one
   uint32_t client_chunks = 0;  // loopback: chunks the client's parser verified
   LinkStats host;
   LinkStats client;  // loopback only

@@ -1,0 +1,52 @@
+// `vds frames STREAM`: what a client displays, frame by frame: decodes the
+// stream through the client library exactly as the firmware does and prints
+// each frame's CRC-32C; optionally writes the frames as PNG.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "vds/enc/frames.h"
+#include "vds/enc/stream_writer.h"
+
+namespace vds::cli {
+namespace {
+
+struct Options {
+  std::string file;
+  std::string png_dir;
+};
+
+void run(const Options& o) {
+  const std::vector<uint8_t> stream = enc::read_file(o.file);
+  std::vector<enc::Image> frames;
+  std::vector<uint32_t> crcs;
+  try {
+    crcs = enc::client_frame_crcs(stream, o.png_dir.empty() ? nullptr : &frames);
+  } catch (const std::runtime_error& e) {
+    throw Failure(kExitBadInput, o.file + ": " + e.what());
+  }
+  if (!o.png_dir.empty()) std::filesystem::create_directories(o.png_dir);
+  for (size_t i = 0; i < crcs.size(); ++i) {
+    std::printf("%08x\n", crcs[i]);
+    if (!o.png_dir.empty()) {
+      char name[32];
+      std::snprintf(name, sizeof name, "/frame%04zu.png", i);
+      enc::save_png(o.png_dir + name, frames[i]);
+    }
+  }
+}
+
+}  // namespace
+
+void add_frames(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand("frames", "Print the CRC-32C of every frame a client displays");
+  sub->add_option("STREAM", o->file, "vds stream")->required();
+  sub->add_option("--png", o->png_dir, "Also write each frame as DIR/frameNNNN.png");
+  sub->callback([o] { run(*o); });
+}
+
+}  // namespace vds::cli

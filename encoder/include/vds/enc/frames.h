@@ -1,0 +1,42 @@
+// Image sequences: a stream of frames (one vds image each) and the host
+// replay of the client firmware's decode path, which gives the CRC-32C of
+// every frame exactly as a client displays it (RGB565 bands).
+#pragma once
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vds/enc/image_codec.h"
+#include "vds/enc/image_io.h"
+
+namespace vds::enc {
+
+struct FrameSequenceOptions {
+  int width = 240;
+  int height = 180;
+  double fps = 20;
+  ImageEncodeOptions image;  // quality / rate target per frame
+};
+
+struct FrameSequenceResult {
+  std::vector<uint8_t> stream;
+  std::vector<double> psnr;         // per frame, RGB, against the resized source
+  std::vector<size_t> frame_bytes;  // per frame, chunks included
+};
+
+// Scales `img` to cover w x h (keeping its aspect ratio, area-averaged) and
+// crops the centre. Returns RGB.
+Image fit_image(const Image& img, int w, int h);
+
+// Encodes each image as one intra frame of an images-mode stream. The
+// header's max_chunk_payload and workspace_bytes are what the frames need.
+FrameSequenceResult encode_frames(const std::vector<Image>& frames, const FrameSequenceOptions& o);
+
+// What a client shows: decodes every frame of an images-mode stream through
+// the client library into RGB565 bands, as firmware_sim/app/client.cpp does,
+// and returns each frame's CRC-32C (and its pixels if `frames` is given).
+// Throws std::runtime_error naming the client status on a bad stream.
+std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames = nullptr);
+
+}  // namespace vds::enc

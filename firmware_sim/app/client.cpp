@@ -1,0 +1,299 @@
+// The vds client firmware: handshake over the link, receive the stream,
+// verify and parse it, decode each image into bands inside the workspace,
+// present them on the board's display, and report upward a CRC-32C and the
+// per-stage instruction counts of every frame, statistics, and the end of
+// the stream. Talks to the hardware only through vds/board.h.
+#include <cstddef>
+#include <cstdint>
+
+#include "print.h"
+#include "vds/arena.h"
+#include "vds/board.h"
+#include "vds/container.h"
+#include "vds/crc32c.h"
+#include "vds/image.h"
+#include "vds/link/link.h"
+#include "vds/link/messages.h"
+
+#ifndef VDS_APP_WORKSPACE_MAX
+#error "VDS_APP_WORKSPACE_MAX (the largest workspace this build can use) must be set by the build"
+#endif
+#ifndef VDS_APP_CHUNK_BYTES
+#define VDS_APP_CHUNK_BYTES 4096  // the largest chunk payload the client accepts
+#endif
+
+namespace {
+
+using vds::Status;
+using vds::fw::Line;
+namespace board = vds::board;
+namespace link = vds::link;
+
+constexpr uint32_t kBandRows = 16;          // one MCU row of a 4:2:0 image
+constexpr uint32_t kStatsPeriodMs = 1000;   // statistics datagram
+constexpr uint32_t kPendingRecords = 8;     // frame records waiting for the checksums channel
+constexpr size_t kStreamReadBytes = 256;    // stream bytes handed to the parser at a time
+constexpr uint32_t kDrainTimeoutMs = 20000;  // after the end, wait this long for the host's acks
+
+alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
+
+struct Client {
+  vds::Arena arena;
+  link::Link link;
+  vds::StreamParser parser;
+  vds::ImageDecoder decoder;
+  size_t stream_mark = 0;  // arena mark below the per-stream state
+  uint32_t epoch = 0;
+
+  // The stream.
+  vds::StreamHeader header{};
+  bool have_header = false;
+  uint16_t* band = nullptr;
+  Status stream_status = Status::more_input;
+  uint32_t stream_bytes = 0;
+  uint32_t stream_crc = 0;
+
+  // The frame being drawn.
+  bool in_frame = false;
+  uint32_t frame_crc = 0;
+  uint32_t frames_shown = 0;
+  uint32_t late_frames = 0;
+  uint32_t first_frame_ms = 0;
+  uint64_t parse_instr = 0, decode_instr = 0, display_instr = 0;
+
+  // Upward messages.
+  link::FrameRecord pending[kPendingRecords];
+  uint32_t pending_head = 0, pending_count = 0;
+  bool done_sent = false;
+  uint32_t last_stats_ms = 0;
+};
+
+Client g;
+
+void log_status(const char* what, Status s) {
+  board::log(Line().str("client: ").str(what).str(": ").str(vds::status_name(s)).str("\n").c_str());
+}
+
+// Display callback of the image decoder: one band of full-width RGB565 rows.
+bool on_band(void*, const vds::PixelRect& r) {
+  const uint64_t t0 = board::instructions();
+  const size_t stride_pixels = static_cast<size_t>(r.stride) / 2;
+  for (uint16_t row = 0; row < r.h; ++row)
+    g.frame_crc = vds::crc32c_update(g.frame_crc, r.pixels + row * r.stride, static_cast<size_t>(r.w) * 2);
+  board::display_band(r.y, r.h, reinterpret_cast<const uint16_t*>(r.pixels), stride_pixels);
+  g.display_instr += board::instructions() - t0;
+  return true;
+}
+
+void finish_frame() {
+  const uint64_t t0 = board::instructions();
+  board::display_end_frame(g.frame_crc);
+  g.display_instr += board::instructions() - t0;
+  const uint32_t now = board::millis();
+  if (g.frames_shown == 0) g.first_frame_ms = now;
+  // Frame i is due one period after frame i-1, counted from the first one.
+  bool late = false;
+  if (g.header.frame_period_us != 0) {
+    const uint64_t due_ms = g.first_frame_ms + (static_cast<uint64_t>(g.frames_shown) * g.header.frame_period_us) / 1000;
+    late = now > due_ms + g.header.frame_period_us / 1000;
+  }
+  if (late) ++g.late_frames;
+  if (g.pending_count < kPendingRecords) {
+    link::FrameRecord& rec = g.pending[(g.pending_head + g.pending_count) % kPendingRecords];
+    rec.index = g.frames_shown;
+    rec.crc = g.frame_crc;
+    rec.parse_instructions = static_cast<uint32_t>(g.parse_instr);
+    rec.decode_instructions = static_cast<uint32_t>(g.decode_instr);
+    rec.display_instructions = static_cast<uint32_t>(g.display_instr);
+    rec.received_ms = now;
+    rec.late = late ? 1 : 0;
+    ++g.pending_count;
+  }
+  ++g.frames_shown;
+  g.in_frame = false;
+}
+
+bool on_header(void*, const vds::StreamHeader& h) {
+  if (h.mode != vds::StreamMode::images) {
+    board::log("client: this firmware plays image streams only\n");
+    return false;
+  }
+  g.header = h;
+  g.have_header = true;
+  // The parser has checked that the declared workspace fits what is left.
+  const Status s = g.decoder.init(g.arena);
+  if (s != Status::ok) {
+    log_status("image decoder", s);
+    return false;
+  }
+  g.band = g.arena.alloc_array<uint16_t>(static_cast<size_t>(h.width) * kBandRows);
+  if (g.band == nullptr) {
+    log_status("band buffer", Status::workspace_too_small);
+    return false;
+  }
+  return true;
+}
+
+vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t size) {
+  if (type != vds::chunk::kImageHeader && type != vds::chunk::kImageData) return vds::ChunkResult::unknown;
+  const uint64_t t0 = board::instructions();
+  const uint64_t display_before = g.display_instr;
+  if (type == vds::chunk::kImageHeader) {
+    board::display_begin_frame(g.header.width, g.header.height);
+    g.in_frame = true;
+    g.frame_crc = 0;
+    g.parse_instr = g.decode_instr = g.display_instr = 0;
+  }
+  const vds::ImageTarget target = vds::ImageTarget::bands(vds::PixelFormat::rgb565, reinterpret_cast<uint8_t*>(g.band),
+                                                          static_cast<ptrdiff_t>(g.header.width) * 2, on_band, nullptr);
+  const Status s = g.decoder.on_chunk(type, payload, size, target);
+  const uint64_t spent = board::instructions() - t0;
+  g.decode_instr += spent - (g.display_instr - display_before);
+  if (vds::is_error(s)) {
+    log_status("image", s);
+    return vds::ChunkResult::abort;
+  }
+  if (type == vds::chunk::kImageData && s == Status::ok) finish_frame();
+  return vds::ChunkResult::consumed;
+}
+
+// (Re)starts the per-stream state above the link's buffers.
+Status start_stream() {
+  g.arena.rewind(g.stream_mark);
+  g.have_header = false;
+  g.band = nullptr;
+  g.stream_status = Status::more_input;
+  g.stream_bytes = 0;
+  g.stream_crc = 0;
+  g.in_frame = false;
+  g.frames_shown = 0;
+  g.late_frames = 0;
+  g.pending_count = 0;
+  g.done_sent = false;
+  vds::ChunkSink sink;
+  sink.on_header = on_header;
+  sink.on_chunk = on_chunk;
+  return g.parser.init(g.arena, VDS_APP_CHUNK_BYTES, sink);
+}
+
+void feed_stream() {
+  uint8_t buf[kStreamReadBytes];
+  // Stop taking stream bytes while frame records wait: back-pressure.
+  while (g.stream_status == Status::more_input && g.pending_count < kPendingRecords) {
+    size_t got = 0;
+    if (g.link.read(link::channel::kStream, buf, sizeof buf, &got) != Status::ok || got == 0) return;
+    g.stream_bytes += static_cast<uint32_t>(got);
+    g.stream_crc = vds::crc32c_update(g.stream_crc, buf, got);
+    const uint64_t t0 = board::instructions();
+    const uint64_t inner0 = g.decode_instr + g.display_instr;
+    Status s = g.parser.feed(buf, got);
+    const uint64_t spent = board::instructions() - t0;
+    // Parsing is what the parser spent outside the image decoder.
+    g.parse_instr += spent - ((g.decode_instr + g.display_instr) - inner0);
+    if (s == Status::more_input) continue;
+    g.stream_status = s;
+    if (vds::is_error(s)) {
+      Line l;
+      l.str("client: stream: ").str(vds::status_name(s)).str(" at byte ").dec(g.parser.error_offset()).str(": ");
+      board::log(l.str(g.parser.error_detail()).str("\n").c_str());
+    }
+  }
+}
+
+void send_messages(uint32_t now) {
+  while (g.pending_count > 0 && g.link.writable(link::channel::kChecksums) >= link::kFrameRecordBytes) {
+    uint8_t msg[link::kFrameRecordBytes];
+    link::encode(g.pending[g.pending_head], msg);
+    size_t took = 0;
+    if (g.link.write(link::channel::kChecksums, msg, sizeof msg, &took) != Status::ok || took != sizeof msg) break;
+    g.pending_head = (g.pending_head + 1) % kPendingRecords;
+    --g.pending_count;
+  }
+  if (now - g.last_stats_ms >= kStatsPeriodMs || (g.stream_status != Status::more_input && !g.done_sent)) {
+    g.last_stats_ms = now;
+    link::ClientStats st{};
+    st.uptime_ms = now;
+    st.stream_bytes = g.stream_bytes;
+    st.frames_shown = g.frames_shown;
+    st.late_frames = g.late_frames;
+    st.workspace_high_water = static_cast<uint32_t>(g.arena.high_water());
+    st.workspace_budget = static_cast<uint32_t>(g.arena.capacity());
+    st.stack_high_water = static_cast<uint32_t>(board::stack_high_water());
+    st.link_retransmissions = g.link.stats().retransmissions;
+    st.link_dropped = g.link.stats().dropped();
+    st.instruction_resolution = board::instruction_resolution();
+    uint8_t msg[link::kClientStatsBytes];
+    link::encode(st, msg);
+    g.link.send_datagram(link::channel::kStats, msg, sizeof msg);
+  }
+  if (g.stream_status != Status::more_input && !g.done_sent && g.pending_count == 0 &&
+      g.link.writable(link::channel::kControl) >= link::kDoneReportBytes) {
+    link::DoneReport d{static_cast<int32_t>(g.stream_status), g.frames_shown, g.stream_bytes, g.stream_crc};
+    uint8_t msg[link::kDoneReportBytes];
+    link::encode(d, msg);
+    size_t took = 0;
+    if (g.link.write(link::channel::kControl, msg, sizeof msg, &took) == Status::ok && took == sizeof msg)
+      g.done_sent = true;
+  }
+}
+
+}  // namespace
+
+// The firmware's entry point, called by each board's start-up code.
+extern "C" int vds_app_main() {
+  board::init();
+  size_t budget = board::workspace_budget();
+  if (budget > sizeof g_workspace) budget = sizeof g_workspace;
+  g.arena = vds::Arena(g_workspace, budget);
+  const link::LinkConfig cfg = link::device_config(board::millis() + 1);
+  Status s = g.link.init(cfg, g.arena);
+  if (s != Status::ok) {
+    log_status("link", s);
+    return 3;
+  }
+  g.stream_mark = g.arena.mark();
+  s = start_stream();
+  if (s != Status::ok) {
+    log_status("workspace", s);
+    return 3;
+  }
+  board::log(Line().str("client: ready, workspace ").dec(budget).str(" bytes\n").c_str());
+
+  uint8_t rx[256];
+  uint8_t tx[256];
+  uint32_t done_at = 0;
+  for (;;) {
+    const uint32_t now = board::millis();
+    bool busy = false;
+    const size_t n = board::uart_read(rx, sizeof rx);
+    if (n) {
+      g.link.receive(rx, n, now);
+      busy = true;
+    }
+    if (g.link.session_epoch() != g.epoch) {
+      // A new session: whatever the previous one delivered is void, and the
+      // host starts the stream again from its first byte.
+      if (g.epoch != 0) board::log("client: new link session, restarting the stream\n");
+      g.epoch = g.link.session_epoch();
+      if (g.stream_bytes != 0 && start_stream() != Status::ok) return 3;
+    }
+    feed_stream();
+    send_messages(now);
+    const size_t m = g.link.transmit(tx, sizeof tx, now);
+    if (m) {
+      board::uart_write(tx, m);
+      busy = true;
+    }
+    if (g.done_sent) {
+      if (done_at == 0) done_at = now | 1u;
+      const bool drained = g.link.unacked(link::channel::kChecksums) == 0 && g.link.unacked(link::channel::kControl) == 0;
+      if (drained || now - done_at > kDrainTimeoutMs) break;
+    }
+    if (!busy) board::wait_for_event(1);
+  }
+  Line l;
+  l.str("client: ").str(vds::status_name(g.stream_status)).str(", ").dec(g.frames_shown).str(" frames, ");
+  l.dec(g.stream_bytes).str(" stream bytes, workspace high-water ").dec(g.arena.high_water()).str(" bytes\n");
+  board::log(l.c_str());
+  return g.stream_status == Status::ok ? 0 : 1;
+}
