@@ -59,7 +59,12 @@ struct Client {
   uint32_t frames_shown = 0;
   uint32_t late_frames = 0;
   uint32_t first_frame_ms = 0;
-  uint64_t parse_instr = 0, decode_instr = 0, display_instr = 0;
+  // Instruction counts, cumulative over the run; a frame's record is the
+  // difference from the snapshot taken when its header chunk arrived.
+  // Parsing is the time inside StreamParser::feed outside the callbacks.
+  uint64_t parse_total = 0, decode_total = 0, display_total = 0;
+  uint64_t parse_at_start = 0, decode_at_start = 0, display_at_start = 0;
+  uint64_t feed_mark = 0;  // instructions() where parser time last started to count
 
   // Upward messages.
   link::FrameRecord pending[kPendingRecords];
@@ -81,14 +86,14 @@ bool on_band(void*, const vds::PixelRect& r) {
   for (uint16_t row = 0; row < r.h; ++row)
     g.frame_crc = vds::crc32c_update(g.frame_crc, r.pixels + row * r.stride, static_cast<size_t>(r.w) * 2);
   board::display_band(r.y, r.h, reinterpret_cast<const uint16_t*>(r.pixels), stride_pixels);
-  g.display_instr += board::instructions() - t0;
+  g.display_total += board::instructions() - t0;
   return true;
 }
 
 void finish_frame() {
   const uint64_t t0 = board::instructions();
   board::display_end_frame(g.frame_crc);
-  g.display_instr += board::instructions() - t0;
+  g.display_total += board::instructions() - t0;
   const uint32_t now = board::millis();
   if (g.frames_shown == 0) g.first_frame_ms = now;
   // Frame i is due one period after frame i-1, counted from the first one.
@@ -102,9 +107,9 @@ void finish_frame() {
     link::FrameRecord& rec = g.pending[(g.pending_head + g.pending_count) % kPendingRecords];
     rec.index = g.frames_shown;
     rec.crc = g.frame_crc;
-    rec.parse_instructions = static_cast<uint32_t>(g.parse_instr);
-    rec.decode_instructions = static_cast<uint32_t>(g.decode_instr);
-    rec.display_instructions = static_cast<uint32_t>(g.display_instr);
+    rec.parse_instructions = static_cast<uint32_t>(g.parse_total - g.parse_at_start);
+    rec.decode_instructions = static_cast<uint32_t>(g.decode_total - g.decode_at_start);
+    rec.display_instructions = static_cast<uint32_t>(g.display_total - g.display_at_start);
     rec.received_ms = now;
     rec.late = late ? 1 : 0;
     ++g.pending_count;
@@ -137,24 +142,31 @@ bool on_header(void*, const vds::StreamHeader& h) {
 vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t size) {
   if (type != vds::chunk::kImageHeader && type != vds::chunk::kImageData) return vds::ChunkResult::unknown;
   const uint64_t t0 = board::instructions();
-  const uint64_t display_before = g.display_instr;
+  const uint64_t parse_before = g.parse_total;
+  g.parse_total += t0 - g.feed_mark;
+  const uint64_t display_before = g.display_total;
   if (type == vds::chunk::kImageHeader) {
     board::display_begin_frame(g.header.width, g.header.height);
     g.in_frame = true;
     g.frame_crc = 0;
-    g.parse_instr = g.decode_instr = g.display_instr = 0;
+    // The parser checked this chunk's CRC before the call: that belongs to the new frame.
+    g.parse_at_start = parse_before;
+    g.decode_at_start = g.decode_total;
+    g.display_at_start = g.display_total;
   }
   const vds::ImageTarget target = vds::ImageTarget::bands(vds::PixelFormat::rgb565, reinterpret_cast<uint8_t*>(g.band),
                                                           static_cast<ptrdiff_t>(g.header.width) * 2, on_band, nullptr);
   const Status s = g.decoder.on_chunk(type, payload, size, target);
-  const uint64_t spent = board::instructions() - t0;
-  g.decode_instr += spent - (g.display_instr - display_before);
+  g.decode_total += (board::instructions() - t0) - (g.display_total - display_before);
+  vds::ChunkResult result = vds::ChunkResult::consumed;
   if (vds::is_error(s)) {
     log_status("image", s);
-    return vds::ChunkResult::abort;
+    result = vds::ChunkResult::abort;
+  } else if (type == vds::chunk::kImageData && s == Status::ok) {
+    finish_frame();
   }
-  if (type == vds::chunk::kImageData && s == Status::ok) finish_frame();
-  return vds::ChunkResult::consumed;
+  g.feed_mark = board::instructions();
+  return result;
 }
 
 // (Re)starts the per-stream state above the link's buffers.
@@ -184,12 +196,9 @@ void feed_stream() {
     if (g.link.read(link::channel::kStream, buf, sizeof buf, &got) != Status::ok || got == 0) return;
     g.stream_bytes += static_cast<uint32_t>(got);
     g.stream_crc = vds::crc32c_update(g.stream_crc, buf, got);
-    const uint64_t t0 = board::instructions();
-    const uint64_t inner0 = g.decode_instr + g.display_instr;
+    g.feed_mark = board::instructions();
     Status s = g.parser.feed(buf, got);
-    const uint64_t spent = board::instructions() - t0;
-    // Parsing is what the parser spent outside the image decoder.
-    g.parse_instr += spent - ((g.decode_instr + g.display_instr) - inner0);
+    g.parse_total += board::instructions() - g.feed_mark;
     if (s == Status::more_input) continue;
     g.stream_status = s;
     if (vds::is_error(s)) {
@@ -261,6 +270,7 @@ extern "C" int vds_app_main() {
 
   uint8_t rx[256];
   uint8_t tx[256];
+  bool done_timing = false;
   uint32_t done_at = 0;
   for (;;) {
     const uint32_t now = board::millis();
@@ -284,8 +294,15 @@ extern "C" int vds_app_main() {
       board::uart_write(tx, m);
       busy = true;
     }
+    if (board::uart_closed()) {
+      if (!g.done_sent) board::log("client: the host closed the link before the end of the stream\n");
+      break;
+    }
     if (g.done_sent) {
-      if (done_at == 0) done_at = now | 1u;
+      if (!done_timing) {
+        done_timing = true;
+        done_at = now;
+      }
       const bool drained = g.link.unacked(link::channel::kChecksums) == 0 && g.link.unacked(link::channel::kControl) == 0;
       if (drained || now - done_at > kDrainTimeoutMs) break;
     }

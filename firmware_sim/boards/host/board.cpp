@@ -42,6 +42,8 @@ struct Options {
 Options g_opt;
 Clock::time_point g_start;
 std::unique_ptr<link::Backend> g_uart;
+bool g_uart_traffic = false;  // a byte has arrived: the host is there
+bool g_uart_closed = false;   // and has gone since
 
 // Pacing: a UART moves one byte per 10 bit times (start, 8 data, stop).
 double g_rx_credit = 0, g_tx_credit = 0;
@@ -131,19 +133,31 @@ void init() {
 }
 
 size_t uart_read(uint8_t* buf, size_t max) {
-  if (!g_uart) return 0;
+  if (!g_uart || g_uart_closed) return 0;
   if (g_opt.baud) {
     refill_credit();
     max = std::min(max, static_cast<size_t>(g_rx_credit));
     if (max == 0) return 0;
   }
-  const size_t n = g_uart->read(buf, max, 0);
+  size_t n = 0;
+  try {
+    n = g_uart->read(buf, max, 0);
+  } catch (const vds::link::BackendError& e) {
+    // A pty master reads EIO while no one holds the other end: before the
+    // first byte that is the host not there yet, afterwards it has gone.
+    if (e.kind() != vds::link::BackendError::Kind::disconnected) throw;
+    if (g_uart_traffic) g_uart_closed = true;
+    return 0;
+  }
+  if (n) g_uart_traffic = true;
   if (g_opt.baud) g_rx_credit -= static_cast<double>(n);
   return n;
 }
 
+bool uart_closed() { return g_uart_closed; }
+
 void uart_write(const uint8_t* data, size_t n) {
-  if (!g_uart) return;
+  if (!g_uart || g_uart_closed) return;
   size_t done = 0;
   while (done < n) {
     size_t take = n - done;
@@ -152,7 +166,16 @@ void uart_write(const uint8_t* data, size_t n) {
       take = std::min(take, static_cast<size_t>(g_tx_credit));
     }
     if (take) {
-      const size_t w = g_uart->write(data + done, take);
+      size_t w = 0;
+      try {
+        w = g_uart->write(data + done, take);
+      } catch (const vds::link::BackendError& e) {
+        if (e.kind() != vds::link::BackendError::Kind::disconnected) throw;
+        if (g_uart_traffic) {
+          g_uart_closed = true;
+          return;
+        }
+      }
       done += w;
       if (g_opt.baud) g_tx_credit -= static_cast<double>(w);
       if (w == take) continue;

@@ -16,6 +16,11 @@ size_t uart_read(uint8_t* buf, size_t max);
 // Sends `n` bytes; blocks until the UART has taken them all.
 void uart_write(const uint8_t* data, size_t n);
 
+// True once the far end of the UART has gone away for good (the host
+// board's pty or socket peer closed after traffic); never on hardware, where
+// a silent line is only silent.
+bool uart_closed();
+
 // Sleeps until something may have happened (a UART byte, a timer tick) or
 // `max_ms` passed. Busy boards may return at once.
 void wait_for_event(uint32_t max_ms);

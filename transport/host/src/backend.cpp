@@ -26,7 +26,9 @@ std::unique_ptr<Backend> open_backend(const std::string& spec, uint32_t baud) {
   auto rest = [&](size_t n) { return spec.substr(n); };
   if (spec.rfind("pty:", 0) == 0) {
     if (rest(4).empty()) throw BackendError(BackendError::Kind::bad_spec, "pty: needs a path, as in pty:/dev/ttyACM0");
-    return open_serial(rest(4), baud);
+    auto b = open_serial(rest(4), baud);
+    b->set_pacing(baud);
+    return b;
   }
   if (spec.rfind("tcp:", 0) == 0) {
     const std::string hp = rest(4);
@@ -36,14 +38,18 @@ std::unique_ptr<Backend> open_backend(const std::string& spec, uint32_t baud) {
       throw BackendError(BackendError::Kind::bad_spec, "tcp: '" + spec + "' is not tcp:HOST:PORT");
     const unsigned long port = std::stoul(hp.substr(c + 1));
     if (port == 0 || port > 65535) throw BackendError(BackendError::Kind::bad_spec, "tcp: port out of range in '" + spec + "'");
-    return tcp_connect(hp.substr(0, c), static_cast<uint16_t>(port));
+    auto b = tcp_connect(hp.substr(0, c), static_cast<uint16_t>(port));
+    b->set_pacing(baud);  // an emulated UART behind a socket is not paced by anyone else
+    return b;
   }
   if (spec.rfind("tcp-listen:", 0) == 0) {
     const std::string p = rest(11);
     if (p.empty() || p.size() > 5 || p.find_first_not_of("0123456789") != std::string::npos || std::stoul(p) > 65535)
       throw BackendError(BackendError::Kind::bad_spec, "tcp-listen: '" + spec + "' is not tcp-listen:PORT");
     TcpListener l(static_cast<uint16_t>(std::stoul(p)), false);
-    return l.accept(-1);
+    auto b = l.accept(-1);
+    if (b) b->set_pacing(baud);
+    return b;
   }
   if (spec.rfind("usb:", 0) == 0) return open_usb(parse_usb_spec(rest(4)));
   throw BackendError(BackendError::Kind::bad_spec,

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstring>
 
 namespace vds::link {
@@ -54,17 +55,43 @@ FdBackend::~FdBackend() {
   if (fd_ >= 0) ::close(fd_);
 }
 
+void FdBackend::set_pacing(uint32_t baud) {
+  bytes_per_s_ = baud / 10;  // a UART byte is 10 bits on the wire
+  tokens_milli_ = 0;
+  last_us_ = 0;
+}
+
 size_t FdBackend::write_room() {
-  if (queue_limit_ == 0) return 4096;
-  int queued = 0;
-  if (ioctl(fd_, TIOCOUTQ, &queued) != 0 || queued < 0) return queue_limit_;
-  return static_cast<size_t>(queued) >= queue_limit_ ? 0 : queue_limit_ - static_cast<size_t>(queued);
+  size_t room = 4096;
+  if (queue_limit_ != 0) {
+    int queued = 0;
+    if (ioctl(fd_, TIOCOUTQ, &queued) != 0 || queued < 0) {
+      room = queue_limit_;
+    } else {
+      room = static_cast<size_t>(queued) >= queue_limit_ ? 0 : queue_limit_ - static_cast<size_t>(queued);
+    }
+  }
+  if (bytes_per_s_ != 0) {
+    const uint64_t now_us = static_cast<uint64_t>(
+        std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch()).count());
+    // Bytes/s times microseconds over 1000 is thousandths of a byte.
+    if (last_us_ != 0) tokens_milli_ += (now_us - last_us_) * bytes_per_s_ / 1000;
+    last_us_ = now_us;
+    const uint64_t burst_milli = std::max<uint64_t>(64, bytes_per_s_ / 50) * 1000;
+    tokens_milli_ = std::min(tokens_milli_, burst_milli);
+    room = std::min<size_t>(room, static_cast<size_t>(tokens_milli_ / 1000));
+  }
+  return room;
 }
 
 size_t FdBackend::write(const uint8_t* data, size_t n) {
   if (n == 0) return 0;
   const ssize_t w = ::write(fd_, data, n);
-  if (w >= 0) return static_cast<size_t>(w);
+  if (w >= 0) {
+    const uint64_t spent = static_cast<uint64_t>(w) * 1000;
+    tokens_milli_ = tokens_milli_ > spent ? tokens_milli_ - spent : 0;
+    return static_cast<size_t>(w);
+  }
   if (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) return 0;
   const int e = errno;
   throw BackendError(kind_of(e), name_ + ": write failed: " + errno_text(e));

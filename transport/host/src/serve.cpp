@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 #include "vds/container.h"
@@ -186,18 +187,37 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     Pump pump(host, *b);
     const uint32_t t0 = monotonic_ms();
     uint32_t acked_at = 0;
+    std::optional<uint32_t> receipt_at, records_at;  // when the report, and then every frame record, had arrived
+    constexpr uint32_t kLingerMs = 300;      // a few of the client's round trips
+    constexpr uint32_t kRecordWaitMs = 5000;  // frame records missing after this are reported missing
     bool announced = false;
     for (;;) {
       const uint32_t now = monotonic_ms();
       srv.pump(host, now);
-      pump.step(now, 1);
+      try {
+        pump.step(now, 1);
+      } catch (const BackendError& e) {
+        // A client that has reported may power off (QEMU exits) while this
+        // side still lingers: that is the end, not a failure.
+        if (!(srv.receipt && e.kind() == BackendError::Kind::disconnected)) throw;
+        break;
+      }
       if (host.established() && !announced) {
         announced = true;
         if (log) log("session established (client nonce " + std::to_string(host.peer_nonce()) + ")");
       }
       if (srv.acked(host) && acked_at == 0) acked_at = now;
+      if (srv.receipt && !receipt_at) receipt_at = now;
+      // The report is in: collect the frame records still on their way (a
+      // separate channel), then keep acknowledging a little longer so the
+      // client sees its last messages acknowledged before the line closes.
+      if (receipt_at) {
+        const bool all_records = srv.frames.size() >= srv.report.frames_shown;
+        if (all_records && !records_at) records_at = now;
+        if ((records_at && now - *records_at > kLingerMs) || now - *receipt_at > kRecordWaitMs) break;
+      }
       // All acknowledged: wait briefly for the report (a client may not send one).
-      if (srv.receipt || (acked_at != 0 && now - acked_at > 2000)) break;
+      if (!srv.receipt && acked_at != 0 && now - acked_at > 2000) break;
       if (o.timeout_s != 0 && now - t0 > o.timeout_s * 1000u)
         throw std::runtime_error(std::string(host.established() ? "the transfer did not finish" : "no client answered") +
                                  " within " + std::to_string(o.timeout_s) + " s on " + b->describe());

@@ -51,7 +51,8 @@ class Backend {
 
 // Opens "pty:PATH" (any tty; raw mode at `baud`), "tcp:HOST:PORT" (client),
 // "tcp-listen:PORT" (server, waits for one peer) or "usb:VID:PID[:IFACE]"
-// (hex ids). "loopback" is not a device: see loopback.h.
+// (hex ids). "loopback" is not a device: see loopback.h. Serial and TCP
+// links are paced at `baud` (10 bits a byte) by the host side.
 std::unique_ptr<Backend> open_backend(const std::string& spec, uint32_t baud);
 
 // Moves bytes between a Link and a Backend. Bytes the Link produced but the

@@ -19,8 +19,14 @@ class FdBackend : public Backend {
   // With a queue limit set (serial ports), only as much as keeps the
   // driver's output queue below it, so a retransmission never waits behind
   // seconds of queued bytes; otherwise 4096.
+  // With a line rate set, also no more than the bytes a UART at that rate
+  // would have sent since the last write (a token bucket holding at most
+  // 20 ms of bytes): a pseudo-terminal or a socket to an emulator has no
+  // baud rate of its own, and without pacing the sender fills the kernel's
+  // buffers, the round trip grows with them, and retransmissions pile up.
   size_t write_room() override;
   void set_queue_limit(size_t bytes) { queue_limit_ = bytes; }
+  void set_pacing(uint32_t baud);
   size_t write(const uint8_t* data, size_t n) override;
   size_t read(uint8_t* buf, size_t n, int timeout_ms) override;
   std::string describe() const override { return name_; }
@@ -30,6 +36,9 @@ class FdBackend : public Backend {
   int fd_;
   std::string name_;
   size_t queue_limit_ = 0;
+  uint32_t bytes_per_s_ = 0;  // 0: not paced
+  uint64_t tokens_milli_ = 0;  // thousandths of a byte the line may still take
+  uint64_t last_us_ = 0;
 };
 
 // Opens a tty and puts it in raw mode (cfmakeraw: no echo, no line

@@ -1,0 +1,167 @@
+#!/usr/bin/env python3
+"""Plays a vds stream on a simulated client in one command: starts the
+client firmware on the chosen board, connects the link and runs `vds serve`.
+
+  host   the firmware as an ordinary process (boards/host); its UART is a new
+         pseudo-terminal, paced at --baud on both sides; it writes the frames
+         it displays as PNGs, a Y4M video (and an MP4 when ffmpeg is there)
+         and a contact sheet;
+  qemu   the Cortex-M4 firmware in qemu-system-arm -M mps2-an386 with
+         -icount shift=0; UART0 is a TCP socket that `vds serve` paces at
+         --baud (QEMU does not); the frame records carry the instruction
+         counts of every frame.
+
+Usage: scripts/sim.py --board host|qemu STREAM [--build build/host-release]
+       [--baud 115200] [--out DIR] [--timeout S]
+Exit status: 0 when the client displayed the whole stream and reported it
+intact, 1 otherwise, 2 for usage errors."""
+import argparse
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def free_port():
+    s = socket.socket()
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+    s.close()
+    return port
+
+
+def frame_crcs(serve_stdout):
+    """The CRC of every frame the client reported, from `vds serve` output."""
+    return [m.group(1) for m in re.finditer(r"^\s*frame\s+\d+\s+crc\s+([0-9a-f]{8})", serve_stdout, re.M)]
+
+
+def frame_instructions(serve_stdout):
+    """(parse, decode, display) instructions of every frame."""
+    return [tuple(int(v) for v in m.groups()) for m in
+            re.finditer(r"^\s*frame\s+\d+\s+crc\s+\S+\s+parse\s+(\d+)\s+decode\s+(\d+)\s+display\s+(\d+)",
+                        serve_stdout, re.M)]
+
+
+class Run:
+    """What one board run produced."""
+
+    def __init__(self, serve, board_rc, board_log, seconds, failure=None):
+        self.serve = serve
+        self.board_rc = board_rc
+        self.board_log = board_log
+        self.seconds = seconds
+        self.failure = failure
+
+    @property
+    def ok(self):
+        return self.failure is None and self.serve.returncode == 0 and self.board_rc == 0
+
+
+def serve_cmd(vds, stream, link, baud, timeout):
+    return [vds, "serve", stream, "--link", link, "--baud", str(baud), "--timeout", str(int(timeout))]
+
+
+def run_host(vds, board, stream, baud=115200, timeout=240, out_dir=None):
+    """The host-native board over a new pseudo-terminal."""
+    cmd = [board, "--uart", "pty-new", "--baud", str(baud)]
+    if out_dir:
+        os.makedirs(out_dir, exist_ok=True)
+        cmd += ["--frames", os.path.join(out_dir, "frames"), "--contact-sheet", os.path.join(out_dir, "contact_sheet.png"),
+                "--y4m", os.path.join(out_dir, "frames.y4m")]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = proc.stderr.readline()
+    m = re.match(r"uart: (\S+)", first)
+    if not m:
+        proc.kill()
+        out, err = proc.communicate()
+        return Run(subprocess.CompletedProcess(cmd, 1, "", ""), proc.returncode, first + out + err, 0,
+                   "the host board did not report its pseudo-terminal")
+    t0 = time.time()
+    serve = subprocess.run(serve_cmd(vds, stream, "pty:" + m.group(1), baud, timeout), capture_output=True, text=True)
+    seconds = time.time() - t0
+    failure = None
+    try:
+        out, err = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        out, err = proc.communicate()
+        failure = "the host board did not exit after the stream"
+    if out_dir and shutil.which("ffmpeg") and os.path.exists(os.path.join(out_dir, "frames.y4m")):
+        subprocess.run(["ffmpeg", "-loglevel", "error", "-y", "-i", os.path.join(out_dir, "frames.y4m"),
+                        "-pix_fmt", "yuv420p", os.path.join(out_dir, "frames.mp4")])
+    return Run(serve, proc.returncode, first + out + err, seconds, failure)
+
+
+def run_qemu(vds, qemu, elf, stream, baud=115200, timeout=240):
+    """The Cortex-M4 board in QEMU, UART0 on a TCP socket."""
+    port = free_port()
+    proc = subprocess.Popen([qemu, "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none",
+                             "-serial", f"tcp:127.0.0.1:{port},server=on,wait=on",
+                             "-semihosting-config", "enable=on,target=native", "-icount", "shift=0",
+                             "-kernel", elf], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    t0 = time.time()
+    serve = None
+    for _ in range(100):  # QEMU takes a moment to listen
+        serve = subprocess.run(serve_cmd(vds, stream, f"tcp:127.0.0.1:{port}", baud, timeout),
+                               capture_output=True, text=True)
+        if "ECONNREFUSED" not in serve.stderr or proc.poll() is not None:
+            break
+        time.sleep(0.1)
+    seconds = time.time() - t0
+    failure = None
+    try:
+        out, err = proc.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        out, err = proc.communicate()
+        failure = "QEMU did not exit after the stream"
+    return Run(serve, proc.returncode, out + err, seconds, failure)
+
+
+def main():
+    ap = argparse.ArgumentParser(description="Play a vds stream on a simulated client board.")
+    ap.add_argument("stream")
+    ap.add_argument("--board", choices=["host", "qemu"], required=True)
+    ap.add_argument("--build", default=os.path.join(ROOT, "build", "host-release"),
+                    help="build directory holding encoder/vds and the firmware")
+    ap.add_argument("--baud", type=int, default=115200)
+    ap.add_argument("--out", default="", help="host board: where frames, video and contact sheet go")
+    ap.add_argument("--timeout", type=float, default=600)
+    a = ap.parse_args()
+    vds = os.path.join(a.build, "encoder", "vds")
+    need = [vds]
+    if a.board == "host":
+        board = os.path.join(a.build, "firmware_sim", "vds_fw_client_host")
+        need.append(board)
+    else:
+        elf = os.path.join(a.build, "cm4", "firmware_sim", "vds_fw_client.elf")
+        need.append(elf)
+        if not shutil.which("qemu-system-arm"):
+            print("sim: qemu-system-arm not found (scripts/setup.sh installs it)", file=sys.stderr)
+            return 2
+    for p in need:
+        if not os.path.exists(p):
+            print(f"sim: {p} not found: build first (make demo builds {a.build})", file=sys.stderr)
+            return 2
+    if not os.path.isfile(a.stream):
+        print(f"sim: {a.stream}: no such stream file", file=sys.stderr)
+        return 2
+    if a.board == "host":
+        r = run_host(vds, board, a.stream, a.baud, a.timeout, a.out or None)
+    else:
+        r = run_qemu(vds, "qemu-system-arm", elf, a.stream, a.baud, a.timeout)
+    sys.stdout.write(r.serve.stdout)
+    sys.stderr.write(r.serve.stderr)
+    sys.stderr.write(r.board_log)
+    if r.failure:
+        print("sim: " + r.failure, file=sys.stderr)
+    return 0 if r.ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
