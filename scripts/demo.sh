@@ -1,54 +1,79 @@
 #!/usr/bin/env bash
-# The demo: builds are done by `make demo`; this encodes a small stream from
-# the sample data, reads it back with the client's parser (`vds info`), and
-# writes a short report to out/demo/report.md.
+# The demo (builds are done by `make demo`): a reel of twelve OpenArena
+# textures is encoded into one vds stream at 240x180, streamed by `vds serve`
+# over a pseudo-terminal at 115,200 baud to the client firmware on the
+# host-native board (which writes the frames, a Y4M video and a contact
+# sheet) and over TCP to the same firmware on the Cortex-M4 board in QEMU
+# (which reports its instruction counts). Both boards' frame CRCs must equal
+# the encoder's reconstruction. Then the client self-test on both boards and
+# the size of the client's parts. Everything goes to out/demo/; the summary
+# is out/demo/report.md.
 set -euo pipefail
 BUILD=${1:-build/host-release}
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 OUT="$ROOT/out/demo"
 VDS="$ROOT/$BUILD/encoder/vds"
-mkdir -p "$OUT"
+CM4="$ROOT/$BUILD/cm4/firmware_sim"
+PK3=/usr/share/games/openarena/baseoa/pak4-textures.pk3
+rm -rf "$OUT"
+mkdir -p "$OUT/src"
+[ -f "$PK3" ] || { echo "demo: $PK3 not found; run scripts/fetch-data.sh" >&2; exit 1; }
 
-TEX=$(ls /usr/share/glmark2/textures/*.jpg 2>/dev/null | head -n 1 || true)
-if [ -z "$TEX" ]; then
-  echo "demo: no glmark2 texture found; run scripts/fetch-data.sh" >&2
+echo "demo: 1/5 taking twelve textures from $(basename "$PK3")"
+python3 - "$PK3" "$OUT/src" <<'PY'
+import os, sys, zipfile
+pk3, out = sys.argv[1], sys.argv[2]
+reel = ["acc_dm3/comp_up.tga", "base_floor/concretefloor1.tga", "base_wall/concrete_ow.tga",
+        "base_wall/metalfloor_wall_15ow.tga", "bubctf1/e8_jumppad02.tga", "clown/vegetation.tga",
+        "cosmo_wall/brickwall1.tga", "czest3ctf/grass_lush.tga", "gothic_block/blocks17_ow.tga",
+        "gothic_wall/proto_brik.tga", "liquids/lavahell2.tga", "organics/dirt.tga"]
+with zipfile.ZipFile(pk3) as z:
+    for i, name in enumerate(reel):
+        with open(os.path.join(out, "%02d_%s" % (i, os.path.basename(name))), "wb") as f:
+            f.write(z.read("textures/" + name))
+PY
+
+echo "demo: 2/5 encoding, then streaming to both boards at 115,200 baud (about a minute)"
+python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
+  --qemu qemu-system-arm --elf "$CM4/vds_fw_client.elf" --work "$OUT" --quality 75 \
+  --inputs "$OUT"/src/*.tga --report "$OUT/run.json" > "$OUT/end_to_end.log" 2>&1 || {
+  tail -n 30 "$OUT/end_to_end.log"
+  echo "demo: the end-to-end run failed (log: out/demo/end_to_end.log)" >&2
   exit 1
-fi
+}
+grep -E '^(encoder|host|cortex-m4) *:|^end-to-end' "$OUT/end_to_end.log"
 
-echo "demo: packing $TEX into a stream"
-"$VDS" pack -o "$OUT/demo.vds" --mode images --size 240x180 --max-chunk 262144 \
-  --chunk "JPEG=$TEX" --meta "source=$(basename "$TEX") (glmark2-data)" --meta "title=vds demo stream"
-"$VDS" info "$OUT/demo.vds" | tee "$OUT/info.txt"
+echo "demo: 3/5 client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
+BOARDS=$(python3 "$ROOT/tests/tools/compare_boards.py" --host "$ROOT/$BUILD/firmware_sim/vds_fw_selftest_host" \
+  --qemu qemu-system-arm --elf "$CM4/vds_fw_selftest.elf")
+echo "$BOARDS" | grep -E '^boards'
 
-echo "demo: Cortex-M4 size of the client parts"
+echo "demo: 4/5 Cortex-M4 size of the client library and the link"
 SIZE_TABLE=$(python3 "$ROOT/tests/tools/check_freestanding.py" \
   --cxx arm-none-eabi-g++ --nm arm-none-eabi-nm --size arm-none-eabi-size --out "$OUT/linkcheck" \
   --lib "decoder=$ROOT/$BUILD/cm4/decoder/libvds_decoder.a" \
   --lib "transport_core=$ROOT/$BUILD/cm4/transport/libvds_transport_core.a")
-echo "$SIZE_TABLE"
 
-echo "demo: client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
-BOARDS=$(python3 "$ROOT/tests/tools/compare_boards.py" --host "$ROOT/$BUILD/firmware_sim/vds_fw_selftest_host" \
-  --qemu qemu-system-arm --elf "$ROOT/$BUILD/cm4/firmware_sim/vds_fw_selftest.elf")
-echo "$BOARDS" | grep -E '^(check|count|info|boards)' | sort -u
-
+echo "demo: 5/5 writing the report"
 {
-  echo "# vds demo report"
+  python3 "$ROOT/scripts/client_report.py" --run "$OUT/run.json" --elf "$CM4/vds_fw_client.elf" \
+    --map "$CM4/vds_fw_client.map" --title "vds demo: twelve textures to a simulated client" --images-dir host
   echo
-  echo "Stream: \`out/demo/demo.vds\`, $(stat -c %s "$OUT/demo.vds") bytes, from \`$TEX\`."
+  echo "Frames the host-native board displayed: \`out/demo/host/frames/\`, video \`out/demo/host/frames.y4m\`"
+  echo "(and \`frames.mp4\` when ffmpeg is installed). Stream: \`out/demo/e2e.vds\`; logs: \`out/demo/end_to_end.log\`."
   echo
-  echo '```'
-  cat "$OUT/info.txt"
-  echo '```'
-  echo
-  echo '```'
-  echo "$SIZE_TABLE"
-  echo '```'
-  echo
-  echo "Client self-test, host board vs Cortex-M4 board under QEMU (\`-icount shift=0\`):"
+  echo "## Client self-test, host board against the Cortex-M4 board"
   echo
   echo '```'
   echo "$BOARDS" | grep -E '^(check|count|info|boards)' | sort -u
   echo '```'
+  echo
+  echo "## Client library and link on the Cortex-M4 (freestanding link check)"
+  echo
+  echo '```'
+  echo "$SIZE_TABLE"
+  echo '```'
 } > "$OUT/report.md"
-echo "demo: report written to out/demo/report.md"
+sed -n '/^## The link/,/^## Flash/p' "$OUT/report.md" | grep -E '^\|' || true
+grep -E '^\*\*Minimum RAM' "$OUT/report.md" || true
+echo "demo: report written to out/demo/report.md, frames in out/demo/host/"
