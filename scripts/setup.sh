@@ -16,7 +16,7 @@ PACKAGES=(
   # anchors the benchmarks and conformance tests compare against
   libjpeg-turbo-progs libturbojpeg0-dev
   # measurement and plots
-  valgrind python3 python3-matplotlib python3-numpy
+  valgrind python3 python3-matplotlib python3-numpy python3-pil
 )
 
 if [ "${1:-}" = "--print" ]; then printf '%s\n' "${PACKAGES[@]}"; exit 0; fi

@@ -41,6 +41,7 @@ def main():
     ap.add_argument("--frames", type=int, default=4)
     ap.add_argument("--baud", type=int, default=115200)
     ap.add_argument("--quality", type=int, default=60)
+    ap.add_argument("--psnr", type=float, default=0, help="encode each frame to this PSNR instead of --quality")
     ap.add_argument("--inputs", nargs="*", default=[], help="images to use instead of synthetic frames")
     ap.add_argument("--report", default="", help="write the measurements as JSON")
     ap.add_argument("--timeout", type=float, default=300)
@@ -56,8 +57,9 @@ def main():
             inputs.append(p)
     stream = os.path.join(a.work, "e2e.vds")
     crc_file = os.path.join(a.work, "encoder.crc")
-    enc = subprocess.run([a.vds, "encode-frames", *inputs, "-o", stream, "--size", "240x180", "--quality",
-                          str(a.quality), "--max-chunk", "1024", "--crc-out", crc_file], capture_output=True, text=True)
+    rate = ["--psnr", str(a.psnr)] if a.psnr else ["--quality", str(a.quality)]
+    enc = subprocess.run([a.vds, "encode-frames", *inputs, "-o", stream, "--size", "240x180", *rate,
+                          "--max-chunk", "1024", "--crc-out", crc_file], capture_output=True, text=True)
     print(enc.stdout + enc.stderr)
     if enc.returncode != 0:
         print("encode-frames failed")
