@@ -1,10 +1,15 @@
 # The README's two commands. Each does its own set-up on a fresh Debian machine.
-.PHONY: demo test setup build-test build-release bench fuzz clean
+.PHONY: demo test setup data build-test build-release bench fuzz clean
 
 JOBS ?= 2
 
 setup:
 	bash scripts/setup.sh
+
+# The sample content (Debian packages): glmark2 models and textures,
+# OpenArena textures. Tests use it when present (real-data conformance).
+data:
+	bash scripts/fetch-data.sh
 
 build-test: setup
 	cmake --preset host
@@ -15,16 +20,15 @@ build-release: setup
 	cmake --build --preset host-release -j $(JOBS)
 
 ## make test: install, build (host under sanitizers + Cortex-M4), run every test
-test: build-test
+test: build-test data
 	ctest --preset host
 
 ## make demo: install, build, fetch sample data, encode, stream, report
-demo: build-release
-	bash scripts/fetch-data.sh
+demo: build-release data
 	bash scripts/demo.sh build/host-release
 
 ## make bench: the benchmarks against the anchors (slow; writes bench/results/)
-bench: build-release
+bench: build-release data
 	bash bench/run_all.sh build/host-release
 
 ## make fuzz: long libFuzzer runs (FUZZ_SECONDS each)

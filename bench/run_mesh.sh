@@ -117,9 +117,8 @@ EOF
   echo
   echo "One decode of each stream under \`valgrind --tool=callgrind --toggle-collect='vds::MeshDecoder::consume*'\`"
   echo "(the mesh decoder and everything it calls; container parsing and file reading excluded), x86-64"
-  echo "release build. The Cortex-M4 figure waits for the simulated board (QEMU); x86-64 and Thumb-2"
-  echo "instruction counts differ, but the work per split (ring walks, candidate scores, 64-bit"
-  echo "divisions done by a libgcc call on the M4) is the same code."
+  echo "release build. The Cortex-M4 figures (QEMU board) come from \`bench/run_mesh_m4.sh\`:"
+  echo "[mesh_m4.md](mesh_m4.md)."
   echo
   cat "$CG"
 } > "$OUT/mesh.md"

@@ -1,0 +1,163 @@
+// Progressive mesh decoding on the board: reads vds mesh streams from host
+// files (mesh_case0.vds, mesh_case1.vds, ... until one is missing; by
+// default the golden test stream), decodes each through the stream parser
+// and the mesh decoder, counts the instructions the mesh decoder spends on
+// the base and per level, and prints a checksum of the mesh after every
+// level. The host board and the Cortex-M4 board must print the same
+// "check" lines (ctest); bench/run_mesh.sh reads the "count" lines.
+#include <cstddef>
+#include <cstdint>
+
+#include "print.h"
+#include "vds/arena.h"
+#include "vds/board.h"
+#include "vds/container.h"
+#include "vds/mesh.h"
+
+#ifndef VDS_APP_WORKSPACE_MAX
+#error "VDS_APP_WORKSPACE_MAX (the largest workspace this build can use) must be set by the build"
+#endif
+
+namespace {
+
+using vds::fw::Line;
+using vds::Status;
+namespace board = vds::board;
+
+constexpr uint32_t kChunkBytes = 16384;  // the largest chunk payload accepted
+constexpr uint32_t kReadBytes = 4096;     // file bytes fed to the parser at a time
+
+alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
+uint8_t g_read[kReadBytes];
+
+struct Run {
+  vds::MeshDecoder decoder;
+  Status init_status = Status::ok;
+  uint64_t instructions = 0;        // inside MeshDecoder::consume, all chunks
+  uint64_t level_instructions = 0;  // since the last completed level
+  uint32_t level_vertices = 0;      // vertex count when that level completed
+  uint64_t base_instructions = 0;
+  uint32_t base_vertices = 0;
+  uint32_t levels = 0;
+};
+
+Run g_run;
+
+// FNV-1a over positions and corner vertices: the mesh after a level.
+uint32_t mesh_hash(const vds::MeshState& m) {
+  uint32_t h = 2166136261u;
+  auto mix = [&h](const void* p, size_t n) {
+    const uint8_t* b = static_cast<const uint8_t*>(p);
+    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 16777619u;
+  };
+  mix(m.positions(), static_cast<size_t>(m.vertex_count()) * 3 * sizeof(uint16_t));
+  mix(m.triangles(), static_cast<size_t>(m.triangle_count()) * 3 * sizeof(uint32_t));
+  return h;
+}
+
+vds::Arena g_arena;
+
+bool on_header(void*, const vds::StreamHeader& h) {
+  g_run.init_status = g_run.decoder.init(g_arena, h.max_vertices, h.max_triangles);
+  return g_run.init_status == Status::ok;
+}
+
+vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t size) {
+  if (!vds::MeshDecoder::handles(type)) return vds::ChunkResult::unknown;
+  const bool had_base = g_run.decoder.drawable();
+  const uint32_t levels_before = g_run.decoder.levels_done();
+  const uint64_t t0 = board::instructions();
+  const Status s = g_run.decoder.consume(type, payload, size);
+  const uint64_t spent = board::instructions() - t0;
+  g_run.instructions += spent;
+  g_run.level_instructions += spent;
+  if (s != Status::ok) {
+    board::log(Line().str("m4 error: mesh decoder: ").str(vds::status_name(s)).str("\n").c_str());
+    return vds::ChunkResult::abort;
+  }
+  const vds::MeshState& m = g_run.decoder.mesh();
+  if (!had_base && g_run.decoder.drawable()) {
+    g_run.base_instructions = g_run.level_instructions;
+    g_run.base_vertices = m.vertex_count();
+    g_run.level_instructions = 0;
+    g_run.level_vertices = m.vertex_count();
+    board::log(Line().str("check level=0 vertices=").dec(m.vertex_count()).str(" triangles=").dec(m.triangle_count())
+                   .str(" hash=0x").hex32(mesh_hash(m)).str("\n").c_str());
+  } else if (g_run.decoder.levels_done() != levels_before) {
+    const uint32_t splits = m.vertex_count() - g_run.level_vertices;
+    Line l;
+    l.str("check level=").dec(g_run.decoder.levels_done()).str(" vertices=").dec(m.vertex_count());
+    l.str(" triangles=").dec(m.triangle_count()).str(" hash=0x").hex32(mesh_hash(m)).str("\n");
+    board::log(l.c_str());
+    Line c;
+    c.str("count level=").dec(g_run.decoder.levels_done()).str(" splits=").dec(splits);
+    c.str(" instructions=").dec(g_run.level_instructions).str("\n");
+    board::log(c.c_str());
+    g_run.level_instructions = 0;
+    g_run.level_vertices = m.vertex_count();
+    ++g_run.levels;
+  }
+  return vds::ChunkResult::consumed;
+}
+
+// Decodes one stream file; false when it does not exist.
+bool run_file(const char* path, int* failures) {
+  const int32_t probe = board::host_file_read(path, 0, g_read, 1);
+  if (probe <= 0) return false;
+  g_arena = vds::Arena(g_workspace, sizeof g_workspace);
+  g_run = Run{};
+  vds::StreamParser parser;
+  vds::ChunkSink sink;
+  sink.on_header = on_header;
+  sink.on_chunk = on_chunk;
+  Status s = parser.init(g_arena, kChunkBytes, sink);
+  uint32_t offset = 0;
+  while (s == Status::ok || s == Status::more_input) {
+    const int32_t got = board::host_file_read(path, offset, g_read, kReadBytes);
+    if (got < 0) {
+      s = Status::io_error;
+      break;
+    }
+    if (got == 0) {
+      s = parser.finish();
+      break;
+    }
+    offset += static_cast<uint32_t>(got);
+    s = parser.feed(g_read, static_cast<size_t>(got));
+    if (s == Status::ok) break;
+  }
+  const vds::MeshState& m = g_run.decoder.mesh();
+  const uint32_t splits = m.vertex_count() - g_run.base_vertices;
+  const char* base = path;
+  for (const char* p = path; *p; ++p)
+    if (*p == '/') base = p + 1;
+  Line l;
+  l.str("m4 stream=").str(base).str(" status=").str(vds::status_name(s)).str(" vertices=").dec(m.vertex_count());
+  l.str(" splits=").dec(splits).str(" levels=").dec(g_run.levels).str(" instructions=").dec(g_run.instructions);
+  l.str(" base_instructions=").dec(g_run.base_instructions).str(" workspace=").dec(g_arena.high_water()).str("\n");
+  board::log(l.c_str());
+  if (s != Status::ok || !g_run.decoder.complete()) ++*failures;
+  return true;
+}
+
+}  // namespace
+
+extern "C" int vds_app_main() {
+  board::init();
+  int failures = 0;
+  int files = 0;
+  char name[32] = "mesh_case0.vds";
+  for (int i = 0; i < 10; ++i) {
+    name[9] = static_cast<char>('0' + i);
+    if (!run_file(name, &failures)) break;
+    ++files;
+  }
+  if (files == 0) {
+    // No benchmark files: decode the golden test stream (the ctest run).
+    if (!run_file(VDS_GOLDEN_MESH_STREAM, &failures)) {
+      board::log("m4 error: cannot read " VDS_GOLDEN_MESH_STREAM "\n");
+      return 1;
+    }
+  }
+  return failures == 0 ? 0 : 1;
+}
