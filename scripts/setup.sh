@@ -13,6 +13,7 @@ PACKAGES=(
   # host libraries
   libgtest-dev libgmock-dev libbenchmark-dev libusb-1.0-0-dev
   libdraco-dev draco libcli11-dev libstb-dev libpng-dev libassimp-dev libzip-dev
+  libsdl2-dev
   # anchors the benchmarks and conformance tests compare against
   libjpeg-turbo-progs libturbojpeg0-dev
   # measurement and plots

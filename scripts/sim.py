@@ -12,7 +12,7 @@ client firmware on the chosen board, connects the link and runs `vds serve`.
          counts of every frame.
 
 Usage: scripts/sim.py --board host|qemu STREAM [--build build/host-release]
-       [--baud 115200] [--out DIR] [--timeout S]
+       [--baud 115200] [--out DIR] [--window] [--timeout S]
 Exit status: 0 when the client displayed the whole stream and reported it
 intact, 1 otherwise, 2 for usage errors."""
 import argparse
@@ -66,14 +66,14 @@ def serve_cmd(vds, stream, link, baud, timeout):
     return [vds, "serve", stream, "--link", link, "--baud", str(baud), "--timeout", str(int(timeout))]
 
 
-def run_host(vds, board, stream, baud=115200, timeout=240, out_dir=None):
+def run_host(vds, board, stream, baud=115200, timeout=240, out_dir=None, window=False, env=None):
     """The host-native board over a new pseudo-terminal."""
-    cmd = [board, "--uart", "pty-new", "--baud", str(baud)]
+    cmd = [board, "--uart", "pty-new", "--baud", str(baud)] + (["--window"] if window else [])
     if out_dir:
         os.makedirs(out_dir, exist_ok=True)
         cmd += ["--frames", os.path.join(out_dir, "frames"), "--contact-sheet", os.path.join(out_dir, "contact_sheet.png"),
                 "--y4m", os.path.join(out_dir, "frames.y4m")]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     first = proc.stderr.readline()
     m = re.match(r"uart: (\S+)", first)
     if not m:
@@ -131,6 +131,7 @@ def main():
                     help="build directory holding encoder/vds and the firmware")
     ap.add_argument("--baud", type=int, default=115200)
     ap.add_argument("--out", default="", help="host board: where frames, video and contact sheet go")
+    ap.add_argument("--window", action="store_true", help="host board: show the frames in a live window (SDL2)")
     ap.add_argument("--timeout", type=float, default=600)
     a = ap.parse_args()
     vds = os.path.join(a.build, "encoder", "vds")
@@ -152,7 +153,7 @@ def main():
         print(f"sim: {a.stream}: no such stream file", file=sys.stderr)
         return 2
     if a.board == "host":
-        r = run_host(vds, board, a.stream, a.baud, a.timeout, a.out or None)
+        r = run_host(vds, board, a.stream, a.baud, a.timeout, a.out or None, a.window)
     else:
         r = run_qemu(vds, "qemu-system-arm", elf, a.stream, a.baud, a.timeout)
     sys.stdout.write(r.serve.stdout)

@@ -66,7 +66,10 @@ def main():
         return 1
     want = open(crc_file).read().split()
 
-    host = sim.run_host(a.vds, a.host_board, stream, a.baud, a.timeout, os.path.join(a.work, "host"))
+    # The live window too, on SDL's headless video driver.
+    env = dict(os.environ, SDL_VIDEODRIVER="dummy")
+    host = sim.run_host(a.vds, a.host_board, stream, a.baud, a.timeout, os.path.join(a.work, "host"), window=True,
+                        env=env)
     print("== vds serve over a pty (host-native board)\n" + host.serve.stdout + host.serve.stderr)
     print("== host-native board\n" + host.board_log)
     qemu = sim.run_qemu(a.vds, a.qemu, a.elf, stream, a.baud, a.timeout)
@@ -92,6 +95,8 @@ def main():
     instr = sim.frame_instructions(qemu.serve.stdout)
     if len(instr) == len(want) and any(d == 0 for _, d, _ in instr):
         failures.append("the Cortex-M4 board reported frames without instruction counts")
+    if "window:" in host.board_log:
+        failures.append("the host board could not show its live window")
     png = os.path.join(a.work, "host", "frames", "frame0000.png")
     if not os.path.exists(png) or not os.path.exists(os.path.join(a.work, "host", "contact_sheet.png")):
         failures.append("the host board wrote no frame PNGs or contact sheet")

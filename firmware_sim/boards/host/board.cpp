@@ -1,8 +1,9 @@
 // The host-native board: the client firmware in an ordinary process.
 // Its UART is any link backend (pty, TCP; see transport/host), paced at a
 // chosen baud rate; its display writes PNG frames, a Y4M video and a
-// contact sheet; its workspace budget is a run-time option. The console is
-// stderr. There is no instruction counter (count with callgrind instead).
+// contact sheet, and shows them in a live window (SDL2) on request; its
+// workspace budget is a run-time option. The console is stdout. There is no
+// instruction counter (count with callgrind instead).
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -21,6 +22,7 @@
 #include "vds/enc/image_io.h"
 #include "vds/link/backend.h"
 #include "vds/link/fd_backends.h"
+#include "window.h"
 
 extern "C" int vds_app_main();
 
@@ -37,11 +39,14 @@ struct Options {
   std::string contact_sheet;   // thumbnails of every frame in one PNG
   size_t workspace = 256 * 1024;
   int contact_columns = 6;
+  bool window = false;         // live window (SDL2)
+  int window_scale = 2;
 };
 
 Options g_opt;
 Clock::time_point g_start;
 std::unique_ptr<link::Backend> g_uart;
+Window g_window;
 bool g_uart_traffic = false;  // a byte has arrived: the host is there
 bool g_uart_closed = false;   // and has gone since
 
@@ -227,6 +232,15 @@ void display_end_frame(uint32_t frame_crc) {
   }
   if (!g_opt.y4m.empty()) write_y4m_frame(img);
   if (!g_opt.contact_sheet.empty()) g_thumbs.push_back(thumbnail(img, 2));
+  if (g_opt.window) {
+    std::string error;
+    if (!g_window.is_open() && !g_window.open(g_width, g_height, g_opt.window_scale, &error)) {
+      std::fprintf(stderr, "vds board: %s; going on without it\n", error.c_str());
+      g_opt.window = false;
+    } else if (!g_window.show(img, g_frame_index)) {
+      g_opt.window = false;  // closed by the user; the run goes on
+    }
+  }
   ++g_frame_index;
 }
 
@@ -255,6 +269,9 @@ int main(int argc, char** argv) {
   app.add_option("--y4m", g_opt.y4m, "Write the displayed frames as a Y4M video");
   app.add_option("--contact-sheet", g_opt.contact_sheet, "Write thumbnails of all frames to this PNG");
   app.add_option("--workspace", g_opt.workspace, "Workspace budget of the client, bytes")->capture_default_str();
+  app.add_flag("--window", g_opt.window, "Show the frames in a live window (SDL2)");
+  app.add_option("--window-scale", g_opt.window_scale, "Window pixels per frame pixel")->check(CLI::Range(1, 8))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
     if (!g_opt.frames_dir.empty()) std::filesystem::create_directories(g_opt.frames_dir);

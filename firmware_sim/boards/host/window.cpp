@@ -1,0 +1,85 @@
+// The host board's live window on SDL2 (see window.h).
+#include "window.h"
+
+#if VDS_HAVE_SDL2
+#include <SDL2/SDL.h>
+#endif
+
+namespace vds::board {
+
+#if VDS_HAVE_SDL2
+
+struct Window::Impl {
+  SDL_Window* window = nullptr;
+  SDL_Renderer* renderer = nullptr;
+  SDL_Texture* texture = nullptr;
+  int width = 0, height = 0;
+};
+
+namespace {
+void release(Window::Impl* w) {
+  if (!w) return;
+  if (w->texture) SDL_DestroyTexture(w->texture);
+  if (w->renderer) SDL_DestroyRenderer(w->renderer);
+  if (w->window) SDL_DestroyWindow(w->window);
+  SDL_Quit();
+  delete w;
+}
+}  // namespace
+
+Window::~Window() { release(impl_); }
+
+bool Window::open(int width, int height, int scale, std::string* error) {
+  if (SDL_Init(SDL_INIT_VIDEO) != 0) {
+    *error = std::string("window: SDL cannot start video: ") + SDL_GetError();
+    return false;
+  }
+  auto* w = new Impl;
+  w->width = width;
+  w->height = height;
+  w->window = SDL_CreateWindow("vds client (host board)", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED,
+                               width * scale, height * scale, 0);
+  if (w->window) w->renderer = SDL_CreateRenderer(w->window, -1, SDL_RENDERER_SOFTWARE);
+  if (w->renderer)
+    w->texture = SDL_CreateTexture(w->renderer, SDL_PIXELFORMAT_RGB24, SDL_TEXTUREACCESS_STREAMING, width, height);
+  if (!w->texture) {
+    *error = std::string("window: ") + SDL_GetError();
+    release(w);
+    return false;
+  }
+  impl_ = w;
+  return true;
+}
+
+bool Window::show(const enc::Image& rgb, uint32_t index) {
+  if (!impl_) return false;
+  SDL_Event e;
+  while (SDL_PollEvent(&e))
+    if (e.type == SDL_QUIT) return false;
+  if (rgb.width == impl_->width && rgb.height == impl_->height && rgb.channels == 3) {
+    SDL_UpdateTexture(impl_->texture, nullptr, rgb.pixels.data(), rgb.width * 3);
+    SDL_RenderClear(impl_->renderer);
+    SDL_RenderCopy(impl_->renderer, impl_->texture, nullptr, nullptr);
+    SDL_RenderPresent(impl_->renderer);
+  }
+  const std::string title = "vds client (host board): frame " + std::to_string(index);
+  SDL_SetWindowTitle(impl_->window, title.c_str());
+  return true;
+}
+
+#else
+
+struct Window::Impl {};
+
+Window::~Window() = default;
+
+bool Window::open(int, int, int, std::string* error) {
+  *error = "window: this build has no SDL2 (install libsdl2-dev and rebuild)";
+  return false;
+}
+
+bool Window::show(const enc::Image&, uint32_t) { return false; }
+
+#endif
+
+}  // namespace vds::board

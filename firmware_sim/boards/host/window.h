@@ -1,0 +1,31 @@
+// The host board's optional live window: shows each displayed frame as it
+// completes. Built with SDL2 when the build finds it; otherwise open()
+// reports that the window is not available.
+#pragma once
+#include <cstdint>
+#include <string>
+
+#include "vds/enc/image_io.h"
+
+namespace vds::board {
+
+class Window {
+ public:
+  Window() = default;
+  ~Window();
+  Window(const Window&) = delete;
+  Window& operator=(const Window&) = delete;
+  // Opens a window `scale` times the frame size; false with `error` set
+  // when it cannot (no SDL2 in this build, no display).
+  bool open(int width, int height, int scale, std::string* error);
+  bool is_open() const { return impl_ != nullptr; }
+  // Shows a frame; false once the user has closed the window.
+  bool show(const enc::Image& rgb, uint32_t index);
+
+  struct Impl;
+
+ private:
+  Impl* impl_ = nullptr;
+};
+
+}  // namespace vds::board
