@@ -6,24 +6,36 @@
 #     and output format, and side-by-side PNGs (reference | client | |diff| x 16);
 #   - x86-64 instructions per frame and per pixel from callgrind (a proxy);
 #   - Cortex-M4: .text of the renderer (arm-none-eabi-g++ -O2), stack use, and,
-#     when qemu-system-arm is present, instructions per frame under QEMU
-#     mps2-an386 with -icount (bench/m4/render_qemu.cpp) plus a bit-exactness
-#     check of every frame's CRC-32C against the host;
+#     when qemu-system-arm is present, instructions per frame on the QEMU board
+#     (mps2-an386, -icount) from the firmware vds_fw_bench_render
+#     (firmware_sim/app/bench_render.cpp), plus a bit-exactness check of every
+#     frame's CRC-32C against the host;
 #   - workspace bytes of typical configurations.
 #
-# Usage: bench/run_render.sh [BUILD_DIR]        (default build/host-release)
-#   The build dir must hold bench_render:
+# Usage: bench/run_render.sh [BUILD_DIR [CM4_BUILD_DIR]]
+#   BUILD_DIR (default build/host-release) must hold bench_render:
 #     cmake -S . -B build/host-release -G Ninja -DCMAKE_C_COMPILER=clang \
 #       -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=Release -DVDS_BUILD_FIRMWARE=OFF
 #     cmake --build build/host-release -j1 --target bench_render
+#   CM4_BUILD_DIR holds the firmware (firmware_sim/vds_fw_bench_render.elf);
+#   default BUILD_DIR/cm4 when it has one (host presets build it), else
+#   build/cortex-m4:
+#     cmake --preset cortex-m4 && cmake --build --preset cortex-m4 --target vds_fw_bench_render
 #   The script configures and builds nothing in the tree; the Cortex-M4
-#   objects are compiled into a temporary directory.
+#   objects for the size and stack figures are compiled into a temporary
+#   directory.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-build/host-release}
 case "$BUILD" in /*) ;; *) BUILD="$ROOT/$BUILD" ;; esac
 BENCH="$BUILD/bench/bench_render"
+CM4=${2:-}
+if [[ -z "$CM4" ]]; then
+  if [[ -f "$BUILD/cm4/firmware_sim/vds_fw_bench_render.elf" ]]; then CM4="$BUILD/cm4"; else CM4="$ROOT/build/cortex-m4"; fi
+fi
+case "$CM4" in /*) ;; *) CM4="$ROOT/$CM4" ;; esac
+ELF="$CM4/firmware_sim/vds_fw_bench_render.elf"
 OUT="$ROOT/bench/results/render.md"
 FRAMES=4  # frames per callgrind run
 M4_FRAMES=3
@@ -38,36 +50,14 @@ trap 'rm -rf "$WORK"' EXIT
 echo "== accuracy"
 "$BENCH" accuracy "$ROOT/bench/results" | tee "$WORK/accuracy.md"
 
-# 2. The cases measured on both targets: label scene texture output depth band cache filter.
-# quad / quad480: a textured plane filling 240x180 (480x180) pixels, every
-# pixel drawn once, perspective-correct, z-tested; their difference is the
-# per-pixel cost. empty: band clearing only.
-cat >"$WORK/cases.txt" <<'EOF'
-quad-nearest-d32-b180 quad rgb565 rgb565 d32 180 4096 nearest
-quad480-nearest-d32-b180 quad480 rgb565 rgb565 d32 180 4096 nearest
-quad-nearest-d32-b16 quad rgb565 rgb565 d32 16 4096 nearest
-quad-bilinear-d32-b180 quad rgb565 rgb565 d32 180 4096 bilinear
-quad480-bilinear-d32-b180 quad480 rgb565 rgb565 d32 180 4096 bilinear
-quad-bilinear-d32-b16 quad rgb565 rgb565 d32 16 4096 bilinear
-quad-bilinear-d16-b16 quad rgb565 rgb565 d16 16 4096 bilinear
-quad-bilinear888-d32-b16 quad xrgb8888 rgb888 d32 16 4096 bilinear
-empty-d32-b180 empty rgb565 rgb565 d32 180 4096 nearest
-empty-d32-b16 empty rgb565 rgb565 d32 16 4096 nearest
-empty-d16-b16 empty rgb565 rgb565 d16 16 4096 nearest
-cube-d16-b16 cube rgb565 rgb565 d16 16 4096 bilinear
-terrain-d16-b16 terrain rgb565 rgb565 d16 16 4096 bilinear
-room-d16-b16 room rgb565 rgb565 d16 16 4096 bilinear
-room-d16-b16-nocache room rgb565 rgb565 d16 16 0 bilinear
-cube-from-view-d16-b16 cube-from-view rgb565 rgb565 d16 16 4096 bilinear
-golden-d16-b16 golden rgb565 rgb565 d16 16 4096 bilinear
-golden888-d32-b180 golden xrgb8888 rgb888 d32 180 4096 bilinear
-EOF
+# 2. The cases measured on both targets (the list: kCases in bench/src/render.cpp),
+# as $WORK/render_case<i>.bin; cases.txt: label scene texture output depth band cache filter.
+"$BENCH" cases "$WORK" "$M4_FRAMES" | tee "$WORK/case_list.txt" | cut -d' ' -f2- >"$WORK/cases.txt"
 
 # 3. x86-64: callgrind counts inside the measured render calls.
 echo "== callgrind ($FRAMES frames per case)"
 i=0
 while read -r label scene tex out depth band cache filter; do
-  "$BENCH" dump "$label" "$scene" "$tex" "$out" "$depth" "$band" "$cache" "$M4_FRAMES" "$filter" "$WORK/render_case$i.bin"
   valgrind --tool=callgrind --callgrind-out-file="$WORK/cg.$i" --toggle-collect='*measured_render*' \
     "$BENCH" frames "$WORK/render_case$i.bin" "$FRAMES" >"$WORK/host.$i" 2>"$WORK/vg.$i"
   ir=$(awk '/^totals:/ {print $2}' "$WORK/cg.$i")
@@ -98,15 +88,15 @@ if command -v arm-none-eabi-g++ >/dev/null; then
   arm-none-eabi-nm -u "$WORK"/m4/render*.o "$WORK/m4/homography.o" | awk 'NF {print $NF}' | grep -v ':$' | sort -u >"$WORK/undef_all.txt"
   arm-none-eabi-nm --defined-only "$WORK"/m4/render*.o "$WORK/m4/homography.o" | awk 'NF == 3 {print $3}' | sort -u >"$WORK/defined.txt"
   comm -23 "$WORK/undef_all.txt" "$WORK/defined.txt" | arm-none-eabi-c++filt >"$WORK/undef.txt"
-  if command -v qemu-system-arm >/dev/null; then
+  if command -v qemu-system-arm >/dev/null && [[ -f "$ELF" ]]; then
     HAVE_QEMU=1
-    echo "== QEMU mps2-an386 -icount shift=0"
-    arm-none-eabi-g++ "${ARM_FLAGS[@]}" -c "$ROOT/bench/m4/render_qemu.cpp" -o "$WORK/m4/render_qemu.o"
-    arm-none-eabi-g++ -mcpu=cortex-m4 -mthumb -mfloat-abi=soft -nostartfiles -T "$ROOT/bench/m4/render_qemu.ld" \
-      -Wl,--gc-sections "$WORK/m4/render_qemu.o" "$WORK"/m4/render.o "$WORK"/m4/render_setup.o "$WORK"/m4/render_clip.o \
-      "$WORK"/m4/render_camera.o "$WORK"/m4/fixed.o "$WORK"/m4/crc32c.o "$WORK"/m4/status.o -lc -lgcc -o "$WORK/render_qemu.elf"
-    (cd "$WORK" && timeout 1200 qemu-system-arm -M mps2-an386 -cpu cortex-m4 -nographic -monitor none -serial none \
-      -semihosting-config enable=on,target=native -icount shift=0 -kernel render_qemu.elf) 2>&1 | tee "$WORK/m4.txt"
+    echo "== QEMU mps2-an386 -icount shift=0 ($ELF)"
+    # The firmware reads render_case<i>.bin from its working directory
+    # through semihosting; its console output arrives on QEMU's stderr.
+    (cd "$WORK" && timeout 1200 qemu-system-arm -M mps2-an386 -cpu cortex-m4 -nographic -monitor none -serial null \
+      -semihosting-config enable=on,target=native -icount shift=0 -kernel "$ELF") 2>&1 | tee "$WORK/m4.txt"
+  else
+    echo "run_render.sh: no QEMU or no $ELF (see the header of this script): Cortex-M4 counts skipped" >&2
   fi
 fi
 
@@ -114,8 +104,9 @@ fi
 "$BENCH" ram >"$WORK/ram.txt"
 
 # 6. The report.
-BUILD_ARG=${1:-build/host-release}
-export WORK OUT FRAMES HAVE_ARM HAVE_QEMU BENCH BUILD_ARG
+BUILD_ARG="${1:-build/host-release}${2:+ $2}"
+ELF_REL=$(realpath --relative-to="$ROOT" "$ELF")
+export WORK OUT FRAMES HAVE_ARM HAVE_QEMU BENCH BUILD_ARG ELF_REL
 export CPU="$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//')"
 export HOSTCXX="$(clang++ --version | head -1)"
 export ARMCXX="$( (arm-none-eabi-g++ --version 2>/dev/null || echo none) | head -1)"

@@ -19,8 +19,13 @@
 //   bench_render ram                 workspace bytes of typical configurations
 //   bench_render dump LABEL SCENE TEX OUT DEPTH BAND CACHE FRAMES FILTER FILE
 //                                    a scene (or quad, or empty) with render settings
-//                                    as a flat binary for the Cortex-M4 run
-//                                    (bench/m4/render_qemu.cpp); FILTER applies to quad
+//                                    as a flat binary for the board run
+//                                    (firmware_sim/app/bench_render.cpp); FILTER applies
+//                                    to quad; CACHE > 0 also turns on a 16-entry setup cache
+//   bench_render cases DIR FRAMES    the benchmark's standard cases as
+//                                    DIR/render_case<i>.bin (FRAMES measured frames each),
+//                                    one line per case on stdout: i label scene tex out
+//                                    depth band cache filter
 // Frame commands print the pixels rasterised and a CRC-32C of the last frame.
 #include <algorithm>
 #include <cmath>
@@ -41,6 +46,9 @@ using namespace vds;
 using namespace vds::enc;
 
 namespace {
+
+// Set-up cache entries of the measured cases that use caches.
+constexpr uint32_t kBenchSetupCache = 16;
 
 [[noreturn]] void usage() {
   std::fprintf(stderr, "usage: see the header of bench/src/render.cpp\n");
@@ -233,24 +241,26 @@ int run_frames(const ClientScene& cs, int w, int h, const ClientRenderSettings& 
 }
 
 int cmd_ram() {
-  std::printf("| size | band rows | output | depth | vertex cache | triangle cache | colour buffer | workspace bytes |\n"
-              "|---|---|---|---|---|---|---|---|\n");
+  std::printf("| size | band rows | output | depth | vertex cache | triangle cache | setup cache | colour buffer | workspace bytes |\n"
+              "|---|---|---|---|---|---|---|---|---|\n");
   struct C {
     int w, h, band;
     PixelFormat f;
     DepthFormat d;
-    uint32_t vcache, tcache;
+    uint32_t vcache, tcache, scache;
     bool target;
   };
   const C cs[] = {
-      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d16, 0, 0, false},
-      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d16, 0, 0, true},
-      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d16, 1089, 2048, false},
-      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d32, 0, 0, false},
-      {240, 180, 8, PixelFormat::rgb565, DepthFormat::d32, 0, 0, false},
-      {240, 180, 180, PixelFormat::rgb565, DepthFormat::d16, 0, 0, false},
-      {240, 180, 16, PixelFormat::rgb888, DepthFormat::d16, 0, 0, false},
-      {320, 240, 16, PixelFormat::rgb565, DepthFormat::d16, 0, 0, false},
+      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d16, 0, 0, 0, false},
+      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d16, 0, 0, 2, false},
+      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d16, 0, 0, 0, true},
+      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d16, 0, 0, 16, true},
+      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d16, 1089, 2048, 16, false},
+      {240, 180, 16, PixelFormat::rgb565, DepthFormat::d32, 0, 0, 0, false},
+      {240, 180, 8, PixelFormat::rgb565, DepthFormat::d32, 0, 0, 0, false},
+      {240, 180, 180, PixelFormat::rgb565, DepthFormat::d16, 0, 0, 0, false},
+      {240, 180, 16, PixelFormat::rgb888, DepthFormat::d16, 0, 0, 0, false},
+      {320, 240, 16, PixelFormat::rgb565, DepthFormat::d16, 0, 0, 0, false},
   };
   static uint8_t frame[320 * 240 * 3];
   for (const C& c : cs) {
@@ -262,12 +272,13 @@ int cmd_ram() {
     cfg.depth = c.d;
     cfg.vertex_cache = c.vcache;
     cfg.triangle_cache = c.tcache;
+    cfg.setup_cache = c.scache;
     if (c.target) {
       cfg.target = frame;
       cfg.target_stride = static_cast<uint32_t>(c.w * bytes_per_pixel(c.f));
     }
-    std::printf("| %dx%d | %d | %s | %s | %u | %u | %s | %zu |\n", c.w, c.h, c.band,
-                c.f == PixelFormat::rgb565 ? "rgb565" : "rgb888", name(c.d), c.vcache, c.tcache,
+    std::printf("| %dx%d | %d | %s | %s | %u | %u | %u | %s | %zu |\n", c.w, c.h, c.band,
+                c.f == PixelFormat::rgb565 ? "rgb565" : "rgb888", name(c.d), c.vcache, c.tcache, c.scache,
                 c.target ? "caller's frame" : "in workspace", render_workspace_size(cfg));
   }
   std::printf("sizeof(Renderer)=%zu\n", sizeof(Renderer));
@@ -275,9 +286,9 @@ int cmd_ram() {
 }
 
 // Flat little-endian dump of a client scene and render settings for
-// bench/m4/render_qemu.cpp (rgb565 and xrgb8888 textures only):
-//   u32 magic 'VRS2', char name[32], u8 output, u8 depth, u16 band rows,
-//   u32 vertex cache, u32 triangle cache, u32 frames, u16 width, u16 height,
+// firmware_sim/app/bench_render.cpp (rgb565 and xrgb8888 textures only):
+//   u32 magic 'VRS3', char name[32], u8 output, u8 depth, u16 band rows,
+//   u32 vertex cache, u32 triangle cache, u32 setup cache, u32 frames, u16 width, u16 height,
 //   camera (18 x i32: rotation 9, position 3, fx fy cx cy near far), u32 clear colour,
 //   u32 num_positions, positions (3 x i32 each),
 //   u32 num_textures, per texture: u8 format, u8 address, u16 w, u16 h, u8 apron, u8 pad,
@@ -285,7 +296,8 @@ int cmd_ram() {
 //   u32 num_meshes, per mesh: u8 shading, filter, cull, pad; u32 colour; i32 texture;
 //     9 x i32 view map; u32 triangles; u16 indices (3 per triangle),
 //   u32 has_uvs, uvs (2 x i32 per position), u32 has_colours, colours (u32 per position).
-// Every array starts on a 4-byte boundary.
+// Every array starts on a 4-byte boundary. The vertex and triangle caches
+// are cut to the scene's counts (the same picture; less RAM on the board).
 int cmd_dump(const std::string& label, const Scene& sc, TexFormat tf, const ClientRenderSettings& st, int frames,
              const std::string& file) {
   if (tf == TexFormat::ycbcr420) usage();
@@ -303,15 +315,18 @@ int cmd_dump(const std::string& label, const Scene& sc, TexFormat tf, const Clie
     out.insert(out.end(), static_cast<const uint8_t*>(p), static_cast<const uint8_t*>(p) + n);
     while (out.size() % 4) out.push_back(0);
   };
-  u32(0x32535256);
+  uint32_t num_tris = 0;
+  for (uint32_t i = 0; i < cs.list().num_meshes; ++i) num_tris += cs.list().meshes[i].num_triangles;
+  u32(0x33535256);
   char name32[32] = {};
   std::strncpy(name32, label.c_str(), 31);
   bytes(name32, 32);
   out.push_back(static_cast<uint8_t>(st.format));
   out.push_back(static_cast<uint8_t>(st.depth));
   u16(static_cast<uint32_t>(st.band_height));
-  u32(st.vertex_cache);
-  u32(st.triangle_cache);
+  u32(std::min(st.vertex_cache, cs.list().num_positions));
+  u32(std::min(st.triangle_cache, num_tris));
+  u32(st.setup_cache);
   u32(static_cast<uint32_t>(frames));
   u16(static_cast<uint32_t>(sc.width));
   u16(static_cast<uint32_t>(sc.height));
@@ -418,7 +433,7 @@ bool load_case(const std::string& path, LoadedCase& c) {
     while (pos % 4 && pos < c.file.size()) ++pos;
     return p;
   };
-  if (u32() != 0x32535256) return false;
+  if (u32() != 0x33535256) return false;
   c.label.assign(reinterpret_cast<const char*>(take(32)), 32);
   c.label = c.label.c_str();
   c.cfg.format = static_cast<PixelFormat>(u8());
@@ -426,6 +441,7 @@ bool load_case(const std::string& path, LoadedCase& c) {
   c.cfg.band_height = u16();
   c.cfg.vertex_cache = u32();
   c.cfg.triangle_cache = u32();
+  c.cfg.setup_cache = u32();
   c.frames = u32();
   c.cfg.width = u16();
   c.cfg.height = u16();
@@ -511,6 +527,64 @@ int cmd_frames(const std::string& path, int n) {
   return 0;
 }
 
+// The benchmark's cases: label scene texture output depth band cache filter.
+// quad / quad480: a textured plane filling 240x180 (480x180) pixels, every
+// pixel drawn once, perspective-correct, z-tested; their difference is the
+// per-pixel cost. empty: band clearing only. The cases with one 180-row band
+// and the xrgb8888 quad do not fit in the Cortex-M4 board's RAM (the board
+// skips them).
+struct BenchCase {
+  const char *label, *scene, *tex, *out, *depth;
+  int band;
+  uint32_t cache;
+  const char* filter;
+};
+const BenchCase kCases[] = {
+    {"quad-nearest-d32-b16", "quad", "rgb565", "rgb565", "d32", 16, 4096, "nearest"},
+    {"quad480-nearest-d32-b16", "quad480", "rgb565", "rgb565", "d32", 16, 4096, "nearest"},
+    {"quad-nearest-d16-b16", "quad", "rgb565", "rgb565", "d16", 16, 4096, "nearest"},
+    {"quad-bilinear-d32-b16", "quad", "rgb565", "rgb565", "d32", 16, 4096, "bilinear"},
+    {"quad480-bilinear-d32-b16", "quad480", "rgb565", "rgb565", "d32", 16, 4096, "bilinear"},
+    {"quad-bilinear-d16-b16", "quad", "rgb565", "rgb565", "d16", 16, 4096, "bilinear"},
+    {"quad-bilinear-d16-b8", "quad", "rgb565", "rgb565", "d16", 8, 4096, "bilinear"},
+    {"quad-bilinear-d32-b180", "quad", "rgb565", "rgb565", "d32", 180, 4096, "bilinear"},
+    {"quad-bilinear888-d32-b16", "quad", "xrgb8888", "rgb888", "d32", 16, 4096, "bilinear"},
+    {"empty-d32-b16", "empty", "rgb565", "rgb565", "d32", 16, 4096, "nearest"},
+    {"empty-d16-b16", "empty", "rgb565", "rgb565", "d16", 16, 4096, "nearest"},
+    {"cube-d16-b16", "cube", "rgb565", "rgb565", "d16", 16, 4096, "bilinear"},
+    {"terrain-d16-b16", "terrain", "rgb565", "rgb565", "d16", 16, 4096, "bilinear"},
+    {"room-d16-b16", "room", "rgb565", "rgb565", "d16", 16, 4096, "bilinear"},
+    {"room-d16-b16-nocache", "room", "rgb565", "rgb565", "d16", 16, 0, "bilinear"},
+    {"cube-from-view-d16-b16", "cube-from-view", "rgb565", "rgb565", "d16", 16, 4096, "bilinear"},
+    {"golden-d16-b16", "golden", "rgb565", "rgb565", "d16", 16, 4096, "bilinear"},
+    {"golden888-d32-b16", "golden", "xrgb8888", "rgb888", "d32", 16, 4096, "bilinear"},
+};
+
+int cmd_cases(const std::string& dir, int frames) {
+  int i = 0;
+  for (const BenchCase& c : kCases) {
+    const std::string n = c.scene;
+    const Filter f = std::string(c.filter) == "nearest" ? Filter::nearest : Filter::bilinear;
+    ClientRenderSettings st;
+    st.format = out_format(c.out);
+    st.depth = depth_format(c.depth);
+    st.band_height = c.band;
+    st.vertex_cache = c.cache;
+    st.triangle_cache = c.cache;
+    st.setup_cache = c.cache ? kBenchSetupCache : 0;
+    Scene sc = n == "empty" ? make_quad_scene(f) : scene_by_name(n, f);
+    if (n == "empty") sc.meshes.clear();
+    const std::string file = dir + "/render_case" + std::to_string(i) + ".bin";
+    if (cmd_dump(c.label, sc, tex_format(c.tex), st, frames, file) != 0) {
+      std::fprintf(stderr, "cannot write %s\n", file.c_str());
+      return 1;
+    }
+    std::printf("%d %s %s %s %s %s %d %u %s\n", i, c.label, c.scene, c.tex, c.out, c.depth, c.band, c.cache, c.filter);
+    ++i;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -559,9 +633,11 @@ int main(int argc, char** argv) {
     st.band_height = std::atoi(argv[7]);
     st.vertex_cache = static_cast<uint32_t>(std::atoi(argv[8]));
     st.triangle_cache = st.vertex_cache;  // the same number of entries
+    st.setup_cache = st.vertex_cache ? kBenchSetupCache : 0;
     Scene sc = n == "empty" ? make_quad_scene(f) : scene_by_name(n, f);
     if (n == "empty") sc.meshes.clear();
     return cmd_dump(argv[2], sc, tex_format(argv[4]), st, std::atoi(argv[9]), argv[11]);
   }
+  if (cmd == "cases" && argc == 4) return cmd_cases(argv[2], std::atoi(argv[3]));
   usage();
 }

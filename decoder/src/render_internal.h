@@ -2,6 +2,7 @@
 // and band driver; render_clip.cpp: clipping; render_setup.cpp: polygon
 // setup and span loops). Not part of the public API.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 
 #include "vds/fixed.h"
@@ -89,8 +90,27 @@ int32_t span_reciprocal(uint32_t w, int* z);
 // Repeat addressing applies: requested and both sizes powers of two.
 bool texture_repeats(const Texture& t);
 
+// What a polygon's set-up depends on: the same for every band of a frame.
+struct PolygonTarget {
+  int32_t width;
+  PixelFormat format;
+  DepthFormat depth_format;
+};
+
 // Draws a convex polygon (a triangle or a clipped triangle) into the band:
 // culling, setup and spans. n in [3, kMaxPolyVerts].
 void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVertex* v, int n, RenderStats& stats);
+
+// The same in two steps, so that one set-up can serve every band a polygon
+// crosses: prepare_polygon does everything that does not depend on the band
+// (culling, planes, span function), draw_prepared the band's spans. The
+// picture is the same as draw_polygon's. PreparedPolygon is opaque here
+// (render_setup.cpp); storage for it: prepared_polygon_bytes(), aligned to
+// prepared_polygon_align().
+struct PreparedPolygon;
+size_t prepared_polygon_bytes();
+size_t prepared_polygon_align();
+void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const ScreenVertex* v, int n, PreparedPolygon* pp);
+void draw_prepared(const BandTarget& band, const PreparedPolygon& pp, RenderStats& stats);
 
 }  // namespace vds::detail

@@ -315,10 +315,12 @@ struct BilinearApronSampler {
       fv = static_cast<uint32_t>(vc) & kFracMask;
     }
     if constexpr (TF == TexFormat::rgb565 && O == PixelFormat::rgb565) {
-      const uint16_t* p = reinterpret_cast<const uint16_t*>(t.base) + index;
-      const uint16_t* q = p + t.stride;
-      const uint32_t top = lerp_spread(spread565(p[0]), spread565(p[1]), fu);
-      const uint32_t bot = lerp_spread(spread565(q[0]), spread565(q[1]), fu);
+      // The lower row by index, not by a second pointer: one register less
+      // in the span loop.
+      const uint16_t* p = reinterpret_cast<const uint16_t*>(t.base);
+      const uint32_t below = index + t.stride;
+      const uint32_t top = lerp_spread(spread565(p[index]), spread565(p[index + 1]), fu);
+      const uint32_t bot = lerp_spread(spread565(p[below]), spread565(p[below + 1]), fu);
       return unspread565(lerp_spread(top, bot, fv));
     } else {
       return from8888<O>(bilerp8888(texel8888<TF>(t, index), texel8888<TF>(t, index + 1), texel8888<TF>(t, index + t.stride),
@@ -528,28 +530,33 @@ bool row_piece(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& 
 
 // The per-pixel reciprocal. For m = w << clz(w) in [2^31, 2^32) (x = m / 2^32
 // in [1/2, 1)) it returns y ~= 2^62 / m = 2^30 / x by linear interpolation
-// between round(2^30 / x_k), x_k = 1/2 + k/512: a 2 KiB table of (value,
-// slope) pairs, read with one LDRD. 7 Cortex-M4 instructions (CLZ, LSL, UBFX,
-// ADD, LDRD, UMULL, SUB) against 12 for a table seed plus a Newton step
-// (vds::recip_mant_fast). The chord lies above the convex 1/x, so
-// -2^-31 <= y / (2^62 / m) - 1 < 2^-18 (h^2/8 max|f''| with h = 1/512, plus
-// the rounding of the entries); tests/unit/render_test.cpp checks the bound.
-struct RecipEntry {
-  int32_t value;   // round(2^39 / (256 + k)), the first clipped to 2^31 - 1
-  uint32_t slope;  // value[k] - value[k + 1], < 2^23
-};
+// between value_k = round(2^30 / x_k), x_k = 1/2 + k/512, with slope_k =
+// value_k - value_(k+1): y = value_k - slope_k t / 2^32 with t = m << 9 the
+// position inside the interval (Q0.32). With m = (256 + k) 2^23 + low,
+// slope_k (2^9 m) / 2^32 = slope_k (256 + k) + slope_k t / 2^32 exactly (the
+// first term is whole), so the table stores base_k = value_k + slope_k (256
+// + k) and slope_k 2^9 (below 2^32) and y = base_k - (slope_k 2^9 m) / 2^32,
+// all modulo 2^32 (y itself is below 2^31): no shift of m. 2 KiB; 8
+// Cortex-M4 instructions (CLZ, LSL, UBFX, ADD, LDR, LDR, UMULL, SUB) against
+// 12 for a table seed plus a Newton step (vds::recip_mant_fast). The chord
+// lies above the convex 1/x, so -2^-31 <= y / (2^62 / m) - 1 < 2^-18 (h^2/8
+// max|f''| with h = 1/512, plus the rounding of the entries);
+// tests/unit/render_test.cpp checks the bound. Each entry is one 64-bit
+// word, slope_k 2^9 in the high half and base_k in the low half, so that it
+// is one load whatever the byte order.
 struct RecipTable {
-  RecipEntry e[256];
+  uint64_t e[256];
 };
 constexpr int32_t recip_node(uint64_t k) {
-  const uint64_t v = ((uint64_t{1} << 40) / (256 + k) + 1) / 2;
-  return v > static_cast<uint64_t>(INT32_MAX) ? INT32_MAX : static_cast<int32_t>(v);
+  const uint64_t v = ((uint64_t{1} << 40) / (256 + k) + 1) / 2;  // round(2^39 / (256 + k))
+  return v > static_cast<uint64_t>(INT32_MAX) ? INT32_MAX : static_cast<int32_t>(v);  // the first clipped to 2^31 - 1
 }
 constexpr RecipTable make_recip_table() {
   RecipTable t{};
   for (uint64_t k = 0; k < 256; ++k) {
-    t.e[k].value = recip_node(k);
-    t.e[k].slope = static_cast<uint32_t>(recip_node(k) - recip_node(k + 1));
+    const uint64_t slope = static_cast<uint64_t>(recip_node(k) - recip_node(k + 1));  // < 2^23
+    const uint32_t base = static_cast<uint32_t>(static_cast<uint64_t>(recip_node(k)) + slope * (256 + k));
+    t.e[k] = (slope << 9) << 32 | base;
   }
   return t;
 }
@@ -558,9 +565,9 @@ constexpr RecipTable kRecipTable = make_recip_table();
 inline int32_t recip_y(uint32_t w, int& z) {
   z = __builtin_clz(w);  // w >= 1 (row_piece keeps every W and q positive)
   const uint32_t m = w << z;
-  const RecipEntry& e = kRecipTable.e[(m >> 23) & 255u];
-  // m << 9 is the position inside the interval, Q0.32.
-  return e.value - static_cast<int32_t>((uint64_t{e.slope} * (m << 9)) >> 32);
+  const uint64_t e = kRecipTable.e[(m >> 23) & 255u];
+  const uint32_t base = static_cast<uint32_t>(e), slope9 = static_cast<uint32_t>(e >> 32);
+  return static_cast<int32_t>(base - static_cast<uint32_t>((uint64_t{slope9} * m) >> 32));
 }
 // round-down of n * y / 2^(32 + sh): SMULL and an arithmetic shift.
 inline int32_t scaled(int32_t n, int32_t y, int sh) { return static_cast<int32_t>((int64_t{n} * y) >> 32) >> sh; }
@@ -590,6 +597,22 @@ void flat_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa, i
   } while (++i != 0);
 }
 
+// Colour entry i of a span whose colour and depth rows end at oe and ze
+// (delta = oe - ze in bytes). When colour and depth entries have the same
+// size, the colour address is the depth address plus delta: the span loop
+// then steps one pointer instead of two (one instruction per pixel less).
+template <PixelFormat O, class DT>
+inline uint8_t* pixel_at(uint8_t* oe, DT* ze, uintptr_t delta, int32_t i) {
+  if constexpr (Store<O>::kBytes == sizeof(DT)) {
+    return reinterpret_cast<uint8_t*>(reinterpret_cast<uintptr_t>(ze + i) + delta);
+  } else if constexpr (2 * Store<O>::kBytes == sizeof(DT)) {
+    // Half the depth address (depth entries are aligned) plus delta = oe - ze / 2.
+    return reinterpret_cast<uint8_t*>((reinterpret_cast<uintptr_t>(ze + i) >> 1) + delta);
+  } else {
+    return oe + i * Store<O>::kBytes;
+  }
+}
+
 template <class Sampler, bool kProj, PixelFormat O, DepthFormat D>
 void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa, int32_t xb) {
   using DT = typename Depth<D>::T;
@@ -605,6 +628,8 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
     // Both buffers are indexed from the piece end with i = -len .. -1.
     DT* const ze = zrow + xa + len;
     uint8_t* const oe = crow + (xa + len) * Store<O>::kBytes;
+    const uintptr_t delta = reinterpret_cast<uintptr_t>(oe) -
+                            (reinterpret_cast<uintptr_t>(ze) >> (sizeof(DT) == 2 * Store<O>::kBytes ? 1 : 0));
     int32_t q = r.q, w = r.w, u = r.n[0], v = r.n[1];
     const int32_t dq = r.dq, dw = r.dw, du = r.dn[0], dv = r.dn[1];
     const int32_t shb = r.sh_base;
@@ -616,7 +641,7 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
         int z;
         const int32_t yr = recip_y(static_cast<uint32_t>(kProj ? w : q), z);
         const int sh = shb - z;
-        Store<O>::put(oe + i * Store<O>::kBytes, Sampler::sample(tex, scaled(u, yr, sh), scaled(v, yr, sh)));
+        Store<O>::put(pixel_at<O, DT>(oe, ze, delta, i), Sampler::sample(tex, scaled(u, yr, sh), scaled(v, yr, sh)));
       }
       q = wrap_add32(q, dq);
       if constexpr (kProj) w = wrap_add32(w, dw);
@@ -706,7 +731,7 @@ SpanFn pick_span(const Mesh& m, bool repeat) {
   return nullptr;
 }
 
-SpanFn select_span(const BandTarget& b, const Mesh& m, bool repeat) {
+SpanFn select_span(const PolygonTarget& b, const Mesh& m, bool repeat) {
   if (b.format == PixelFormat::rgb565) {
     return b.depth_format == DepthFormat::d16 ? pick_span<PixelFormat::rgb565, DepthFormat::d16>(m, repeat)
                                               : pick_span<PixelFormat::rgb565, DepthFormat::d32>(m, repeat);
@@ -767,7 +792,27 @@ bool texture_repeats(const Texture& t) {
   return t.address == TexAddress::repeat && is_pow2(t.width) && is_pow2(t.height);
 }
 
-void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVertex* v, int n, RenderStats& stats) {
+// A polygon set up for rasterisation: everything draw_polygon computes that
+// does not depend on the band, so that one set-up serves every band the
+// polygon crosses (RenderConfig::setup_cache).
+struct PreparedPolygon {
+  PolySetup s;
+  SpanFn fn;                        // nullptr: nothing to draw (culled, off screen, compiled out)
+  int32_t row_begin, row_end;       // rows [row_begin, row_end) the polygon can cover
+  int32_t n;                        // outline vertices
+  bool culled;                      // facing or zero area (counted per band it touches)
+  bool set_up;                      // planes computed (counted per band it touches)
+  RasterVertex outline[kMaxPolyVerts];
+};
+
+size_t prepared_polygon_bytes() { return sizeof(PreparedPolygon); }
+size_t prepared_polygon_align() { return alignof(PreparedPolygon); }
+
+void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const ScreenVertex* v, int n, PreparedPolygon* pp) {
+  pp->fn = nullptr;
+  pp->culled = false;
+  pp->set_up = false;
+  pp->n = n;
   // Rows and columns the polygon can touch (pixel centres inside its box).
   int32_t xmin = v[0].x, xmax = v[0].x, ymin = v[0].y, ymax = v[0].y;
   for (int i = 1; i < n; ++i) {
@@ -776,11 +821,13 @@ void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVe
     ymin = v[i].y < ymin ? v[i].y : ymin;
     ymax = v[i].y > ymax ? v[i].y : ymax;
   }
+  pp->row_begin = raster_row(ymin);
+  pp->row_end = raster_row(ymax);
   if (xmin < -kRasterCoordLimit || xmax > kRasterCoordLimit || ymin < -kRasterCoordLimit || ymax > kRasterCoordLimit) {
     return;  // cannot happen after guard-band clipping; kept as a hard limit
   }
-  if (raster_row(ymax) <= band.y0 || raster_row(ymin) >= band.y1) return;
-  if (raster_row(xmax) <= 0 || raster_row(xmin) >= band.width) return;
+  if (raster_row(xmax) <= 0 || raster_row(xmin) >= target.width) return;
+  for (int i = 0; i < n; ++i) pp->outline[i] = {v[i].x, v[i].y};
 
   // Orientation and the best-conditioned fan triangle for the planes.
   int64_t area = 0, best = 0;
@@ -795,10 +842,10 @@ void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVe
   }
   const Mesh& m = *mat.mesh;
   if (area == 0 || best == 0 || (m.cull == Cull::back && area > 0) || (m.cull == Cull::front && area < 0)) {
-    ++stats.culled;
+    pp->culled = true;
     return;
   }
-  ++stats.setups;
+  pp->set_up = true;
 
   const ScreenVertex& a = v[0];
   const ScreenVertex& b = v[bi];
@@ -807,7 +854,7 @@ void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVe
   const bool neg = best < 0;
   // Every field the span functions read is set below (no zeroing of the
   // whole struct: it is a few hundred bytes and this runs per triangle).
-  PolySetup s;
+  PolySetup& s = pp->s;
   s.xr = a.x >> 8;
   s.yr = a.y >> 8;
   s.nn = 0;
@@ -850,7 +897,7 @@ void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVe
   const int32_t(&h)[3][3] = m.view_map.m;
   int64_t wrow[3] = {0, 0, 0}, nrow[2][3] = {{0, 0, 0}, {0, 0, 0}};
   if (m.shading == Shading::flat) {
-    s.flat = band.format == PixelFormat::rgb565 ? pack565(m.color) : (m.color & 0xFFFFFFu);
+    s.flat = target.format == PixelFormat::rgb565 ? pack565(m.color) : (m.color & 0xFFFFFFu);
   } else if (m.shading == Shading::gouraud) {
     // N = colour (Q8.8) q < 2^46; the result is the colour in Q8.8.
     s.nn = 3;
@@ -863,7 +910,7 @@ void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVe
     repeat = texture_repeats(t);
     s.tex = make_tex_ctx(t, repeat);
     s.nn = 2;
-    const int f = fraction_bits(m, band.format);
+    const int f = fraction_bits(m, target.format);
     // Texture origin: a whole number of texture periods below the polygon
     // keeps the numerators small (repeat only; clamp needs true coordinates).
     int64_t org[2] = {0, 0};
@@ -888,7 +935,7 @@ void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVe
     s.tex = make_tex_ctx(t, repeat);
     s.nn = 2;
     s.proj = true;
-    const int f = fraction_bits(m, band.format);
+    const int f = fraction_bits(m, target.format);
     // The homography works on coordinates / 256 (vds/homography.h): per
     // pixel, 256 W = h20 x + h21 y + 256 h22 and 65536 S = 256 (h00 x + h01 y)
     // + 65536 h02, so that texel u = 65536 S / (256 W).
@@ -998,16 +1045,31 @@ void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVe
     s.fast = true;  // flat: q only
   }
 
-  const SpanFn fn = select_span(band, m, repeat);
+  pp->fn = select_span(target, m, repeat);
+}
+
+void draw_prepared(const BandTarget& band, const PreparedPolygon& pp, RenderStats& stats) {
+  if (pp.row_end <= band.y0 || pp.row_begin >= band.y1) return;
+  if (pp.culled) ++stats.culled;
+  const SpanFn fn = pp.fn;
   if (!fn) return;
-  for (int i = 1; i + 1 < n; ++i) {
-    const RasterVertex rv[3] = {{v[0].x, v[0].y}, {v[i].x, v[i].y}, {v[i + 1].x, v[i + 1].y}};
+  const PolySetup& s = pp.s;
+  const RasterVertex* o = pp.outline;
+  for (int i = 1; i + 1 < pp.n; ++i) {
+    const RasterVertex rv[3] = {o[0], o[i], o[i + 1]};
     raster_triangle(rv, band.y0, band.y1, band.width, [&](int32_t y, int32_t xa, int32_t xb) {
       fn(band, s, y, xa, xb);
       ++stats.spans;
       stats.pixels += static_cast<uint32_t>(xb - xa);
     });
   }
+}
+
+void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVertex* v, int n, RenderStats& stats) {
+  PreparedPolygon pp;
+  prepare_polygon(PolygonTarget{band.width, band.format, band.depth_format}, mat, v, n, &pp);
+  if (pp.set_up && pp.row_end > band.y0 && pp.row_begin < band.y1) ++stats.setups;
+  draw_prepared(band, pp, stats);
 }
 
 }  // namespace vds::detail

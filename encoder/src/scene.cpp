@@ -732,6 +732,7 @@ ClientFrame render_client(const ClientScene& scene, const vds::Camera& camera, i
   cfg.depth = settings.depth;
   cfg.vertex_cache = settings.vertex_cache;
   cfg.triangle_cache = settings.triangle_cache;
+  cfg.setup_cache = settings.setup_cache;
   std::vector<uint8_t> workspace(vds::render_workspace_size(cfg));
   vds::Arena arena(workspace.data(), workspace.size());
   vds::Renderer r;

@@ -124,6 +124,9 @@ TEST(RenderBands, AnyBandHeightAndCacheSizesGiveTheSameFrame) {
           st.band_height = band;
           st.vertex_cache = cache;
           st.triangle_cache = cache == 5u ? 9u : cache;  // some triangles cached, some not
+          // Set-ups kept across bands: none, a few slots shared by many
+          // triangles (evictions), or one per triangle.
+          st.setup_cache = cache == 0u ? 0u : (cache == 5u ? 3u : 4096u);
           const ClientFrame fr = enc::render_client(cs, 240, 180, st);
           ASSERT_EQ(fr.status, Status::ok);
           if (first.empty()) {
@@ -398,6 +401,24 @@ TEST(RenderApi, ValidationStatuses) {
     Arena small(ws.data(), ws.size() - 64);
     Renderer r;
     EXPECT_EQ(r.init(cfg, small), Status::workspace_too_small);
+  }
+  {
+    // The set-up cache: bounded, paid for in the workspace, and init needs
+    // exactly what render_workspace_size says (from any alignment).
+    RenderConfig sc = cfg;
+    sc.setup_cache = 4097;
+    EXPECT_EQ(render_workspace_size(sc), 0u);
+    sc.setup_cache = 3;
+    const size_t need = render_workspace_size(sc);
+    EXPECT_GT(need, render_workspace_size(cfg) + 3 * 64);
+    std::vector<uint8_t> big(need + 8);
+    for (size_t shift = 0; shift < 8; ++shift) {
+      Arena a(big.data() + shift, need);
+      Renderer r;
+      EXPECT_EQ(r.init(sc, a), Status::ok) << shift;
+      Arena b(big.data() + shift, render_workspace_size(cfg) + 64);
+      EXPECT_EQ(r.init(sc, b), Status::workspace_too_small) << shift;
+    }
   }
   Arena a(ws.data(), ws.size());
   Renderer r;

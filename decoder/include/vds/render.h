@@ -173,6 +173,13 @@ struct RenderConfig {
   // instead of testing their vertices. Needs their vertices in the vertex
   // cache; others are tested per band. A RAM/time trade-off, same picture.
   uint32_t triangle_cache = 0;
+  // Set-up polygons kept for the later bands they cross (a direct-mapped
+  // table indexed by triangle number, as counted for triangle_cache; the
+  // bytes per entry: render_workspace_size). Only triangles that reach below
+  // the current band are kept, so a large triangle is clipped and set up
+  // once per frame instead of once per band. 0..4096; a RAM/time trade-off,
+  // same picture.
+  uint32_t setup_cache = 0;
   // Optional caller-owned whole-frame colour buffer (height rows of
   // target_stride bytes). When set, bands are drawn straight into it and the
   // workspace holds no colour band. When null, the band lives in the workspace.
@@ -197,7 +204,7 @@ struct RenderStats {
   uint32_t triangles = 0;        // triangles submitted (once per frame)
   uint32_t culled = 0;           // facing or zero-area rejections (each band counts)
   uint32_t clipped = 0;          // triangle-band pairs that took the clipping path
-  uint32_t setups = 0;           // triangle-band pairs set up for rasterisation
+  uint32_t setups = 0;           // polygon set-ups (per band it is drawn in, unless kept by setup_cache)
   uint32_t spans = 0;            // non-empty spans
   uint32_t pixels = 0;           // pixels rasterised (before the depth test)
   uint32_t reprojected = 0;      // vertex transforms beyond the cache
@@ -242,6 +249,9 @@ class Renderer {
   detail::CachedVertex* cache_ = nullptr;
   uint8_t* cache_outcode_ = nullptr;
   uint16_t* tri_bands_ = nullptr;  // [first, last] band of each cached triangle
+  uint8_t* setups_ = nullptr;      // setup_cache prepared polygons of setup_bytes_ each
+  uint32_t* setup_tags_ = nullptr; // triangle number + 1 held by each entry; 0 empty
+  uint32_t setup_bytes_ = 0;
   RenderStats stats_{};
   bool ready_ = false;
 };

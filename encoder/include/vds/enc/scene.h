@@ -172,6 +172,7 @@ struct ClientRenderSettings {
   int band_height = 16;
   uint32_t vertex_cache = 65536;
   uint32_t triangle_cache = 65536;
+  uint32_t setup_cache = 16;
 };
 
 struct ClientFrame {
