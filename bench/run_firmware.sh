@@ -60,17 +60,7 @@ for v in 0 1 2 3 4; do
 done
 
 echo "== demo reel (twelve textures, quality 75)"
-mkdir -p "$WORK/reel"
-python3 - "$PK3" "$WORK/reel" <<'PY'
-import os, sys, zipfile
-reel = ["acc_dm3/comp_up.tga", "base_floor/concretefloor1.tga", "base_wall/concrete_ow.tga",
-        "base_wall/metalfloor_wall_15ow.tga", "bubctf1/e8_jumppad02.tga", "clown/vegetation.tga",
-        "cosmo_wall/brickwall1.tga", "czest3ctf/grass_lush.tga", "gothic_block/blocks17_ow.tga",
-        "gothic_wall/proto_brik.tga", "liquids/lavahell2.tga", "organics/dirt.tga"]
-with zipfile.ZipFile(sys.argv[1]) as z:
-    for i, n in enumerate(reel):
-        open(os.path.join(sys.argv[2], "%02d_%s" % (i, os.path.basename(n))), "wb").write(z.read("textures/" + n))
-PY
+python3 "$ROOT/scripts/demo_reel.py" "$WORK/reel" "$PK3"
 python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$HOSTB" --qemu qemu-system-arm \
   --elf "$CM4/vds_fw_client.elf" --work "$WORK/reel_run" --quality 75 --inputs "$WORK"/reel/*.tga \
   --report "$WORK/reel.json" >"$WORK/reel.log" 2>&1 || { tail -n 30 "$WORK/reel.log"; exit 1; }

@@ -20,18 +20,7 @@ mkdir -p "$OUT/src"
 [ -f "$PK3" ] || { echo "demo: $PK3 not found; run scripts/fetch-data.sh" >&2; exit 1; }
 
 echo "demo: 1/5 taking twelve textures from $(basename "$PK3")"
-python3 - "$PK3" "$OUT/src" <<'PY'
-import os, sys, zipfile
-pk3, out = sys.argv[1], sys.argv[2]
-reel = ["acc_dm3/comp_up.tga", "base_floor/concretefloor1.tga", "base_wall/concrete_ow.tga",
-        "base_wall/metalfloor_wall_15ow.tga", "bubctf1/e8_jumppad02.tga", "clown/vegetation.tga",
-        "cosmo_wall/brickwall1.tga", "czest3ctf/grass_lush.tga", "gothic_block/blocks17_ow.tga",
-        "gothic_wall/proto_brik.tga", "liquids/lavahell2.tga", "organics/dirt.tga"]
-with zipfile.ZipFile(pk3) as z:
-    for i, name in enumerate(reel):
-        with open(os.path.join(out, "%02d_%s" % (i, os.path.basename(name))), "wb") as f:
-            f.write(z.read("textures/" + name))
-PY
+python3 "$ROOT/scripts/demo_reel.py" "$OUT/src" "$PK3"
 
 echo "demo: 2/5 encoding, then streaming to both boards at 115,200 baud (about a minute)"
 python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
