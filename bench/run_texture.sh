@@ -9,15 +9,19 @@
 #      PCHIP) per image and per set; the same for other perceptual slopes;
 #   2. client decode cost of the five 240x180 views: the JPEG cjpeg -quality 85
 #      writes, and the vds stream at the same RGB PSNR (as the client decodes
-#      the JPEG), both to an RGB565 frame: Cortex-M4 instructions under QEMU
-#      mps2-an386 -icount (bench/m4/texture_qemu.cpp) with a cross-target CRC
-#      check, and x86-64 instructions from callgrind;
+#      the JPEG), both to an RGB565 frame: Cortex-M4 instructions of the board
+#      firmware vds_fw_bench_texture (firmware_sim/app/bench_texture.cpp) under
+#      QEMU mps2-an386 -icount, with a cross-target CRC check, and x86-64
+#      instructions from callgrind;
 #   3. decoder workspace and Cortex-M4 .text of each decoder (arm-none-eabi-g++
 #      -O2, --gc-sections, arm-none-eabi-size).
 #
 # Usage: bench/run_texture.sh [BUILD_DIR]      (default build/host-release)
 #   BUILD_DIR must hold bench/bench_texture (a release build: cmake --preset
 #   host-release && cmake --build --preset host-release --target bench_texture).
+#   The firmware is built in the Cortex-M4 build CM4_BUILD (default
+#   BUILD_DIR/cm4, the host presets' sub-build; configured here with
+#   toolchain/arm-none-eabi-cortex-m4.cmake if it does not exist yet).
 #   QUICK=1 uses a coarser quality ladder (for trying changes).
 #   bench/run_texture.sh --train [BUILD_DIR] regenerates the trained context
 #   starting probabilities (decoder/src/image_model_init.inc) from the training
@@ -201,18 +205,22 @@ ARM_FLAGS=(-std=c++20 -mcpu=cortex-m4 -mthumb -mfloat-abi=soft -O2 -ffreestandin
 HAVE_M4=0
 if command -v arm-none-eabi-g++ >/dev/null && command -v qemu-system-arm >/dev/null; then
   HAVE_M4=1
-  echo "== Cortex-M4 (arm-none-eabi-g++ -O2, QEMU mps2-an386 -icount shift=0)"
-  (cd "$WORK/m4" &&
-   for f in container crc32c status arith huffman bitreader idct image_header image_model image_output image_decoder \
-            jpeg_markers jpeg_scan; do
-     arm-none-eabi-g++ "${ARM_FLAGS[@]}" -c "$ROOT/decoder/src/$f.cpp" -o "$f.o"
-   done &&
-   arm-none-eabi-g++ "${ARM_FLAGS[@]}" -c "$ROOT/bench/m4/texture_qemu.cpp" -o texture_qemu.o &&
-   arm-none-eabi-g++ -mcpu=cortex-m4 -mthumb -mfloat-abi=soft -nostartfiles -T "$ROOT/bench/m4/texture_qemu.ld" \
-     -Wl,--gc-sections ./*.o -lc -lgcc -o texture_qemu.elf &&
-   timeout 600 qemu-system-arm -M mps2-an386 -cpu cortex-m4 -nographic -monitor none -serial none \
-     -semihosting-config enable=on,target=native -icount shift=0 -kernel texture_qemu.elf 2>&1 | grep '^m4 ') |
-    tee "$WORK/m4.txt"
+  # The Cortex-M4 build: the host build's sub-build when there is one (the
+  # presets make it), else configured here.
+  CM4=${CM4_BUILD:-$BUILD/cm4}
+  case "$CM4" in /*) ;; *) CM4="$ROOT/$CM4" ;; esac
+  if [[ ! -f "$CM4/build.ninja" ]]; then
+    cmake -S "$ROOT" -B "$CM4" -G Ninja -DCMAKE_TOOLCHAIN_FILE="$ROOT/toolchain/arm-none-eabi-cortex-m4.cmake" \
+      -DCMAKE_BUILD_TYPE=Release >/dev/null
+  fi
+  cmake --build "$CM4" --target vds_fw_bench_texture >/dev/null
+  ELF="$CM4/firmware_sim/vds_fw_bench_texture.elf"
+  echo "== Cortex-M4 ($ELF on QEMU mps2-an386 -icount shift=0)"
+  # The firmware reads texture_case<N>.bin from its working directory through
+  # semihosting; its console output arrives on QEMU's stderr.
+  (cd "$WORK/m4" && timeout 600 qemu-system-arm -M mps2-an386 -cpu cortex-m4 -nographic -monitor none -serial none \
+     -semihosting-config enable=on,target=native -icount shift=0 -kernel "$ELF") 2>&1 | grep '^m4 ' | tee "$WORK/m4.txt"
+  grep -q '^m4 done' "$WORK/m4.txt" || { echo "run_texture.sh: the Cortex-M4 run failed" >&2; exit 1; }
 
   # .text of each decoder alone: a probe that uses only it, linked with --gc-sections.
   cat >"$WORK/m4/probe_vds.cpp" <<'CPP'
@@ -242,8 +250,7 @@ CPP
    for p in vds jpeg; do
      arm-none-eabi-g++ "${ARM_FLAGS[@]}" -c probe_$p.cpp -o probe_$p.o.p
      arm-none-eabi-g++ -mcpu=cortex-m4 -mthumb -mfloat-abi=soft -nostartfiles -nostdlib -Wl,-e,reset_handler \
-       -Wl,--gc-sections probe_$p.o.p container.o crc32c.o status.o arith.o huffman.o bitreader.o idct.o \
-       image_header.o image_model.o image_output.o image_decoder.o jpeg_markers.o jpeg_scan.o -lc -lgcc -o probe_$p.elf
+       -Wl,--gc-sections probe_$p.o.p "$CM4/decoder/libvds_decoder.a" -lc -lgcc -o probe_$p.elf
      echo "$p $(arm-none-eabi-size probe_$p.elf | tail -1)"
    done) | tee "$WORK/sizes.txt"
 fi
@@ -313,8 +320,11 @@ L.append('Each 240x180 view coded by `cjpeg -quality 85` (4:2:0, standard Huffma
          '12,464 bytes at 155 instructions/pixel, 132 with its lookup tables) and by vds at the smallest size whose '
          'RGB PSNR reaches that of the JPEG as the client decodes it (no fancy upsampling). Both decoded by the client '
          'library to an RGB565 frame. vds counts include the stream parser (chunk CRC-32C checks). Cortex-M4: '
-         'executed instructions of `bench/m4/texture_qemu.cpp` (arm-none-eabi-g++ -O2) under QEMU mps2-an386 '
-         '`-icount shift=0`, mean of 3 decodes; x86-64: callgrind Ir inside the decode call (clang -O3).\n')
+         'executed instructions of the board firmware `vds_fw_bench_texture` (`firmware_sim/app/bench_texture.cpp`, '
+         'the Cortex-M4 build: arm-none-eabi-g++ -O2) on the QEMU board mps2-an386 with `-icount shift=0` '
+         '(`board::instructions()`, 40 instructions per tick), mean of 3 decodes; input, chunk buffer and decoder '
+         'workspace inside the board\'s 128 KiB workspace budget; x86-64: callgrind Ir inside the decode call '
+         '(clang -O3).\n')
 L.append('| view | JPEG bytes | JPEG PSNR | M4 instr/px | x86 instr/px | vds bytes | vds PSNR | M4 instr/px | x86 instr/px | M4 = host output |')
 L.append('|---|---:|---:|---:|---:|---:|---:|---:|---:|---|')
 px = 240 * 180
@@ -348,7 +358,8 @@ L.append('## Reproduce\n')
 L.append('```sh\ncmake --preset host-release && cmake --build --preset host-release --target bench_texture\n'
          'bench/run_texture.sh build/host-release\n```\n')
 L.append('Pieces by hand: `bench_texture views|rd|bd|decode|make-vds|m4-case|psnr|workspace` (usage at the top of '
-         '`bench/src/texture.cpp`); the QEMU command line is in `bench/run_texture.sh`, step 2.\n')
+         '`bench/src/texture.cpp`); the firmware build and the QEMU command line are in `bench/run_texture.sh`, '
+         'step 2 (`CM4_BUILD=dir` picks the Cortex-M4 build).\n')
 open(out, 'w').write('\n'.join(L))
 PY
 echo "done: $OUT/texture.md"

@@ -14,7 +14,8 @@
 //                                           encodes IN at the smallest size reaching
 //                                           PSNR (RGB dB); prints bytes and PSNR
 //   bench_texture m4-case FILE OUT REPS     wraps a .vds stream or .jpg as a case file
-//                                           for bench/m4/texture_qemu.cpp; prints the
+//                                           for the board firmware vds_fw_bench_texture
+//                                           (firmware_sim/app/bench_texture.cpp); prints the
 //                                           host's CRC-32C of the decoded RGB565 frame
 //   bench_texture psnr A B                  RGB PSNR of two image files
 //   bench_texture workspace                 the decoders' workspace and object sizes
@@ -555,7 +556,7 @@ int cmd_decode(const std::string& path, int n) {
 }
 
 // The frame the client decodes to (RGB565) for a .vds stream or a JPEG, as
-// bench/m4/texture_qemu.cpp does it, for the cross-target CRC.
+// the board firmware (firmware_sim/app/bench_texture.cpp) does it, for the cross-target CRC.
 std::vector<uint16_t> client_rgb565(const std::vector<uint8_t>& bytes, int* w, int* h) {
   const bool is_jpeg = bytes.size() > 2 && bytes[0] == 0xFF && bytes[1] == 0xD8;
   std::vector<uint8_t> ws(vds::JpegDecoder::kWorkspaceBytes + vds::ImageDecoder::kWorkspaceBytes + 64);

@@ -40,7 +40,7 @@ detail::OutputGeometry geometry(const ImageHeader& h) {
 
 Status ImageDecoder::init(Arena& arena) {
   const size_t mark = arena.mark();
-  ctx_ = arena.alloc_array<m::Contexts>(1);
+  ctx_ = arena.alloc_array<m::PackedContexts>(1);
   coef_ = arena.alloc_array<int16_t>(64);
   mcu_pix_ = arena.alloc_array<uint8_t>(kMcuSampleBytes);
   packed_ = arena.alloc_array<uint8_t>(kPackedBytes);
@@ -125,55 +125,96 @@ inline void clear_block(int16_t* coef) {
   for (int i = 0; i < 16; ++i) __builtin_memcpy(coef + 4 * i, &zero, sizeof zero);
 }
 
+// The level loop walks one table, indexed by the count of levels still to
+// code (1..63) and the scan index k (1..63), whose entry holds every byte
+// offset that pair selects: bits 0..15 the sig context's offset from the
+// start of PackedClassContexts, bits 16..23 the level contexts' offset
+// within gt1 (and gt2), bits 24..31 the natural position times 2 (the byte
+// offset of an int16_t or uint16_t element in natural order). The next scan
+// position is the next entry; after a level, one row up (one level fewer).
+// 16 KB of constants buys a loop that keeps only the walking pointer.
+struct WalkTable {
+  uint32_t e[64][64];
+};
+constexpr size_t kCtxBytes = sizeof(m::PackedContext);
+constexpr WalkTable make_walk_table() {
+  WalkTable t{};
+  for (int n = 0; n < 64; ++n) {
+    for (int k = 0; k < 64; ++k) {
+      const size_t sig = offsetof(m::PackedClassContexts, sig) +
+                         (static_cast<size_t>(m::kSigLeftOf[n]) * m::kSigPos + m::kSigPosOf[k]) * kCtxBytes;
+      const size_t level = (static_cast<size_t>(m::kLevelPosOf[k]) * m::kLevelLeft + m::kLevelLeftOf[n]) * kCtxBytes;
+      t.e[n][k] = static_cast<uint32_t>(sig) | static_cast<uint32_t>(level) << 16 |
+                  static_cast<uint32_t>(m::kZigzag[k] * 2) << 24;
+    }
+  }
+  return t;
+}
+constexpr WalkTable kWalk = make_walk_table();
+static_assert(sizeof(m::PackedClassContexts) <= 65536 && sizeof(m::PackedClassContexts::gt1) <= 256,
+              "walk table offsets fit their fields");
+constexpr int kWalkRow = 64;
+constexpr uint32_t kWalkSigMask = 0xFFFFu;
+constexpr int kWalkLevelShift = 16, kWalkNaturalShift = 24;
+
+inline __attribute__((always_inline)) m::PackedContext& context_at(uint8_t* base, uint32_t offset) {
+  return *reinterpret_cast<m::PackedContext*>(base + offset);
+}
+
 // The levels of a block (nz >= 1) in zig-zag order: the sig bins find each
-// nonzero position (none is coded where every remaining position must be
-// nonzero). The loop walks the packed tables image_model::kScan and kLeft
-// with byte offsets. Returns 0, or -1 on a magnitude no encoder writes.
-inline __attribute__((always_inline)) int decode_levels(m::RangeDecoder& rd, m::ClassContexts& cc, uint32_t nz,
+// nonzero position; none is coded where every remaining position must be
+// nonzero, i.e. once the zeros the block can still hold (63 - nz at the
+// start) run out. Returns 0, or -1 on a magnitude no encoder writes.
+inline __attribute__((always_inline)) int decode_levels(m::RangeDecoder& rd, m::PackedClassContexts& cc, uint32_t nz,
                                                         int16_t* coef, const uint16_t* qnat) {
   uint32_t left = nz;
+  uint32_t zeros = 63 - nz;
   int order = 0;
-  const uint32_t* scan = m::kScan.e + 1;
-  // While scan < stop more positions remain than levels: a sig bin is coded.
-  const uint32_t* stop = m::kScan.e + 64 - left;
-  uint8_t* const sig0 = reinterpret_cast<uint8_t*>(cc.sig);
-  uint8_t* const gt10 = reinterpret_cast<uint8_t*>(cc.gt1);
+  const uint32_t* tp = &kWalk.e[nz][1];
+  uint8_t* base = reinterpret_cast<uint8_t*>(&cc);
   uint8_t* const out = reinterpret_cast<uint8_t*>(coef);
   const uint8_t* const qn = reinterpret_cast<const uint8_t*>(qnat);
   for (;;) {
-    const uint32_t rows = m::kLeft.e[left];
-    uint8_t* sig = sig0 + (rows & 0xFFFFu);
-    // An empty asm makes the row pointer an opaque register value: without
-    // it GCC rebuilds the address from its parts (spilled to the stack) for
-    // every sig bin, the hottest bin of the decoder.
-    __asm__("" : "+r"(sig), "+r"(stop));
-    uint32_t e = *scan;
-    while (scan < stop && !rd.bit(*reinterpret_cast<ArithContext*>(sig + ((e >> 8) & 0xFFu)))) e = *++scan;
-    uint8_t* const g1 = gt10 + ((e >> 16) & 0xFFu) + (rows >> 16);
+    uint32_t e = *tp;
+    while (zeros != 0 && !rd.bit(context_at(base, e & kWalkSigMask))) {
+      e = *++tp;
+      --zeros;
+    }
+    uint8_t* const g = base + ((e >> kWalkLevelShift) & 0xFFu);
     uint32_t mag = 1;
-    if (rd.bit(*reinterpret_cast<ArithContext*>(g1))) {
+    if (rd.bit(context_at(g, offsetof(m::PackedClassContexts, gt1)))) {
       mag = 2;
-      // gt2 has the layout of gt1, right after it.
-      if (rd.bit(*reinterpret_cast<ArithContext*>(g1 + sizeof cc.gt1))) {
+      if (rd.bit(context_at(g, offsetof(m::PackedClassContexts, gt2)))) {
         const uint32_t u = rd.exp_golomb(order);
         if (u > m::kMaxLevel - 3) return -1;
         if (u > (m::kRestRaise << order) && order < m::kRestMaxOrder) ++order;
         mag = 3 + u;
       }
     }
-    // Dequantise and saturate to the IDCT's domain.
-    const uint32_t pos = e & 0xFFu;
-    const uint32_t v = mag * *reinterpret_cast<const uint16_t*>(qn + pos);
-    const int neg = rd.bypass();
-    *reinterpret_cast<int16_t*>(out + pos) = static_cast<int16_t>(neg ? -static_cast<int32_t>(v > 2048 ? 2048 : v)
-                                                                      : static_cast<int32_t>(v > 2047 ? 2047 : v));
+    // Dequantise (mag <= 2048 and steps <= 2047: no overflow) and saturate
+    // to the IDCT's domain, [-2048, 2047].
+    // The sign is a bypass bin (RangeDecoder::bypass()), decoded here so
+    // that each outcome stores its own saturated value.
+    const uint32_t pos = e >> kWalkNaturalShift;
+    const int32_t v = static_cast<int32_t>(mag * *reinterpret_cast<const uint16_t*>(qn + pos));
+    const uint32_t half = rd.range >> 1;
+    int32_t value;
+    if (rd.code >= half) {
+      rd.code -= half;
+      rd.range -= half;
+      value = v > -kIdctCoefMin ? kIdctCoefMin : -v;
+    } else {
+      rd.range = half;
+      value = v > kIdctCoefMax ? kIdctCoefMax : v;
+    }
+    if (rd.range < kArithRangeTop) rd.renormalise();
+    *reinterpret_cast<int16_t*>(out + pos) = static_cast<int16_t>(value);
     if (--left == 0) return 0;
-    ++scan;
-    ++stop;
+    tp += 1 - kWalkRow;
   }
 }
-static_assert(offsetof(image_model::ClassContexts, gt2) == offsetof(image_model::ClassContexts, gt1) +
-                                                                sizeof(image_model::ClassContexts::gt1),
+static_assert(offsetof(image_model::PackedClassContexts, gt2) ==
+                  offsetof(image_model::PackedClassContexts, gt1) + sizeof(image_model::PackedClassContexts::gt1),
               "decode_levels finds gt2 right after gt1");
 }  // namespace
 
@@ -184,7 +225,7 @@ static_assert(offsetof(image_model::ClassContexts, gt2) == offsetof(image_model:
 int ImageDecoder::decode_block(m::RangeDecoder& rdr, int comp, int bx, int by, bool first_col, int16_t* coef) {
   m::RangeDecoder rd = rdr;
   const int cls = comp == 0 ? 0 : 1;
-  m::ClassContexts& cc = ctx_->cls[cls];
+  m::PackedClassContexts& cc = ctx_->cls[cls];
   const int bw = blocks_w(header_, comp);
   Info& me = cur_[comp][by * bw + bx];
 
@@ -243,7 +284,7 @@ int ImageDecoder::decode_block(m::RangeDecoder& rdr, int comp, int bx, int by, b
     if (dc < m::kDcLevelMin || dc > m::kDcLevelMax) result = -1;
 
     // nz: prefix of its bit length; the "> 0" bin is implied by a zero DC residual.
-    ArithContext* pre = cc.nz_prefix[m::kNzBucketOf[pred_nz]];
+    m::PackedContext* pre = cc.nz_prefix[m::kNzBucketOf[pred_nz]];
     int len = res == 0 ? 1 : rd.bit(pre[0]);
     if (len != 0)
       while (len < m::kNzPrefixBins && rd.bit(pre[len])) ++len;

@@ -22,42 +22,50 @@ constexpr uint8_t kInit[kContextCount][2] = {
 constexpr int kInitToQ15Shift = kArithProbShift - 8;
 constexpr uint32_t kInitHalfStep = 1u << (kInitToQ15Shift - 1);
 
-template <typename F>
-void for_each(Contexts& c, F&& f) {
-  for (ClassContexts& k : c.cls) {
-    for (ArithContext& x : k.cbf) f(x, &k == &c.cls[0] ? 0 : 1);
-    for (ArithContext& x : k.dc_zero) f(x, &k == &c.cls[0] ? 0 : 1);
-    for (ArithContext& x : k.dc_gt1) f(x, &k == &c.cls[0] ? 0 : 1);
+template <typename Ctx, typename F>
+void for_each(ContextsOf<Ctx>& c, F&& f) {
+  for (ClassContextsOf<Ctx>& k : c.cls) {
+    for (auto& x : k.cbf) f(x, &k == &c.cls[0] ? 0 : 1);
+    for (auto& x : k.dc_zero) f(x, &k == &c.cls[0] ? 0 : 1);
+    for (auto& x : k.dc_gt1) f(x, &k == &c.cls[0] ? 0 : 1);
     f(k.dc_gt2, &k == &c.cls[0] ? 0 : 1);
     for (auto& row : k.nz_prefix)
-      for (ArithContext& x : row) f(x, &k == &c.cls[0] ? 0 : 1);
-    for (ArithContext& x : k.nz_suffix) f(x, &k == &c.cls[0] ? 0 : 1);
+      for (auto& x : row) f(x, &k == &c.cls[0] ? 0 : 1);
+    for (auto& x : k.nz_suffix) f(x, &k == &c.cls[0] ? 0 : 1);
     for (auto& row : k.sig)
-      for (ArithContext& x : row) f(x, &k == &c.cls[0] ? 0 : 1);
+      for (auto& x : row) f(x, &k == &c.cls[0] ? 0 : 1);
     for (auto& row : k.gt1)
-      for (ArithContext& x : row) f(x, &k == &c.cls[0] ? 0 : 1);
+      for (auto& x : row) f(x, &k == &c.cls[0] ? 0 : 1);
     for (auto& row : k.gt2)
-      for (ArithContext& x : row) f(x, &k == &c.cls[0] ? 0 : 1);
+      for (auto& x : row) f(x, &k == &c.cls[0] ? 0 : 1);
   }
-  for (ArithContext& x : c.region) f(x, 0);
+  for (auto& x : c.region) f(x, 0);
+}
+
+// The starting state of context i of class cls.
+ArithContext start_context(size_t i, int cls, int quant_luma, int quant_chroma) {
+  int q = cls == 0 ? quant_luma : quant_chroma;
+  q = q < kInitIndexLo ? kInitIndexLo : (q > kInitIndexHi ? kInitIndexHi : q);
+  const int lo = kInit[i][0], hi = kInit[i][1];
+  const int p = lo + ((hi - lo) * (q - kInitIndexLo)) / (kInitIndexHi - kInitIndexLo);
+  ArithContext x = arith_context(kArithDefaultFastShift, kArithDefaultSlowShift,
+                                 (static_cast<uint32_t>(p) << kInitToQ15Shift) + kInitHalfStep);
+  // Trained starting points make the warm-up (fast learning from 0.5)
+  // unnecessary; skipping it also spares every bin its bookkeeping.
+  x.count = kArithWarmupDone;
+  return x;
 }
 
 }  // namespace
 
 void init_contexts(Contexts& c, int quant_luma, int quant_chroma) {
   size_t i = 0;
-  for_each(c, [&](ArithContext& x, int cls) {
-    int q = cls == 0 ? quant_luma : quant_chroma;
-    q = q < kInitIndexLo ? kInitIndexLo : (q > kInitIndexHi ? kInitIndexHi : q);
-    const int lo = kInit[i][0], hi = kInit[i][1];
-    const int p = lo + ((hi - lo) * (q - kInitIndexLo)) / (kInitIndexHi - kInitIndexLo);
-    x = arith_context(kArithDefaultFastShift, kArithDefaultSlowShift,
-                      (static_cast<uint32_t>(p) << kInitToQ15Shift) + kInitHalfStep);
-    // Trained starting points make the warm-up (fast learning from 0.5)
-    // unnecessary; skipping it also spares every bin its bookkeeping.
-    x.count = kArithWarmupDone;
-    ++i;
-  });
+  for_each(c, [&](ArithContext& x, int cls) { x = start_context(i++, cls, quant_luma, quant_chroma); });
+}
+
+void init_contexts(PackedContexts& c, int quant_luma, int quant_chroma) {
+  size_t i = 0;
+  for_each(c, [&](PackedContext& x, int cls) { x = pack_context(start_context(i++, cls, quant_luma, quant_chroma)); });
 }
 
 ArithContext& context_at(Contexts& c, size_t i) {
@@ -70,5 +78,6 @@ ArithContext& context_at(Contexts& c, size_t i) {
 }
 
 static_assert(sizeof(Contexts) % sizeof(ArithContext) == 0, "Contexts holds only ArithContext");
+static_assert(sizeof(PackedContexts) == kContextCount * sizeof(PackedContext), "the same contexts, packed");
 
 }  // namespace vds::image_model

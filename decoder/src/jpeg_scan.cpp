@@ -45,6 +45,15 @@ inline int16_t dequant(int32_t v, uint32_t q) {
   return static_cast<int16_t>(x < kIdctCoefMin ? kIdctCoefMin : (x > kIdctCoefMax ? kIdctCoefMax : x));
 }
 
+// Zeroes a coefficient block with 8-byte stores: the freestanding build
+// turns a 128-byte memset into a call, which costs several times more on a
+// Cortex-M4.
+inline void clear_block(int16_t* coef) {
+  const uint64_t zero = 0;
+#pragma GCC unroll 16
+  for (int i = 0; i < 16; ++i) __builtin_memcpy(coef + 4 * i, &zero, sizeof zero);
+}
+
 }  // namespace
 
 // Tops the bit buffer up to more than 24 bits from the piece, undoing byte
@@ -112,13 +121,27 @@ int JpegDecoder::decode_block(const uint8_t*& p, const uint8_t* end, Component& 
   int16_t* const coef = coef_;
 #define VDS_SYNC() (acc_ = acc, bits_ = bits)
 #define VDS_LOAD() (acc = acc_, bits = bits_)
+  // Tops the local bit buffer up: bytes other than 0xFF go straight in
+  // (most of the data); a 0xFF, the end of the piece or a 0xFF left over
+  // from the previous piece are fill()'s business.
+  const auto top_up = [&]() __attribute__((always_inline)) {
+    if (!pending_ff_) {
+      while (bits <= 24 && p != end && *p != 0xFF) {
+        acc |= static_cast<uint32_t>(*p++) << (24 - bits);
+        bits += 8;
+      }
+    }
+    if (bits < kMaxCodeBits) {
+      VDS_SYNC();
+      fill(p, end);
+      VDS_LOAD();
+    }
+  };
 
   if (pending_s_ != 0) {  // a code was read before the last piece ended; its extra bits were not
     const int s = pending_s_;
     if (bits < s) {
-      VDS_SYNC();
-      fill(p, end);
-      VDS_LOAD();
+      top_up();
       if (bits < s) return 0;
     }
     const int32_t v = extend(acc >> (32 - s), s);
@@ -140,9 +163,7 @@ int JpegDecoder::decode_block(const uint8_t*& p, const uint8_t* end, Component& 
 
   if (k == 0) {
     if (bits < kMaxCodeBits) {
-      VDS_SYNC();
-      fill(p, end);
-      VDS_LOAD();
+      top_up();
       if (bits < kMaxCodeBits && !marker_hit_) return 0;
     }
     int len = 0;
@@ -153,9 +174,7 @@ int JpegDecoder::decode_block(const uint8_t*& p, const uint8_t* end, Component& 
     int32_t diff = 0;
     if (s != 0) {
       if (bits < s) {
-        VDS_SYNC();
-        fill(p, end);
-        VDS_LOAD();
+        top_up();
         if (bits < s) {
           pending_s_ = static_cast<uint8_t>(s);
           pending_dc_ = true;
@@ -178,9 +197,7 @@ int JpegDecoder::decode_block(const uint8_t*& p, const uint8_t* end, Component& 
   const HuffmanTable& table = ac_[c.ta];
   while (k < 64) {
     if (bits < kMaxCodeBits) {
-      VDS_SYNC();
-      fill(p, end);
-      VDS_LOAD();
+      top_up();
       if (bits < kMaxCodeBits && !marker_hit_) {
         k_ = static_cast<uint8_t>(k);
         VDS_SYNC();
@@ -223,9 +240,7 @@ int JpegDecoder::decode_block(const uint8_t*& p, const uint8_t* end, Component& 
     k += run;
     if (k > 63) return -1;
     if (bits < s) {
-      VDS_SYNC();
-      fill(p, end);
-      VDS_LOAD();
+      top_up();
       if (bits < s) {
         pending_s_ = static_cast<uint8_t>(s);
         k_ = static_cast<uint8_t>(k);
@@ -267,7 +282,7 @@ Status JpegDecoder::finish_block(int comp, int bx, int by) {
   }
   if (any_ac_) {
     idct8x8_put(coef_, dst, stride);
-    __builtin_memset(coef_, 0, 64 * sizeof(int16_t));
+    clear_block(coef_);
   } else {
     idct8x8_put_dc(coef_[0], dst, stride);
     coef_[0] = 0;

@@ -1,7 +1,8 @@
 // The image decoder's inlined range decoder (vds::image_model::RangeDecoder)
 // against the entropy core's vds::ArithDecoder: the same bins, the same
 // latched status and the same finish() verdict on encoder output, on
-// truncated and extended output and on random bytes.
+// truncated and extended output and on random bytes; the same for the
+// decoder's packed contexts (bit(PackedContext&)), state included.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -44,24 +45,39 @@ struct Op {
 // Runs the script through both decoders and compares everything.
 void compare(const std::vector<uint8_t>& bytes, const std::vector<Op>& ops, const std::vector<ArithContext>& init) {
   std::vector<ArithContext> ca = init, cb = init;
+  // The client decoder's packed contexts (both estimates in one word).
+  std::vector<vds::image_model::PackedContext> cp;
+  for (const ArithContext& c : init) cp.push_back(vds::image_model::pack_context(c));
   vds::ArithDecoder a;
-  RangeDecoder b;
+  RangeDecoder b, p;
   ASSERT_EQ(a.init(bytes.data(), bytes.size()), b.init(bytes.data(), static_cast<uint32_t>(bytes.size())));
+  ASSERT_EQ(p.init(bytes.data(), static_cast<uint32_t>(bytes.size())), b.status);
   for (size_t i = 0; i < ops.size(); ++i) {
     const Op& op = ops[i];
     if (op.kind == 0) {
-      ASSERT_EQ(a.decode_bit(ca[op.ctx]), b.bit(cb[op.ctx])) << "bin " << i;
+      const int bin = a.decode_bit(ca[op.ctx]);
+      ASSERT_EQ(bin, b.bit(cb[op.ctx])) << "bin " << i;
+      ASSERT_EQ(bin, p.bit(cp[op.ctx])) << "packed bin " << i;
       ASSERT_EQ(ca[op.ctx].p0_fast, cb[op.ctx].p0_fast);
       ASSERT_EQ(ca[op.ctx].p0_slow, cb[op.ctx].p0_slow);
+      ASSERT_EQ(cp[op.ctx], vds::image_model::pack_context(ca[op.ctx])) << "packed state " << i;
     } else if (op.kind == 1) {
-      ASSERT_EQ(a.decode_bypass(), b.bypass()) << "bin " << i;
+      const int bin = a.decode_bypass();
+      ASSERT_EQ(bin, b.bypass()) << "bin " << i;
+      ASSERT_EQ(bin, p.bypass()) << "bin " << i;
     } else {
-      ASSERT_EQ(a.decode_exp_golomb(nullptr, 0, op.k), b.exp_golomb(op.k)) << "value " << i;
+      const uint32_t v = a.decode_exp_golomb(nullptr, 0, op.k);
+      ASSERT_EQ(v, b.exp_golomb(op.k)) << "value " << i;
+      ASSERT_EQ(v, p.exp_golomb(op.k)) << "value " << i;
     }
     b.check_end();  // the decode loop's check point
+    p.check_end();
     ASSERT_EQ(a.status(), b.status) << "after op " << i;
+    ASSERT_EQ(a.status(), p.status) << "after op " << i;
   }
-  ASSERT_EQ(a.finish(), b.finish());
+  const Status done = a.finish();
+  ASSERT_EQ(done, b.finish());
+  ASSERT_EQ(done, p.finish());
 }
 
 TEST(ImageArith, MatchesArithDecoderOnEncoderOutput) {

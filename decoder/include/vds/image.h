@@ -188,7 +188,7 @@ class ImageDecoder {
   static constexpr size_t kCoefBytes = 64 * sizeof(int16_t);
   static constexpr size_t kMcuSampleBytes = 16 * 16 + 2 * 8 * 8;
   static constexpr size_t kPackedBytes = 16 * 16 * 3;
-  static constexpr size_t kWorkspaceBytes = sizeof(image_model::Contexts) + alignof(image_model::Contexts) +
+  static constexpr size_t kWorkspaceBytes = sizeof(image_model::PackedContexts) + alignof(image_model::PackedContexts) +
                                             kCoefBytes + alignof(int16_t) + kMcuSampleBytes + kPackedBytes;
 
   // Carves the workspace from the arena (workspace_too_small if it does not fit).
@@ -231,7 +231,7 @@ class ImageDecoder {
   int decode_block(image_model::RangeDecoder& rd, int comp, int bx, int by, bool first_col, int16_t* coef);
 
   image_model::RangeDecoder rd_{};  // the current IMGD chunk
-  image_model::Contexts* ctx_ = nullptr;
+  image_model::PackedContexts* ctx_ = nullptr;
   int16_t* coef_ = nullptr;     // one block, natural order
   uint8_t* mcu_pix_ = nullptr;  // Y'CbCr samples of one MCU: Y 16x16, Cb 8x8, Cr 8x8
   uint8_t* packed_ = nullptr;   // one MCU of packed pixels (rects targets)

@@ -61,43 +61,6 @@ inline constexpr uint8_t kLevelLeftOf[64] = {
     0, 0, 1, 2, 2, 3, 3, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4,
     4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4,
     4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4};
-// Per scan index, the byte offsets the decoder's level loop needs, packed in
-// one word so that the loop walks a single table: bits 0..7 the natural
-// position times 2 (an int16_t or uint16_t element in natural order), bits
-// 8..15 the sig context's offset within a row of ClassContexts::sig, bits
-// 16..23 the level context's offset within ClassContexts::gt1 / gt2 at
-// levels-left bucket 0.
-struct ScanTable {
-  uint32_t e[64];
-};
-constexpr ScanTable make_scan_table(int context_bytes) {
-  ScanTable t{};
-  for (int k = 0; k < 64; ++k)
-    t.e[k] = static_cast<uint32_t>(kZigzag[k] * 2) | static_cast<uint32_t>(kSigPosOf[k] * context_bytes) << 8 |
-             static_cast<uint32_t>(kLevelPosOf[k] * kLevelLeft * context_bytes) << 16;
-  return t;
-}
-inline constexpr ScanTable kScan = make_scan_table(sizeof(ArithContext));
-static_assert(kSigPos * sizeof(ArithContext) <= 256 && kLevelPos * kLevelLeft * sizeof(ArithContext) <= 256,
-              "scan table offsets fit a byte");
-
-// Per count of levels left (1..63), the byte offsets of the context rows it
-// selects: bits 0..15 the sig row (ClassContexts::sig[kSigLeftOf[n]]) from
-// the start of sig, bits 16..23 the levels-left column of gt1 / gt2.
-struct LeftTable {
-  uint32_t e[64];
-};
-constexpr LeftTable make_left_table(int context_bytes) {
-  LeftTable t{};
-  for (int n = 0; n < 64; ++n)
-    t.e[n] = static_cast<uint32_t>(kSigLeftOf[n] * kSigPos * context_bytes) |
-             static_cast<uint32_t>(kLevelLeftOf[n] * context_bytes) << 16;
-  return t;
-}
-inline constexpr LeftTable kLeft = make_left_table(sizeof(ArithContext));
-static_assert(kSigLeft * kSigPos * sizeof(ArithContext) < 65536 && kLevelLeft * sizeof(ArithContext) < 256,
-              "left table offsets fit their fields");
-
 // |v| - 3 of a level is coded with a bypass Exp-Golomb code of order k; k
 // starts at 0 in each block and grows by one (up to kRestMaxOrder) after a
 // remainder above kRestRaise << k, so blocks with large levels spend fewer bins.
@@ -126,22 +89,45 @@ constexpr int kDcRestOrder = 1;
 constexpr int kDcLevelMin = -2048;
 constexpr int kDcLevelMax = 2047;
 
-struct ClassContexts {
-  ArithContext cbf[kCbfCtx];
-  ArithContext dc_zero[kDcZeroCtx];
-  ArithContext dc_gt1[kDcZeroCtx];
-  ArithContext dc_gt2;
-  ArithContext nz_prefix[kNzBuckets][kNzPrefixBins];
-  ArithContext nz_suffix[kNzPrefixBins + 1];
-  ArithContext sig[kSigLeft][kSigPos];  // by levels left, then position
-  ArithContext gt1[kLevelPos][kLevelLeft];
-  ArithContext gt2[kLevelPos][kLevelLeft];
+// The contexts of one class, in any representation of a context: the
+// encoder and the training tools use vds::ArithContext, the client decoder
+// PackedContext (below). The layout is the same up to the element size.
+template <typename Ctx>
+struct ClassContextsOf {
+  Ctx cbf[kCbfCtx];
+  Ctx dc_zero[kDcZeroCtx];
+  Ctx dc_gt1[kDcZeroCtx];
+  Ctx dc_gt2;
+  Ctx nz_prefix[kNzBuckets][kNzPrefixBins];
+  Ctx nz_suffix[kNzPrefixBins + 1];
+  Ctx sig[kSigLeft][kSigPos];  // by levels left, then position
+  Ctx gt1[kLevelPos][kLevelLeft];
+  Ctx gt2[kLevelPos][kLevelLeft];
 };
 
-struct Contexts {
-  ClassContexts cls[kClasses];
-  ArithContext region[2];  // MCU coded flag, by the previous MCU's flag
+template <typename Ctx>
+struct ContextsOf {
+  ClassContextsOf<Ctx> cls[kClasses];
+  Ctx region[2];  // MCU coded flag, by the previous MCU's flag
 };
+
+using ClassContexts = ClassContextsOf<ArithContext>;
+using Contexts = ContextsOf<ArithContext>;
+
+// The client decoder's context: both probability estimates of an
+// ArithContext in one word, p0_fast in bits 0..15 and p0_slow in bits
+// 16..31. The codec's contexts are all past their warm-up with the default
+// shifts (init_contexts), so the count and the shifts carry no information;
+// one load and one store per bin instead of two of each, and 4 bytes
+// instead of 6.
+using PackedContext = uint32_t;
+using PackedClassContexts = ClassContextsOf<PackedContext>;
+using PackedContexts = ContextsOf<PackedContext>;
+constexpr int kPackedSlowShift = 16;  // bit position of p0_slow
+constexpr uint32_t kPackedLowMask = 0xFFFFu;
+constexpr PackedContext pack_context(const ArithContext& c) {
+  return static_cast<uint32_t>(c.p0_fast) | static_cast<uint32_t>(c.p0_slow) << kPackedSlowShift;
+}
 
 constexpr size_t kContextCount = sizeof(Contexts) / sizeof(ArithContext);
 
@@ -149,6 +135,8 @@ constexpr size_t kContextCount = sizeof(Contexts) / sizeof(ArithContext);
 // quantiser index (luma index for luma and region contexts, chroma index
 // for chroma contexts), adaptation already past its warm-up.
 void init_contexts(Contexts& c, int quant_luma, int quant_chroma);
+// The same starting state for the client decoder.
+void init_contexts(PackedContexts& c, int quant_luma, int quant_chroma);
 
 // The i-th context of a Contexts in declaration order (for training tools).
 ArithContext& context_at(Contexts& c, size_t i);
@@ -228,6 +216,32 @@ struct RangeDecoder {
       range -= bound;
       ctx.p0_fast = static_cast<ProbQ15>(pf - (pf >> kArithDefaultFastShift));
       ctx.p0_slow = static_cast<ProbQ15>(ps - (ps >> kArithDefaultSlowShift));
+      bin = 1;
+    }
+    if (range < kArithRangeTop) renormalise();
+    return bin;
+  }
+
+  // bit() on a PackedContext: the same arithmetic on both halves of the
+  // word. The halves never carry into each other: both estimates stay in
+  // [1, 32767], so their sum fits 16 bits, kProbOneQ15 - p does not borrow,
+  // and each update keeps its half below 2^15.
+  inline __attribute__((always_inline)) int bit(PackedContext& ctx) {
+    constexpr uint32_t kOneBoth = kProbOneQ15 | kProbOneQ15 << kPackedSlowShift;
+    constexpr int kSlowDown = kPackedSlowShift + kArithDefaultSlowShift;
+    const uint32_t p = ctx;
+    const uint32_t p0 = ((p + (p >> kPackedSlowShift)) & kPackedLowMask) >> 1;  // (fast + slow) / 2
+    const uint32_t bound = (range >> kArithProbShift) * p0;
+    int bin;
+    if (code < bound) {
+      range = bound;
+      const uint32_t d = kOneBoth - p;  // kProbOneQ15 - p in each half
+      ctx = p + ((d & kPackedLowMask) >> kArithDefaultFastShift) + ((d >> kSlowDown) << kPackedSlowShift);
+      bin = 0;
+    } else {
+      code -= bound;
+      range -= bound;
+      ctx = p - ((p & kPackedLowMask) >> kArithDefaultFastShift) - ((p >> kSlowDown) << kPackedSlowShift);
       bin = 1;
     }
     if (range < kArithRangeTop) renormalise();
