@@ -41,10 +41,13 @@ def frame_crcs(serve_stdout):
 
 
 def frame_instructions(serve_stdout):
-    """(parse, decode, display) instructions of every frame."""
-    return [tuple(int(v) for v in m.groups()) for m in
-            re.finditer(r"^\s*frame\s+\d+\s+crc\s+\S+\s+parse\s+(\d+)\s+decode\s+(\d+)\s+display\s+(\d+)",
-                        serve_stdout, re.M)]
+    """(parse, decode, display, entropy, transform) instructions of every frame."""
+    rows = []
+    for m in re.finditer(r"^\s*frame\s+\d+\s+crc\s+\S+\s+parse\s+(\d+)\s+decode\s+(\d+)\s+"
+                         r"\(entropy\s+(\d+)\s+transform\s+(\d+)\)\s+display\s+(\d+)", serve_stdout, re.M):
+        p, d, e, t, s = (int(v) for v in m.groups())
+        rows.append((p, d, s, e, t))
+    return rows
 
 
 class Run:

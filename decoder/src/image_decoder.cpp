@@ -108,6 +108,7 @@ Status ImageDecoder::feed(const uint8_t* imgd, uint32_t size) {
     s = decode_mcu(first + i);
     if (s == Status::ok) s = rd_.status;
   }
+  if (clock_) clock_->enter(StageClock::idle);
   if (s == Status::ok) s = rd_.finish();
   if (s != Status::ok) return status_ = s;
   next_mcu_ = first + count;
@@ -367,7 +368,9 @@ Status ImageDecoder::decode_mcu(uint32_t mcu) {
     const int bw = blocks_w(h, c);
     for (int by = 0; by < bw; ++by) {
       for (int bx = 0; bx < bw; ++bx) {
+        if (clock_) clock_->enter(StageClock::entropy);
         const int nz = decode_block(rd_, c, bx, by, mx == 0, coef_);
+        if (clock_) clock_->enter(StageClock::transform);
         if (nz < 0) return Status::malformed;
         if (rd_.status != Status::ok) return rd_.status;
         uint8_t* dst;
@@ -403,6 +406,7 @@ Status ImageDecoder::decode_mcu(uint32_t mcu) {
       for (int b = 0; b < bw; ++b) row_start_[c][b] = cur_[c][(bw - 1) * bw + b];
   }
 
+  if (clock_) clock_->enter(StageClock::colour);
   if (direct) return Status::ok;
   const detail::McuSamples s{mcu_pix_, y_stride, ncomp == 3 ? mcu_pix_ + kMcuCbOffset : nullptr,
                              ncomp == 3 ? mcu_pix_ + kMcuCrOffset : nullptr, kChromaStride,

@@ -64,6 +64,8 @@ struct Client {
   // Parsing is the time inside StreamParser::feed outside the callbacks.
   uint64_t parse_total = 0, decode_total = 0, display_total = 0;
   uint64_t parse_at_start = 0, decode_at_start = 0, display_at_start = 0;
+  vds::StageClock stages;  // the image decoder's split of decode_total (boards with a counter)
+  uint64_t entropy_at_start = 0, transform_at_start = 0;
   uint64_t feed_mark = 0;  // instructions() where parser time last started to count
 
   // Upward messages.
@@ -110,6 +112,8 @@ void finish_frame() {
     rec.parse_instructions = static_cast<uint32_t>(g.parse_total - g.parse_at_start);
     rec.decode_instructions = static_cast<uint32_t>(g.decode_total - g.decode_at_start);
     rec.display_instructions = static_cast<uint32_t>(g.display_total - g.display_at_start);
+    rec.entropy_instructions = static_cast<uint32_t>(g.stages.spent[vds::StageClock::entropy] - g.entropy_at_start);
+    rec.transform_instructions = static_cast<uint32_t>(g.stages.spent[vds::StageClock::transform] - g.transform_at_start);
     rec.received_ms = now;
     rec.late = late ? 1 : 0;
     ++g.pending_count;
@@ -130,6 +134,11 @@ bool on_header(void*, const vds::StreamHeader& h) {
   if (s != Status::ok) {
     log_status("image decoder", s);
     return false;
+  }
+  if (board::instruction_resolution() != 0) {
+    g.stages = vds::StageClock{};
+    g.stages.now = [](void*) { return board::instructions(); };
+    g.decoder.set_stage_clock(&g.stages);
   }
   g.band = g.arena.alloc_array<uint16_t>(static_cast<size_t>(h.width) * kBandRows);
   if (g.band == nullptr) {
@@ -153,6 +162,8 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
     g.parse_at_start = parse_before;
     g.decode_at_start = g.decode_total;
     g.display_at_start = g.display_total;
+    g.entropy_at_start = g.stages.spent[vds::StageClock::entropy];
+    g.transform_at_start = g.stages.spent[vds::StageClock::transform];
   }
   const vds::ImageTarget target = vds::ImageTarget::bands(vds::PixelFormat::rgb565, reinterpret_cast<uint8_t*>(g.band),
                                                           static_cast<ptrdiff_t>(g.header.width) * 2, on_band, nullptr);

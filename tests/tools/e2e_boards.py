@@ -93,8 +93,8 @@ def main():
     if qemu_crcs != want:
         failures.append("Cortex-M4 board frame CRCs differ from the encoder's reconstruction")
     instr = sim.frame_instructions(qemu.serve.stdout)
-    if len(instr) == len(want) and any(d == 0 for _, d, _ in instr):
-        failures.append("the Cortex-M4 board reported frames without instruction counts")
+    if len(instr) != len(want) or any(d == 0 or e == 0 or t == 0 or e + t > d for _, d, _, e, t in instr):
+        failures.append("the Cortex-M4 board's per-stage instruction counts are missing or inconsistent")
     if "window:" in host.board_log:
         failures.append("the host board could not show its live window")
     png = os.path.join(a.work, "host", "frames", "frame0000.png")

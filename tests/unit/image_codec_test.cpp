@@ -390,6 +390,42 @@ TEST(ImageCodec, PackedTargetsAgreeWithEachOther) {
   }
 }
 
+// A stage clock sees every block's entropy decoding and transform and every
+// MCU's colour output, and changes nothing in the pixels.
+TEST(ImageCodec, StageClockAccountsEveryStageAndChangesNothing) {
+  const Image img = synth(64, 48, 7);
+  ImageEncodeOptions o;
+  o.quality = 80;
+  const EncodedImage e = vds::enc::encode_image(img, o);
+  std::vector<uint8_t> ws(ImageDecoder::kWorkspaceBytes);
+  auto decode = [&](vds::StageClock* clock, std::vector<uint8_t>* frame) {
+    vds::Arena arena(ws.data(), ws.size());
+    ImageDecoder d;
+    ASSERT_EQ(d.init(arena), Status::ok);
+    d.set_stage_clock(clock);
+    ASSERT_EQ(d.start(e.imgh.data(), static_cast<uint32_t>(e.imgh.size()),
+                      ImageTarget::frame(PixelFormat::rgb888, frame->data(), 64 * 3)),
+              Status::ok);
+    for (const auto& c : e.imgd) ASSERT_FALSE(vds::is_error(d.feed(c.data(), static_cast<uint32_t>(c.size()))));
+    ASSERT_TRUE(d.done());
+  };
+  std::vector<uint8_t> plain(64 * 48 * 3), timed(64 * 48 * 3);
+  decode(nullptr, &plain);
+  // A clock that advances by one per reading: each stage gets one unit per entry.
+  uint64_t ticks = 0;
+  vds::StageClock clock;
+  clock.ctx = &ticks;
+  clock.now = [](void* ctx) { return ++*static_cast<uint64_t*>(ctx); };
+  decode(&clock, &timed);
+  EXPECT_EQ(plain, timed);
+  const uint64_t blocks = (64 / 16) * (48 / 16) * 6;  // 4:2:0: four luma and two chroma blocks per MCU
+  const uint64_t mcus = (64 / 16) * (48 / 16);
+  EXPECT_EQ(clock.spent[vds::StageClock::entropy], blocks);
+  EXPECT_EQ(clock.spent[vds::StageClock::transform], blocks);
+  EXPECT_EQ(clock.spent[vds::StageClock::colour], mcus);
+  EXPECT_EQ(clock.current, vds::StageClock::idle);
+}
+
 TEST(ImageCodec, TargetsThatDoNotFitAreRefused) {
   const EncodedImage e = vds::enc::encode_image(synth(20, 10, 3), ImageEncodeOptions{});
   uint8_t buf[20 * 10 * 3 + 4];

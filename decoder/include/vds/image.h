@@ -178,6 +178,30 @@ void image_quant_table(int index, int slope, bool chroma, uint16_t out_zigzag[64
 // coder's bytes for exactly those MCUs.
 constexpr uint32_t kImageDataPrefixBytes = 6;
 
+// --- Stage accounting (measurement builds) ---------------------------------------
+
+// Where a decoder spends its work, for benchmarks and the firmware's frame
+// records: the decoder calls `now` (an instruction or cycle counter) where
+// each stage begins and adds the difference to that stage's total. The
+// caller owns it and reads `spent`; without one (the default) the decoder
+// pays one test per block.
+struct StageClock {
+  enum Stage : int8_t { idle = -1, entropy = 0, transform = 1, colour = 2 };
+  static constexpr int kStages = 3;
+  uint64_t (*now)(void* ctx) = nullptr;
+  void* ctx = nullptr;
+  uint64_t spent[kStages] = {};  // entropy decoding; dequantisation and IDCT; colour conversion and output
+  uint64_t last = 0;
+  int8_t current = idle;
+
+  void enter(Stage s) {
+    const uint64_t t = now(ctx);
+    if (current != idle) spent[current] += t - last;
+    last = t;
+    current = s;
+  }
+};
+
 // --- The decoder -------------------------------------------------------------------
 
 class ImageDecoder {
@@ -211,6 +235,10 @@ class ImageDecoder {
   // Returns more_input/ok/error as above; other types return ok untouched.
   Status on_chunk(uint32_t type, const uint8_t* payload, uint32_t size, const ImageTarget& target);
 
+  // Accounts the work per stage into `clock` from now on (nullptr: stop).
+  // Time spent in the target's callbacks counts as colour output.
+  void set_stage_clock(StageClock* clock) { clock_ = clock; }
+
   bool done() const { return started_ && next_mcu_ == header_.mcu_count() && status_ == Status::ok; }
   Status status() const { return status_; }
   const ImageHeader& header() const { return header_; }
@@ -230,6 +258,7 @@ class ImageDecoder {
   Status decode_mcu(uint32_t mcu);
   int decode_block(image_model::RangeDecoder& rd, int comp, int bx, int by, bool first_col, int16_t* coef);
 
+  StageClock* clock_ = nullptr;
   image_model::RangeDecoder rd_{};  // the current IMGD chunk
   image_model::PackedContexts* ctx_ = nullptr;
   int16_t* coef_ = nullptr;     // one block, natural order

@@ -26,6 +26,8 @@ size_t encode(const FrameRecord& m, uint8_t out[kFrameRecordBytes]) {
   put32(p, m.crc);
   put32(p, m.parse_instructions);
   put32(p, m.decode_instructions);
+  put32(p, m.entropy_instructions);
+  put32(p, m.transform_instructions);
   put32(p, m.display_instructions);
   put32(p, m.received_ms);
   *p++ = m.late;
@@ -65,6 +67,8 @@ Status decode(const uint8_t* p, size_t n, FrameRecord* m) {
   m->crc = get32(p);
   m->parse_instructions = get32(p);
   m->decode_instructions = get32(p);
+  m->entropy_instructions = get32(p);
+  m->transform_instructions = get32(p);
   m->display_instructions = get32(p);
   m->received_ms = get32(p);
   m->late = *p;

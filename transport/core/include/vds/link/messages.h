@@ -24,11 +24,13 @@ struct FrameRecord {
   uint32_t crc;
   uint32_t parse_instructions;   // container parsing and chunk verification
   uint32_t decode_instructions;  // entropy decoding, inverse transform, colour conversion
+  uint32_t entropy_instructions;    // of which entropy decoding (0 if not measured)
+  uint32_t transform_instructions;  // of which dequantisation and inverse transform (0 if not measured)
   uint32_t display_instructions; // band output and the frame CRC
   uint32_t received_ms;          // when its last byte arrived (board clock)
   uint8_t late;                  // 1 if it missed its presentation time
 };
-constexpr size_t kFrameRecordBytes = 1 + 6 * 4 + 1;
+constexpr size_t kFrameRecordBytes = 1 + 8 * 4 + 1;
 
 struct ClientStats {
   uint32_t uptime_ms;
