@@ -44,7 +44,8 @@ class FdBackend : public Backend {
 // Opens a tty and puts it in raw mode (cfmakeraw: no echo, no line
 // editing, no CR/LF translation, 8 data bits) at `baud`. Throws
 // BackendError naming the path (not_found, access, bad_spec for a baud the
-// system has no constant for, io when it is not a terminal).
+// system has no constant for, io when it is not a terminal). A
+// pseudo-terminal (/dev/pts/N) takes any baud: only the pacing sets its rate.
 std::unique_ptr<FdBackend> open_serial(const std::string& path, uint32_t baud);
 
 // The termios speed constant for a baud rate; throws BackendError(bad_spec).
