@@ -3,6 +3,8 @@
 // pty/serial, TCP and malformed --link arguments.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
 #include <vector>
 
 #include "vds/link/fd_backends.h"
@@ -185,6 +187,29 @@ TEST(LinkBackends, PtyCarriesBytesBothWaysUnchanged) {
     got.insert(got.end(), buf.begin(), buf.begin() + static_cast<std::ptrdiff_t>(n));
   }
   EXPECT_EQ(got, all) << "no echo, no CR/LF translation";
+}
+
+// A pseudo-terminal takes any line rate (the modem's 14,400 included) and
+// the host paces it: after a burst the room is gone, and it comes back at
+// baud/10 bytes per second.
+TEST(LinkBackends, PtyTakesAnyBaudAndIsPaced) {
+  PtyPair p = open_pty_pair();
+  auto slave = open_serial(p.slave_path, 14400);
+  slave->set_pacing(14400);  // 1,440 bytes/s, a burst of at most 64 bytes
+  std::vector<uint8_t> data(64, 0x55);
+  size_t room = slave->write_room();
+  for (int i = 0; i < 50 && room < data.size(); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    room = slave->write_room();
+  }
+  ASSERT_EQ(room, data.size()) << "the burst is 64 bytes";
+  ASSERT_EQ(slave->write(data.data(), data.size()), data.size());
+  EXPECT_LT(slave->write_room(), 32u) << "a burst spends the room (it refills at 1.44 bytes/ms)";
+  std::this_thread::sleep_for(std::chrono::milliseconds(25));  // 36 bytes at 1,440 bytes/s
+  const size_t later = slave->write_room();
+  EXPECT_GE(later, 30u);
+  EXPECT_LE(later, 64u);
+  EXPECT_THROW(open_serial("/dev/null", 14400), BackendError) << "a real port needs a rate the driver knows";
 }
 
 }  // namespace
