@@ -2,8 +2,12 @@
 // 1989) factorisation, 12 multiplies per 1-D transform; accuracy per IEEE 1180-1990.
 #include "vds/idct.h"
 
-#if defined(__ARM_FEATURE_SIMD32)
-#include <arm_acle.h>  // __uqadd8 / __uqsub8 (Cortex-M4 DSP extension)
+#if defined(__ARM_FEATURE_SIMD32) && defined(__ARM_FEATURE_DSP) && defined(__ARM_FEATURE_QBIT) && \
+    defined(__ARM_FEATURE_SAT)
+#include <arm_acle.h>  // dual 16-bit multiply-accumulate, saturation, the Q flag (Cortex-M4 DSP extension)
+#define VDS_IDCT_DUAL16 1
+#elif defined(__ARM_FEATURE_SIMD32)
+#include <arm_acle.h>  // __uqadd8 / __uqsub8
 #endif
 
 namespace vds {
@@ -104,7 +108,7 @@ static_assert(Llm<13>::a3 == 25172 && Llm<13>::s6 == 4433 && Llm<11>::a3 == 6293
 // already shifted to Q(kBits) with its rounding term added (dc_term), so one
 // add rounds all eight outputs. y[n] is x[n] in Q(kBits).
 template <int kBits>
-inline __attribute__((always_inline)) void idct1d(u32 dc_term, const u32 x[8], u32 y[8]) {
+constexpr inline __attribute__((always_inline)) void idct1d(u32 dc_term, const u32 x[8], u32 y[8]) {
   using K = Llm<kBits>;
   // Even part: X0 +/- X4, then the X2/X6 rotation by 3 multiplies.
   const u32 t0 = dc_term + (x[4] << kBits);
@@ -246,21 +250,245 @@ inline void rows(const int32_t* ws, u32 bias, int16_t* out16, uint8_t* dst, ptrd
   }
 }
 
+#if defined(VDS_IDCT_DUAL16)
+// ---- Cortex-M4: both passes on 16-bit lanes ---------------------------------
+// Each 1-D pass above is a linear map modulo 2^32, so it equals the plain
+// matrix product y[n] = dc_term +/- (x4 << kBits) + sum_v M[n][v] x[v] whose
+// entries M are the LLM multipliers summed along each input's paths (the
+// same identity idct1d_low relies on). Every entry fits a signed halfword,
+// so with the inputs packed in pairs the M4's SMUAD/SMLAD do two of the
+// products and the sum in one instruction, and the results are those of
+// the 32-bit path bit for bit: a lane product is exact, and the sums are
+// the same residues modulo 2^32.
+// The column pass reads int16 coefficients, so it always fits the lanes; its
+// Q3 results fit a halfword only when the block is not extreme (in-domain
+// blocks can reach 17 bits). They are saturated to int16 (SSAT), which
+// raises the sticky Q flag when a value did not fit (SMLAD raises it too on
+// any accumulator overflow); then the block is transformed again by the
+// 32-bit path. Otherwise the row pass takes halfword pairs as well.
+namespace dual {
+
+// M[n][v] of a pass: idct1d applied to the unit vector e_v (dc_term 0).
+template <int kBits>
+constexpr int32_t entry(int n, int v) {
+  u32 x[8] = {};
+  x[v] = 1;
+  u32 y[8] = {};
+  idct1d<kBits>(0, x, y);
+  return static_cast<int32_t>(y[n]);
+}
+constexpr bool fits16(int32_t v) { return v >= -32768 && v <= 32767; }
+constexpr uint32_t pair(int32_t lo, int32_t hi) {
+  return (static_cast<uint32_t>(lo) & 0xFFFFu) | static_cast<uint32_t>(hi) << 16;
+}
+
+// The halfword pairs of one pass: the even rotation r0 (outputs 0, 7, 3,
+// 4) and r1 (1, 6, 2, 5) on (x2, x6); the odd sums o_n (output n and 7 - n)
+// on (x1, x3) and (x5, x7).
+struct Pairs {
+  uint32_t r[2];
+  uint32_t o13[4];
+  uint32_t o57[4];
+  bool ok;  // every entry fits a halfword, and the structure assumed holds
+};
+template <int kBits>
+constexpr Pairs make_pairs() {
+  Pairs p{};
+  p.ok = true;
+  for (int i = 0; i < 2; ++i) {
+    p.r[i] = pair(entry<kBits>(i, 2), entry<kBits>(i, 6));
+    p.ok = p.ok && fits16(entry<kBits>(i, 2)) && fits16(entry<kBits>(i, 6));
+  }
+  for (int n = 0; n < 4; ++n) {
+    p.o13[n] = pair(entry<kBits>(n, 1), entry<kBits>(n, 3));
+    p.o57[n] = pair(entry<kBits>(n, 5), entry<kBits>(n, 7));
+    for (int v = 1; v < 8; v += 2) p.ok = p.ok && fits16(entry<kBits>(n, v)) && entry<kBits>(7 - n, v) == -entry<kBits>(n, v);
+  }
+  // Even inputs: outputs 0/3 and 1/2 mirror the rotation, 7 - n repeats n.
+  for (int v = 2; v < 8; v += 4) {
+    p.ok = p.ok && entry<kBits>(3, v) == -entry<kBits>(0, v) && entry<kBits>(2, v) == -entry<kBits>(1, v);
+    for (int n = 0; n < 4; ++n) p.ok = p.ok && entry<kBits>(7 - n, v) == entry<kBits>(n, v);
+  }
+  return p;
+}
+constexpr Pairs kColPairs = make_pairs<kConstBits1>();
+constexpr Pairs kRowPairs = make_pairs<kConstBits2>();
+static_assert(kColPairs.ok && kRowPairs.ok, "LLM matrix entries fit halfwords with the expected symmetry");
+
+// GCC does not pick PKHBT / PKHTB for these merges.
+inline __attribute__((always_inline)) uint32_t low_halves(uint32_t a, uint32_t b) {  // a.lo, b.lo
+  uint32_t r;
+  __asm__("pkhbt %0, %1, %2, lsl #16" : "=r"(r) : "r"(a), "r"(b));
+  return r;
+}
+inline __attribute__((always_inline)) uint32_t high_halves(uint32_t a, uint32_t b) {  // a.hi, b.hi
+  uint32_t r;
+  __asm__("pkhtb %0, %2, %1, asr #16" : "=r"(r) : "r"(a), "r"(b));
+  return r;
+}
+inline int32_t s32(uint32_t v) { return static_cast<int32_t>(v); }
+
+// One 1-D transform from packed inputs: dc = x0 * 2^kBits + rounding (and
+// level shift), x4 in either half of w4 (kHigh4), p13 = (x1, x3), p57 =
+// (x5, x7), p26 = (x2, x6). y[n] as 32-bit residues, as idct1d.
+template <const Pairs& k, int kBits, bool kHigh4>
+inline __attribute__((always_inline)) void idct1d_pairs(u32 dc, uint32_t w4, uint32_t p13, uint32_t p57,
+                                                        uint32_t p26, u32 y[8]) {
+  constexpr int32_t kUnit = int32_t{1} << kBits;
+  const u32 t0 = static_cast<u32>(kHigh4 ? __smlatb(s32(w4), kUnit, s32(dc)) : __smlabb(s32(w4), kUnit, s32(dc)));
+  const u32 t1 = (dc << 1) - t0;  // dc - x4 * 2^kBits
+  const u32 r0 = static_cast<u32>(__smuad(s32(p26), s32(k.r[0])));
+  const u32 r1 = static_cast<u32>(__smuad(s32(p26), s32(k.r[1])));
+  const u32 e0 = t0 + r0, e3 = t0 - r0, e1 = t1 + r1, e2 = t1 - r1;
+  const u32 o0 = static_cast<u32>(__smlad(s32(p57), s32(k.o57[0]), __smuad(s32(p13), s32(k.o13[0]))));
+  const u32 o1 = static_cast<u32>(__smlad(s32(p57), s32(k.o57[1]), __smuad(s32(p13), s32(k.o13[1]))));
+  const u32 o2 = static_cast<u32>(__smlad(s32(p57), s32(k.o57[2]), __smuad(s32(p13), s32(k.o13[2]))));
+  const u32 o3 = static_cast<u32>(__smlad(s32(p57), s32(k.o57[3]), __smuad(s32(p13), s32(k.o13[3]))));
+  y[0] = e0 + o0;
+  y[7] = e0 - o0;
+  y[1] = e1 + o1;
+  y[6] = e1 - o1;
+  y[2] = e2 + o2;
+  y[5] = e2 - o2;
+  y[3] = e3 + o3;
+  y[4] = e3 - o3;
+}
+
+inline __attribute__((always_inline)) uint32_t load32(const void* p) {
+  uint32_t v;
+  __builtin_memcpy(&v, p, sizeof v);  // unaligned-capable word load
+  return v;
+}
+inline __attribute__((always_inline)) void store32(void* p, uint32_t v) { __builtin_memcpy(p, &v, sizeof v); }
+
+// One column of a pair (kHigh: the odd column, the high halves of the
+// words at coef). It loads its own words: see columns().
+template <bool kHigh>
+inline __attribute__((always_inline)) void column(const int16_t* coef, int16_t* out) {
+  uint32_t w[8];
+#pragma GCC unroll 8
+  for (int v = 0; v < 8; ++v) w[v] = load32(coef + 8 * v);
+  constexpr u32 kRound = kPass1Round;
+  const u32 dc = static_cast<u32>(kHigh ? __smlatb(s32(w[0]), int32_t{1} << kConstBits1, s32(kRound))
+                                        : __smlabb(s32(w[0]), int32_t{1} << kConstBits1, s32(kRound)));
+  const uint32_t p13 = kHigh ? high_halves(w[1], w[3]) : low_halves(w[1], w[3]);
+  const uint32_t p57 = kHigh ? high_halves(w[5], w[7]) : low_halves(w[5], w[7]);
+  const uint32_t p26 = kHigh ? high_halves(w[2], w[6]) : low_halves(w[2], w[6]);
+  u32 y[8];
+  idct1d_pairs<kColPairs, kConstBits1, kHigh>(dc, w[4], p13, p57, p26, y);
+#pragma GCC unroll 8
+  for (int r = 0; r < 8; ++r) out[8 * r] = static_cast<int16_t>(__ssat(s32(y[r]) >> kPass1Shift, 16));
+}
+
+// Column pass into ws (Q3 halfwords, natural order). Returns false when a
+// value did not fit a halfword (or an accumulator overflowed): ws is then
+// unusable.
+inline __attribute__((always_inline)) bool columns(const int16_t* coef, int16_t* ws) {
+  __set_saturation_occurred(0);
+  for (int c = 0; c < 8; c += 2) {
+    uint32_t w[8];
+#pragma GCC unroll 8
+    for (int v = 0; v < 8; ++v) w[v] = load32(coef + 8 * v + c);
+    if ((w[1] | w[2] | w[3] | w[4] | w[5] | w[6] | w[7]) == 0) {
+      // Both columns flat: DC << kPass1FracBits down each.
+      const int32_t lo = __ssat(static_cast<int16_t>(w[0]) * (int32_t{1} << kPass1FracBits), 16);
+      const int32_t hi = __ssat((s32(w[0]) >> 16) * (int32_t{1} << kPass1FracBits), 16);
+      const uint32_t both = low_halves(static_cast<uint32_t>(lo), static_cast<uint32_t>(hi));
+#pragma GCC unroll 8
+      for (int r = 0; r < 8; ++r) store32(ws + 8 * r + c, both);
+      continue;
+    }
+    // One column at a time: the barrier keeps the compiler from
+    // interleaving the two, which would need more registers than there are.
+    column<false>(coef + c, ws + c);
+    __asm__ volatile("" ::: "memory");
+    column<true>(coef + c, ws + c + 1);
+  }
+  return __saturation_occurred() == 0;
+}
+
+// Row pass from halfword pairs, emitting as rows() does.
+template <Emit kEmit>
+inline __attribute__((always_inline)) void rows(const int16_t* ws, u32 bias, int16_t* out16, uint8_t* dst,
+                                                ptrdiff_t stride) {
+  for (int r = 0; r < 8; ++r) {
+    const uint32_t r01 = load32(ws + 8 * r), r23 = load32(ws + 8 * r + 2);
+    const uint32_t r45 = load32(ws + 8 * r + 4), r67 = load32(ws + 8 * r + 6);
+    const u32 dc = static_cast<u32>(__smlabb(s32(r01), int32_t{1} << kConstBits2, s32(bias)));
+    int32_t v[8];
+    if (((r01 >> 16) | r23 | r45 | r67) == 0) {
+      const int32_t flat = s32(dc) >> kPass2Shift;
+      if constexpr (kEmit == Emit::put) {  // one clamp for the whole row
+        constexpr uint32_t kSplat = 0x01010101u;
+        const uint32_t p = clamp_u8(flat) * kSplat;
+        store32(dst + r * stride, p);
+        store32(dst + r * stride + 4, p);
+        continue;
+      }
+#pragma GCC unroll 8
+      for (int n = 0; n < 8; ++n) v[n] = flat;
+    } else {
+      u32 y[8];
+      idct1d_pairs<kRowPairs, kConstBits2, false>(dc, r45, high_halves(r01, r23), high_halves(r45, r67),
+                                                  low_halves(r23, r67), y);
+#pragma GCC unroll 8
+      for (int n = 0; n < 8; ++n) v[n] = s32(y[n]) >> kPass2Shift;
+    }
+    if constexpr (kEmit == Emit::store) {
+      int16_t* o = out16 + 8 * r;
+#pragma GCC unroll 8
+      for (int n = 0; n < 8; ++n) o[n] = static_cast<int16_t>(v[n]);
+    } else if constexpr (kEmit == Emit::put) {
+      uint32_t b[8];
+#pragma GCC unroll 8
+      for (int n = 0; n < 8; ++n) b[n] = clamp_u8(v[n]);
+      store32(dst + r * stride, b[0] | b[1] << 8 | b[2] << 16 | b[3] << 24);
+      store32(dst + r * stride + 4, b[4] | b[5] << 8 | b[6] << 16 | b[7] << 24);
+    } else {
+      uint8_t* d = dst + r * stride;
+#pragma GCC unroll 8
+      for (int n = 0; n < 8; ++n) d[n] = clamp_u8(d[n] + v[n]);
+    }
+  }
+}
+
+// The whole block; false (nothing written) when the 32-bit path must do it.
+template <Emit kEmit>
+inline __attribute__((always_inline)) bool transform(const int16_t* coef, u32 bias, int16_t* out16, uint8_t* dst,
+                                                     ptrdiff_t stride) {
+  alignas(4) int16_t ws[64];
+  if (!columns(coef, ws)) return false;
+  rows<kEmit>(ws, bias, out16, dst, stride);
+  return true;
+}
+
+}  // namespace dual
+#endif  // VDS_IDCT_DUAL16
+
 }  // namespace
 
 void idct8x8(const int16_t coef[64], int16_t out[64]) {
+#if defined(VDS_IDCT_DUAL16)
+  if (dual::transform<Emit::store>(coef, kPass2Round, out, nullptr, 0)) return;
+#endif
   int32_t ws[64];
   columns(coef, ws);
   rows<Emit::store>(ws, kPass2Round, out, nullptr, 0);
 }
 
 void idct8x8_put(const int16_t coef[64], uint8_t* dst, ptrdiff_t stride) {
+#if defined(VDS_IDCT_DUAL16)
+  if (dual::transform<Emit::put>(coef, kPass2Round + kPutLevel, nullptr, dst, stride)) return;
+#endif
   int32_t ws[64];
   columns(coef, ws);
   rows<Emit::put>(ws, kPass2Round + kPutLevel, nullptr, dst, stride);
 }
 
 void idct8x8_add(const int16_t coef[64], uint8_t* dst, ptrdiff_t stride) {
+#if defined(VDS_IDCT_DUAL16)
+  if (dual::transform<Emit::add>(coef, kPass2Round, nullptr, dst, stride)) return;
+#endif
   int32_t ws[64];
   columns(coef, ws);
   rows<Emit::add>(ws, kPass2Round, nullptr, dst, stride);

@@ -23,6 +23,13 @@ constexpr int kChromaStride = 8;
 
 using Info = ImageDecoder::BlockInfo;
 
+// nz_suffix[0] is never coded (the suffix starts at bit length 2), so the
+// decoder keeps it at zero: a context whose bins are all ones and cost
+// nothing. RangeDecoder::bit() on it finds bound = 0, so the bin is 1, range
+// and code stay as they are, and the update leaves the zero in place.
+constexpr size_t kAlwaysOneOffset = offsetof(m::PackedClassContexts, nz_suffix);
+constexpr m::PackedContext kAlwaysOne = 0;
+
 uint32_t rd32(const uint8_t* p) {
   return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 | static_cast<uint32_t>(p[2]) << 16 |
          static_cast<uint32_t>(p[3]) << 24;
@@ -72,6 +79,7 @@ Status ImageDecoder::start(const uint8_t* imgh, uint32_t size, const ImageTarget
     for (int k = 0; k < 64; ++k) quant_[c][m::kZigzag[k]] = zz[k];
   }
   m::init_contexts(*ctx_, h.quant_luma, h.quant_chroma);
+  for (m::PackedClassContexts& cc : ctx_->cls) cc.nz_suffix[0] = kAlwaysOne;
   std::memset(cur_, 0, sizeof cur_);
   std::memset(left_, 0, sizeof left_);
   std::memset(row_start_, 0, sizeof row_start_);
@@ -128,25 +136,35 @@ inline void clear_block(int16_t* coef) {
 
 // The level loop walks one table, indexed by the count of levels still to
 // code (1..63) and the scan index k (1..63), whose entry holds every byte
-// offset that pair selects: bits 0..15 the sig context's offset from the
-// start of PackedClassContexts, bits 16..23 the level contexts' offset
-// within gt1 (and gt2), bits 24..31 the natural position times 2 (the byte
-// offset of an int16_t or uint16_t element in natural order). The next scan
-// position is the next entry; after a level, one row up (one level fewer).
-// 16 KB of constants buys a loop that keeps only the walking pointer.
+// offset that pair selects: the sig context's offset from the start of
+// PackedClassContexts, the level contexts' offset within gt1 (and gt2),
+// and the natural position times 2 (the byte offset of an int16_t or
+// uint16_t element in natural order). The next scan position is the next
+// entry; after a level, one row up (one level fewer). 16 KB of constants
+// buys a loop that keeps only the walking pointer; the sig offset is a
+// halfword of its own so that the hottest load needs no masking.
+struct WalkEntry {
+  uint16_t sig;
+  uint8_t level;
+  uint8_t natural2;
+};
 struct WalkTable {
-  uint32_t e[64][64];
+  WalkEntry e[64][64];
 };
 constexpr size_t kCtxBytes = sizeof(m::PackedContext);
 constexpr WalkTable make_walk_table() {
   WalkTable t{};
   for (int n = 0; n < 64; ++n) {
     for (int k = 0; k < 64; ++k) {
-      const size_t sig = offsetof(m::PackedClassContexts, sig) +
-                         (static_cast<size_t>(m::kSigLeftOf[n]) * m::kSigPos + m::kSigPosOf[k]) * kCtxBytes;
+      // Where the remaining positions hold only the remaining levels (no
+      // zeros left: k + n == 64), the bin is not coded: the always-one
+      // context stands in for it.
+      const size_t sig = k + n >= 64 ? kAlwaysOneOffset
+                                     : offsetof(m::PackedClassContexts, sig) +
+                                           (static_cast<size_t>(m::kSigLeftOf[n]) * m::kSigPos + m::kSigPosOf[k]) *
+                                               kCtxBytes;
       const size_t level = (static_cast<size_t>(m::kLevelPosOf[k]) * m::kLevelLeft + m::kLevelLeftOf[n]) * kCtxBytes;
-      t.e[n][k] = static_cast<uint32_t>(sig) | static_cast<uint32_t>(level) << 16 |
-                  static_cast<uint32_t>(m::kZigzag[k] * 2) << 24;
+      t.e[n][k] = {static_cast<uint16_t>(sig), static_cast<uint8_t>(level), static_cast<uint8_t>(m::kZigzag[k] * 2)};
     }
   }
   return t;
@@ -154,9 +172,8 @@ constexpr WalkTable make_walk_table() {
 constexpr WalkTable kWalk = make_walk_table();
 static_assert(sizeof(m::PackedClassContexts) <= 65536 && sizeof(m::PackedClassContexts::gt1) <= 256,
               "walk table offsets fit their fields");
+static_assert(sizeof(WalkEntry) == 4, "one word per walk entry");
 constexpr int kWalkRow = 64;
-constexpr uint32_t kWalkSigMask = 0xFFFFu;
-constexpr int kWalkLevelShift = 16, kWalkNaturalShift = 24;
 
 inline __attribute__((always_inline)) m::PackedContext& context_at(uint8_t* base, uint32_t offset) {
   return *reinterpret_cast<m::PackedContext*>(base + offset);
@@ -165,23 +182,19 @@ inline __attribute__((always_inline)) m::PackedContext& context_at(uint8_t* base
 // The levels of a block (nz >= 1) in zig-zag order: the sig bins find each
 // nonzero position; none is coded where every remaining position must be
 // nonzero, i.e. once the zeros the block can still hold (63 - nz at the
-// start) run out. Returns 0, or -1 on a magnitude no encoder writes.
+// start) run out, which the walk table handles with the always-one context.
+// Returns 0, or -1 on a magnitude no encoder writes.
 inline __attribute__((always_inline)) int decode_levels(m::RangeDecoder& rd, m::PackedClassContexts& cc, uint32_t nz,
                                                         int16_t* coef, const uint16_t* qnat) {
   uint32_t left = nz;
-  uint32_t zeros = 63 - nz;
   int order = 0;
-  const uint32_t* tp = &kWalk.e[nz][1];
+  const WalkEntry* tp = &kWalk.e[nz][1];
   uint8_t* base = reinterpret_cast<uint8_t*>(&cc);
   uint8_t* const out = reinterpret_cast<uint8_t*>(coef);
   const uint8_t* const qn = reinterpret_cast<const uint8_t*>(qnat);
   for (;;) {
-    uint32_t e = *tp;
-    while (zeros != 0 && !rd.bit(context_at(base, e & kWalkSigMask))) {
-      e = *++tp;
-      --zeros;
-    }
-    uint8_t* const g = base + ((e >> kWalkLevelShift) & 0xFFu);
+    while (!rd.bit(context_at(base, tp->sig))) ++tp;
+    uint8_t* const g = base + tp->level;
     uint32_t mag = 1;
     if (rd.bit(context_at(g, offsetof(m::PackedClassContexts, gt1)))) {
       mag = 2;
@@ -192,11 +205,10 @@ inline __attribute__((always_inline)) int decode_levels(m::RangeDecoder& rd, m::
         mag = 3 + u;
       }
     }
-    // Dequantise (mag <= 2048 and steps <= 2047: no overflow) and saturate
-    // to the IDCT's domain, [-2048, 2047].
-    // The sign is a bypass bin (RangeDecoder::bypass()), decoded here so
-    // that each outcome stores its own saturated value.
-    const uint32_t pos = e >> kWalkNaturalShift;
+    // Dequantise (mag <= 2048 and steps <= 2047: no overflow), apply the
+    // sign (a bypass bin, RangeDecoder::bypass(), decoded here) and
+    // saturate to the IDCT's domain, [-2048, 2047]: one SSAT on a Cortex-M4.
+    const uint32_t pos = tp->natural2;
     const int32_t v = static_cast<int32_t>(mag * *reinterpret_cast<const uint16_t*>(qn + pos));
     const uint32_t half = rd.range >> 1;
     int32_t value;

@@ -139,4 +139,31 @@ TEST(ImageArith, MatchesArithDecoderOnRandomBytes) {
   }
 }
 
+// The client decoder's level loop relies on a zero PackedContext being a
+// free "always 1" bin (no sig bin is coded where no zeros are left): the
+// bin is 1, and range, code, the read position and the context are unchanged.
+TEST(ImageArith, ZeroPackedContextIsAFreeOne) {
+  Rng r{4242};
+  for (int trial = 0; trial < 200; ++trial) {
+    std::vector<uint8_t> bytes(8 + r.next() % 64);
+    for (auto& b : bytes) b = static_cast<uint8_t>(r.next());
+    bytes[0] &= 0x7F;  // a valid start
+    RangeDecoder d;
+    ASSERT_EQ(d.init(bytes.data(), static_cast<uint32_t>(bytes.size())), Status::ok);
+    vds::image_model::PackedContext live = 0x40004000u;  // p0 = 0.5 in both halves
+    const int before = static_cast<int>(r.next() % 40);
+    for (int i = 0; i < before; ++i) d.bit(live);
+    const RangeDecoder saved = d;
+    vds::image_model::PackedContext zero = 0;
+    for (int i = 0; i < 5; ++i) {
+      EXPECT_EQ(d.bit(zero), 1);
+      EXPECT_EQ(zero, 0u);
+    }
+    EXPECT_EQ(d.range, saved.range);
+    EXPECT_EQ(d.code, saved.code);
+    EXPECT_EQ(d.ptr, saved.ptr);
+    EXPECT_EQ(d.past, saved.past);
+  }
+}
+
 }  // namespace

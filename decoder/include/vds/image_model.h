@@ -99,7 +99,8 @@ struct ClassContextsOf {
   Ctx dc_gt1[kDcZeroCtx];
   Ctx dc_gt2;
   Ctx nz_prefix[kNzBuckets][kNzPrefixBins];
-  Ctx nz_suffix[kNzPrefixBins + 1];
+  Ctx nz_suffix[kNzPrefixBins + 1];  // [len], len 2..6; [0] and [1] are never coded
+                                     // (the client decoder keeps [0] as its always-one context)
   Ctx sig[kSigLeft][kSigPos];  // by levels left, then position
   Ctx gt1[kLevelPos][kLevelLeft];
   Ctx gt2[kLevelPos][kLevelLeft];
