@@ -26,6 +26,7 @@ struct EncodeMeshOptions {
   double max_error = -1;
   double removal_ratio = -1;
   double rate_weight = -1;
+  double packing_weight = -1;
   int steps = 0;
   uint32_t max_chunk = 4096;
   bool quiet = false;
@@ -52,6 +53,7 @@ void run_encode_mesh(const EncodeMeshOptions& o) {
   if (o.max_error > 0) e.simplify.max_error = o.max_error;
   if (o.removal_ratio > 0) e.simplify.removal_ratio = o.removal_ratio;
   if (o.rate_weight >= 0) e.simplify.rate_weight = o.rate_weight;
+  if (o.packing_weight >= 0) e.simplify.packing_weight = o.packing_weight;
   if (o.steps > 0) e.simplify.steps = o.steps;
   e.max_chunk_payload = o.max_chunk;
 
@@ -107,6 +109,9 @@ void add_encode_mesh(CLI::App& app) {
   sub->add_option("--removal-ratio", o->removal_ratio, "R: least fraction of vertices a level removes")
       ->check(CLI::Range(0.01, 0.5));
   sub->add_option("--rate-weight", o->rate_weight, "Weight of the prediction residual in the removal priority")
+      ->check(CLI::Range(0.0, 1000.0));
+  sub->add_option("--packing-weight", o->packing_weight,
+                  "Removal order: priority rank plus this per neighbour a removal locks (0: priority only)")
       ->check(CLI::Range(0.0, 1000.0));
   sub->add_option("--steps", o->steps, "S: threshold steps (0: from eq. 6)")->check(CLI::NonNegativeNumber);
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes (the client's chunk buffer)")

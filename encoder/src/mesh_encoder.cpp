@@ -792,6 +792,7 @@ MeshEncodeOptions paper_mesh_options() {
   o.coder = MeshCoder::huffman;
   o.predictor = MeshPredictor::laplacian;
   o.simplify.rate_weight = 0;
+  o.simplify.packing_weight = 0;
   return o;
 }
 

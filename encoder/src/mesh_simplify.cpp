@@ -8,6 +8,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <cstdlib>
+#include <functional>
 
 #include "vds/enc/mesh_import.h"
 
@@ -309,17 +310,54 @@ class Simplifier {
     return true;
   }
 
+  // Unlocked live neighbours of v: what removing v takes from this level.
+  uint32_t residual(uint32_t v, const std::vector<char>& locked) {
+    ring(v, ring_tmp_);
+    uint32_t n = 0;
+    for (uint32_t w : ring_tmp_)
+      if (valive_[w] && !locked[w]) ++n;
+    return n;
+  }
+
   void pass(double threshold, std::vector<char>& locked, std::vector<char>& target, SimplifyLevel& level,
             int& max_deg) {
     std::vector<std::pair<double, uint32_t>> order;
     for (uint32_t v = 0; v < P_.size(); ++v)
       if (valive_[v] && !locked[v] && !vf_[v].empty()) order.emplace_back(priority(v), v);
     std::sort(order.begin(), order.end());
-    std::vector<uint32_t> rv;
+    // Visiting order: by priority rank (0..1), plus packing_weight per
+    // unlocked neighbour the removal would lock. Vertices whose
+    // neighbourhood is already mostly locked waste least of the level, so
+    // a positive weight packs larger independent sets.
+    const double pw = opt_.packing_weight;
+    std::vector<double> rank(P_.size(), 0);
+    for (size_t i = 0; i < order.size(); ++i) rank[order[i].second] = double(i) / double(order.size());
+    struct Entry {
+      double key;
+      uint32_t v;
+      uint32_t res;
+      bool operator>(const Entry& o) const { return key > o.key || (key == o.key && v > o.v); }
+    };
+    std::vector<Entry> heap;
+    std::vector<char> tried(pw > 0 ? P_.size() : 0, 0);
+    for (const auto& e : order) {
+      const uint32_t res = pw > 0 ? residual(e.second, locked) : 0;
+      heap.push_back({rank[e.second] + pw * res, e.second, res});
+    }
+    std::make_heap(heap.begin(), heap.end(), std::greater<Entry>());
+    std::vector<uint32_t> rv, rw;
     std::vector<std::pair<double, size_t>> cand;
-    for (const auto& entry : order) {
-      const uint32_t v = entry.second;
+    while (!heap.empty()) {
+      std::pop_heap(heap.begin(), heap.end(), std::greater<Entry>());
+      const Entry top = heap.back();
+      heap.pop_back();
+      const uint32_t v = top.v;
       if (locked[v] || !valive_[v]) continue;
+      if (pw > 0) {
+        if (tried[v]) continue;
+        if (residual(v, locked) != top.res) continue;  // a fresher entry is queued
+        tried[v] = 1;
+      }
       if (alive_count_ <= opt_.min_base_vertices) return;
       const bool vb = ring(v, rv);
       cand.clear();
@@ -338,6 +376,19 @@ class Simplifier {
           for (uint32_t w : ring_before) locked[w] = 1;
           locked[v] = 1;
           target[c.u] = 1;
+          if (pw > 0) {
+            // The neighbours of the newly locked vertices lost candidates
+            // around them: queue them again with their smaller key.
+            for (uint32_t w : ring_before) {
+              ring(w, rw);
+              for (uint32_t x : rw) {
+                if (!valive_[x] || locked[x] || tried[x] || vf_[x].empty()) continue;
+                const uint32_t res = residual(x, locked);
+                heap.push_back({rank[x] + pw * res, x, res});
+                std::push_heap(heap.begin(), heap.end(), std::greater<Entry>());
+              }
+            }
+          }
           break;
         }
       }

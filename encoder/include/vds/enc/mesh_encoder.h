@@ -19,7 +19,10 @@
 namespace vds::enc {
 
 struct MeshEncodeOptions {
-  MeshEncodeOptions() { simplify.rate_weight = 2.0; }
+  MeshEncodeOptions() {
+    simplify.rate_weight = 4.0;
+    simplify.packing_weight = 0.1;
+  }
   int bits = 10;  // quantisation bits per axis, 2..16
   MeshCoder coder = MeshCoder::arith;
   MeshPredictor predictor = MeshPredictor::parallelogram;
@@ -33,7 +36,8 @@ struct MeshEncodeOptions {
 // The paper's choices: Huffman coding, the Laplacian predictor of eq. 13
 // and the vertex priority of eq. 1 alone (rate_weight 0). The default
 // options instead code arithmetically with the parallelogram-weighted
-// predictor and add the prediction residual to the priority.
+// predictor, add the prediction residual to the priority and visit the
+// vertices of a level so that its independent sets come out larger.
 MeshEncodeOptions paper_mesh_options();
 
 // One row of the per-level table; row 0 is the base mesh.

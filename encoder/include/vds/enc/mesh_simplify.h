@@ -17,7 +17,12 @@
 //    of the original model to the simplified model");
 //  - within a level, the 1-ring of a removed vertex is locked (the removed
 //    vertices form an independent set) and a vertex takes at most one
-//    collapse (so each split vertex splits once per level);
+//    collapse (so each split vertex splits once per level); vertices are
+//    visited by priority rank (0..1) plus packing_weight per still unlocked
+//    neighbour, kept up to date as rings get locked: a vertex whose
+//    neighbours are mostly locked already costs the level least, so a
+//    positive weight packs larger independent sets (a departure from the
+//    paper, which visits by priority alone);
 //  - thresholds E_k = kE/S, k = 1..S (S from eq. 6 unless given): a level
 //    ends once it has removed at least R·|M_{i+1}| vertices; below that the
 //    threshold is raised and the level continues. Once k = S (the whole
@@ -41,6 +46,7 @@ struct SimplifyOptions {
   double alpha = 1.0;          // weight of the shortest edge in the priority (paper: 1.0)
   double beta = 0.01;          // weight of the longest edge (paper: 0.01)
   double rate_weight = 0;      // weight of the prediction residual |v - centroid(ring)| (0: the paper's priority)
+  double packing_weight = 0;   // visiting order: priority rank + this per unlocked neighbour (0: by priority)
   double removal_ratio = 0.2;  // R: minimum fraction of a level's vertices removed (paper: 1/5..1/4)
   double max_error = 0.1;      // E as a fraction of the bounding-box diagonal
   double tail_removal_ratio = 0.05;  // levels after E is exhausted go on while they remove this much
