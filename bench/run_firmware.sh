@@ -66,6 +66,37 @@ python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$HOSTB" --q
   --report "$WORK/reel.json" >"$WORK/reel.log" 2>&1 || { tail -n 30 "$WORK/reel.log"; exit 1; }
 cp "$WORK/reel_run/host/contact_sheet.png" "$OUT/firmware_contact_sheet.png"
 
+echo "== the smallest workspace the reel plays in, on each board (bisection, 64-byte steps)"
+python3 - "$ROOT/scripts" "$VDS" "$HOSTB" "$CM4/vds_fw_client.elf" "$WORK/reel_run/e2e.vds" \
+  "$WORK/reel_run/encoder.crc" "$WORK/budget.json" <<'PY'
+import json, sys
+sys.path.insert(0, sys.argv[1])
+import sim
+vds, hostb, elf, stream, crcs, out = sys.argv[2:8]
+want = open(crcs).read().split()
+
+def plays(board, ws):
+    if board == "host":
+        r = sim.run_host(vds, hostb, stream, 1000000, 60, workspace=ws)
+    else:
+        r = sim.run_qemu(vds, "qemu-system-arm", elf, stream, 230400, 60, workspace=ws)
+    return r.ok and sim.frame_crcs(r.serve.stdout) == want
+
+result = {}
+for board, hi in (("host", 262144), ("cortex-m4", 131072)):
+    lo = 4096
+    assert plays(board, hi) and not plays(board, lo), board
+    while hi - lo > 64:
+        mid = (lo + hi) // 2 // 8 * 8
+        if plays(board, mid):
+            hi = mid
+        else:
+            lo = mid
+    result[board] = {"plays": hi, "refused": lo}
+    print(f"   {board}: plays with {hi:,} bytes of workspace, refused with {lo:,}")
+json.dump(result, open(out, "w"))
+PY
+
 python3 - "$ROWS" "$OUT/firmware.md" <<'PY'
 import json, re, subprocess, sys, datetime, platform
 rows = [l.split() for l in open(sys.argv[1])]
@@ -109,6 +140,28 @@ python3 "$ROOT/scripts/client_report.py" --run "$WORK/reel.json" --elf "$CM4/vds
   --map "$CM4/vds_fw_client.map" --title "The demo reel: twelve OpenArena textures at quality 75" \
   --images-dir . | sed -e 's/^## /### /' -e 's/^# /## /' -e 's|(./contact_sheet.png)|(firmware_contact_sheet.png)|' -e "s|$WORK/||g" \
   >>"$OUT/firmware.md"
+python3 - "$WORK/budget.json" "$CM4/vds_fw_client.elf" >>"$OUT/firmware.md" <<'PY'
+import json, re, subprocess, sys
+b = json.load(open(sys.argv[1]))
+size = subprocess.run(["arm-none-eabi-size", "-A", sys.argv[2]], capture_output=True, text=True).stdout
+secs = {m.group(1): int(m.group(2)) for m in re.finditer(r"^(\.\w+)\s+(\d+)", size, re.M)}
+ws = 131072  # VDS_WORKSPACE_BYTES of the build
+other = secs.get(".data", 0) + secs.get(".bss", 0) - ws
+m4 = b["cortex-m4"]["plays"]
+print("### The smallest budget the reel plays in")
+print()
+print("Found by bisection on each board (`scripts/sim.py` with a workspace budget: `--workspace` on the host board, "
+      "a semihosting argument on the QEMU board), every frame's CRC checked at each step:")
+print()
+print("| board | plays with | refused with |")
+print("|---|---:|---:|")
+for name in ("host", "cortex-m4"):
+    print(f"| {name} | {b[name]['plays']:,} bytes | {b[name]['refused']:,} bytes |")
+print()
+print(f"On the Cortex-M4 the whole client then needs {other:,} bytes of other static data + {m4:,} of workspace + "
+      f"the stack (high-water above): **{other + m4:,} bytes plus stack**. (The host board's workspace is larger: "
+      "pointers are 8 bytes there.)")
+PY
 {
   echo
   echo "## Reproduce"

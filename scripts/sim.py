@@ -72,9 +72,11 @@ def serve_cmd(vds, stream, link, baud, timeout):
     return [vds, "serve", stream, "--link", link, "--baud", str(baud), "--timeout", str(int(timeout))]
 
 
-def run_host(vds, board, stream, baud=115200, timeout=240, out_dir=None, window=False, env=None):
+def run_host(vds, board, stream, baud=115200, timeout=240, out_dir=None, window=False, env=None, workspace=0):
     """The host-native board over a new pseudo-terminal."""
     cmd = [board, "--uart", "pty-new", "--baud", str(baud)] + (["--window"] if window else [])
+    if workspace:
+        cmd += ["--workspace", str(workspace)]
     if out_dir:
         os.makedirs(out_dir, exist_ok=True)
         cmd += ["--frames", os.path.join(out_dir, "frames"), "--contact-sheet", os.path.join(out_dir, "contact_sheet.png"),
@@ -103,12 +105,14 @@ def run_host(vds, board, stream, baud=115200, timeout=240, out_dir=None, window=
     return Run(serve, proc.returncode, first + out + err, seconds, failure)
 
 
-def run_qemu(vds, qemu, elf, stream, baud=115200, timeout=240):
-    """The Cortex-M4 board in QEMU, UART0 on a TCP socket."""
+def run_qemu(vds, qemu, elf, stream, baud=115200, timeout=240, workspace=0):
+    """The Cortex-M4 board in QEMU, UART0 on a TCP socket. `workspace` lowers
+    the firmware's workspace budget below its build's (semihosting argument)."""
     port = free_port()
+    semihosting = "enable=on,target=native" + (f",arg=vds_fw_client,arg=workspace={workspace}" if workspace else "")
     proc = subprocess.Popen([qemu, "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none",
                              "-serial", f"tcp:127.0.0.1:{port},server=on,wait=on",
-                             "-semihosting-config", "enable=on,target=native", "-icount", "shift=0",
+                             "-semihosting-config", semihosting, "-icount", "shift=0",
                              "-kernel", elf], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     t0 = time.time()
     serve = None
@@ -139,6 +143,7 @@ def main():
     ap.add_argument("--out", default="", help="host board: where frames, video and contact sheet go")
     ap.add_argument("--window", action="store_true", help="host board: show the frames in a live window (SDL2)")
     ap.add_argument("--timeout", type=float, default=600)
+    ap.add_argument("--workspace", type=int, default=0, help="the client's workspace budget, bytes (default: the board's)")
     a = ap.parse_args()
     vds = os.path.join(a.build, "encoder", "vds")
     need = [vds]
@@ -159,12 +164,12 @@ def main():
         print(f"sim: {a.stream}: no such stream file", file=sys.stderr)
         return 2
     if a.board == "host":
-        r = run_host(vds, board, a.stream, a.baud, a.timeout, a.out or None, a.window)
+        r = run_host(vds, board, a.stream, a.baud, a.timeout, a.out or None, a.window, workspace=a.workspace)
     else:
         if a.baud > QEMU_UART_MAX_BAUD:
             print(f"sim: note: QEMU's emulated UART takes about 30 KB/s under -icount; at {a.baud} baud the extra "
                   "bytes only queue in socket buffers and the link slows down (use <= 230400)", file=sys.stderr)
-        r = run_qemu(vds, "qemu-system-arm", elf, a.stream, a.baud, a.timeout)
+        r = run_qemu(vds, "qemu-system-arm", elf, a.stream, a.baud, a.timeout, workspace=a.workspace)
     sys.stdout.write(r.serve.stdout)
     sys.stderr.write(r.serve.stderr)
     sys.stderr.write(r.board_log)

@@ -10,6 +10,7 @@
 #include "vds/enc/stream_writer.h"
 #include "vds/link/backend.h"
 #include "vds/link/serve.h"
+#include "vds/status.h"
 
 namespace vds::cli {
 namespace {
@@ -82,8 +83,9 @@ void run_serve(const ServeArgs& a) {
     std::printf("  client report      %llu bytes, CRC-32C %08x: matches\n",
                 static_cast<unsigned long long>(r.receipt_bytes), r.receipt_crc);
   } else if (r.report_seen) {
-    throw Failure(kExitBadInput, "the client reports status " + std::to_string(r.report_status) + ", " +
-                                     std::to_string(r.receipt_bytes) + " bytes: not the stream that was sent");
+    throw Failure(kExitBadInput, "the client reports status " + std::to_string(r.report_status) + " (" +
+                                     status_name(static_cast<Status>(r.report_status)) + ") after " +
+                                     std::to_string(r.receipt_bytes) + " bytes: it did not play the whole stream");
   } else {
     std::printf("  client report      none (all bytes acknowledged; the client sent no report)\n");
   }

@@ -33,6 +33,7 @@ enum : int {
   kSysWrite0 = 0x04,
   kSysRead = 0x06,
   kSysSeek = 0x0A,
+  kSysGetCmdline = 0x15,
   kSysExitExtended = 0x20,
 };
 constexpr uint32_t kOpenModeReadBinary = 1;  // "rb" in the semihosting mode table
@@ -43,6 +44,27 @@ int semihost(int op, const void* arg) {
   register const void* r1 asm("r1") = arg;
   asm volatile("bkpt 0xAB" : "+r"(r0) : "r"(r1) : "memory");
   return r0;
+}
+
+// The workspace budget of this run: VDS_WORKSPACE_BYTES, or less when the
+// semihosting command line (QEMU: -semihosting-config ...,arg=workspace=N)
+// asks for it, so one build can be tried at smaller budgets.
+size_t g_workspace_budget = VDS_WORKSPACE_BYTES;
+
+void read_budget_from_cmdline() {
+  char line[128] = {};
+  uint32_t block[2] = {reinterpret_cast<uint32_t>(line), sizeof line - 1};
+  if (semihost(kSysGetCmdline, block) != 0) return;
+  const char key[] = "workspace=";
+  for (uint32_t i = 0; line[i]; ++i) {
+    uint32_t k = 0;
+    while (key[k] && line[i + k] == key[k]) ++k;
+    if (key[k]) continue;
+    uint32_t v = 0;
+    for (uint32_t j = i + k; line[j] >= '0' && line[j] <= '9' && v < 100000000u; ++j) v = v * 10 + (line[j] - '0');
+    if (v > 0 && v < g_workspace_budget) g_workspace_budget = v;
+    return;
+  }
 }
 
 uint64_t ticks() {
@@ -98,6 +120,7 @@ void init() {
   uart0().ctrl = kUartTxEnable | kUartRxEnable | kUartRxIrqEnable;
   nvic_iser0() = (1u << kUart0RxIrq) | (1u << kTimer0Irq) | (1u << kTimer1Irq);
   asm volatile("cpsie i" ::: "memory");
+  read_budget_from_cmdline();
 }
 
 size_t uart_read(uint8_t* buf, size_t max) {
@@ -130,7 +153,7 @@ void display_begin_frame(uint16_t, uint16_t) {}
 void display_band(uint16_t, uint16_t, const uint16_t*, size_t) {}
 void display_end_frame(uint32_t) {}
 
-size_t workspace_budget() { return VDS_WORKSPACE_BYTES; }
+size_t workspace_budget() { return g_workspace_budget; }
 
 uint32_t millis() { return static_cast<uint32_t>(ticks() / kTicksPerMs); }
 uint64_t instructions() { return ticks() * kInstructionsPerTick; }
