@@ -55,8 +55,10 @@ void run_serve(const ServeArgs& a) {
               a.link.c_str(), a.baud, r.simulated ? " (simulated time)" : "");
   std::printf("  time               %.3f s, goodput %.1f %% of %u bytes/s\n", r.seconds, r.goodput * 100, a.baud / 10);
   std::printf("  sessions           %u\n", r.sessions);
-  std::printf("  frames             %u data, %u retransmitted, final payload %u B\n", r.host.data_frames_sent,
-              r.host.retransmissions, r.final_frame_payload);
+  std::printf("  frames             %u data, %u retransmitted (%u timeouts, %u losses inferred from acks), "
+              "final payload %u B\n",
+              r.host.data_frames_sent, r.host.retransmissions, r.host.timeouts, r.host.fast_losses,
+              r.final_frame_payload);
   if (r.simulated)
     std::printf("  client             %u chunks verified, %u frames dropped (bad CRC %u)\n", r.client_chunks,
                 r.client.dropped(), r.client.bad_crc);
@@ -67,9 +69,10 @@ void run_serve(const ServeArgs& a) {
                 f.parse_instructions, f.decode_instructions, f.entropy_instructions, f.transform_instructions,
                 f.display_instructions, f.late ? " late" : "");
   if (r.have_stats)
-    std::printf("  client stats       %u frames shown, %u late, %u stream bytes, workspace %u of %u B, stack %u B\n",
+    std::printf("  client stats       %u frames shown, %u late, %u stream bytes, workspace %u of %u B, stack %u B, "
+                "link %u resent, %u dropped\n",
                 r.stats.frames_shown, r.stats.late_frames, r.stats.stream_bytes, r.stats.workspace_high_water,
-                r.stats.workspace_budget, r.stats.stack_high_water);
+                r.stats.workspace_budget, r.stats.stack_high_water, r.stats.link_retransmissions, r.stats.link_dropped);
   if (!a.crc_out.empty()) {
     std::string text;
     for (const link::FrameRecord& f : r.frames) {
