@@ -46,7 +46,8 @@ SIZE_TABLE=$(python3 "$ROOT/tests/tools/check_freestanding.py" \
 echo "demo: 5/5 writing the report"
 {
   python3 "$ROOT/scripts/client_report.py" --run "$OUT/run.json" --elf "$CM4/vds_fw_client.elf" \
-    --map "$CM4/vds_fw_client.map" --title "vds demo: twelve textures to a simulated client" --images-dir host
+    --map "$CM4/vds_fw_client.map" --title "vds demo: twelve textures to a simulated client" --images-dir host |
+    sed "s|$OUT/||g"
   echo
   echo "Frames the host-native board displayed: \`out/demo/host/frames/\`, video \`out/demo/host/frames.y4m\`"
   echo "(and \`frames.mp4\` when ffmpeg is installed). Stream: \`out/demo/e2e.vds\`; logs: \`out/demo/end_to_end.log\`."
