@@ -201,6 +201,13 @@ struct RenderFrame {
   const DrawList& list;
   FrameCamera fc;
   uint32_t cached = 0;
+  // The set-up cache (Renderer::setup_*): live entries [0, live) sorted by
+  // tag, the band's new ones at [cap - fresh, cap) (the latest lowest), the
+  // cursor of the band's walk through the live ones, and free slots.
+  // Slots [unused, cap) have not been taken yet this frame (no free list to
+  // fill per frame).
+  uint32_t live = 0, fresh = 0, cursor = 0, free_slots = 0, unused = 0;
+  int32_t live_end = 0;  // the first row past the live polygon that ends first
 
   // Camera-space vertex i (no attributes).
   ClipVertex camera_vertex(uint32_t i) const {
@@ -266,6 +273,16 @@ struct RenderFrame {
             } else {
               first = static_cast<uint16_t>(r0 / bh);
               last = static_cast<uint16_t>((r1 - 1) / bh);
+              if ((o0 | o1 | o2) == 0 && !drawable(m, r.cache_[idx[0]], r.cache_[idx[1]], r.cache_[idx[2]])) {
+                // Unclipped and off screen sideways, facing away or of zero
+                // area: no band draws it (draw_mesh would reject it in each
+                // of its bands, counting it culled there when on screen).
+                if (on_screen_x(r.cache_[idx[0]], r.cache_[idx[1]], r.cache_[idx[2]])) {
+                  r.stats_.culled += static_cast<uint32_t>(last - first) + 1;
+                }
+                first = 1;
+                last = 0;
+              }
             }
           }
         }
@@ -273,6 +290,23 @@ struct RenderFrame {
         r.tri_bands_[2 * g + 1] = last;
       }
     }
+  }
+
+  // Whether an unclipped triangle's columns reach the screen, as
+  // prepare_polygon tests them (pixel centres inside its box).
+  bool on_screen_x(const CachedVertex& a, const CachedVertex& b, const CachedVertex& c) const {
+    const int32_t xlo = a.x < b.x ? (a.x < c.x ? a.x : c.x) : (b.x < c.x ? b.x : c.x);
+    const int32_t xhi = a.x > b.x ? (a.x > c.x ? a.x : c.x) : (b.x > c.x ? b.x : c.x);
+    return raster_row(xhi) > 0 && raster_row(xlo) < r.cfg_.width;
+  }
+
+  // Whether an unclipped triangle can draw anything: on screen sideways,
+  // facing the way the mesh draws and of non-zero area (the same products
+  // as prepare_polygon's).
+  bool drawable(const Mesh& m, const CachedVertex& a, const CachedVertex& b, const CachedVertex& c) const {
+    const int64_t area = int64_t{b.x - a.x} * (c.y - a.y) - int64_t{c.x - a.x} * (b.y - a.y);
+    if (area == 0 || (m.cull == Cull::back && area > 0) || (m.cull == Cull::front && area < 0)) return false;
+    return on_screen_x(a, b, c);
   }
 
   uint8_t fetch(uint32_t i, CachedVertex* out) {
@@ -299,26 +333,96 @@ struct RenderFrame {
     }
   }
 
+  // Triangle cache entry g: the bands of rows [r0, r1) (clamped to the screen).
+  void set_triangle_rows(uint32_t g, int32_t r0, int32_t r1) {
+    const int32_t bh = r.cfg_.band_height;
+    r0 = r0 < 0 ? 0 : r0;
+    r1 = r1 > r.cfg_.height ? r.cfg_.height : r1;
+    if (r0 >= r1) {
+      r.tri_bands_[2 * g] = 1;
+      r.tri_bands_[2 * g + 1] = 0;
+    } else {
+      r.tri_bands_[2 * g] = static_cast<uint16_t>(r0 / bh);
+      r.tri_bands_[2 * g + 1] = static_cast<uint16_t>((r1 - 1) / bh);
+    }
+  }
+
   detail::PreparedPolygon* setup_entry(uint32_t slot) const {
     return reinterpret_cast<detail::PreparedPolygon*>(r.setups_ + size_t{slot} * r.setup_bytes_);
   }
 
   // Draws polygon sv[0..n) of triangle number g. A polygon that reaches
   // below the band is set up into its setup_cache entry, for later bands.
-  void draw(const BandTarget& band, const MaterialCtx& mat, const ScreenVertex* sv, int n, uint32_t g) {
+  // A clipped polygon is the same in every band: its rows replace the
+  // widened estimate of the triangle cache, so that later bands skip it with
+  // two compares instead of clipping it again.
+  void draw(const BandTarget& band, const MaterialCtx& mat, const ScreenVertex* sv, int n, uint32_t g, bool clipped) {
     const uint32_t scap = r.cfg_.setup_cache;
-    int32_t ymax = sv[0].y;
-    for (int k = 1; k < n; ++k) ymax = sv[k].y > ymax ? sv[k].y : ymax;
-    if (scap == 0 || g == UINT32_MAX || raster_row(ymax) <= band.y1) {
+    int32_t ymin = sv[0].y, ymax = sv[0].y;
+    for (int k = 1; k < n; ++k) {
+      ymin = sv[k].y < ymin ? sv[k].y : ymin;
+      ymax = sv[k].y > ymax ? sv[k].y : ymax;
+    }
+    if (clipped && g < r.cfg_.triangle_cache) set_triangle_rows(g, raster_row(ymin), raster_row(ymax));
+    // Kept for later bands when it reaches below this one and a slot is free
+    // (first come, first served: taking the slot of a kept polygon that ends
+    // sooner was measured to set up more polygons, not fewer).
+    const bool keep = (free_slots != 0 || unused < scap) && g < UINT32_MAX - 1 && raster_row(ymax) > band.y1;
+    if (raster_row(ymax) <= band.y0 || raster_row(ymin) >= band.y1) {
+      // Only a clipped polygon gets here with rows that miss the band (it is
+      // visited in every band its unclipped triangle may reach): no set-up
+      // for this band (draw_polygon would set it up and draw nothing).
+      // A clipped polygon below the band waits for its first band when the
+      // triangle cache (narrowed above) brings it back there: clipping it
+      // again costs less than holding a slot until then.
+      if (!keep || (clipped && g < r.cfg_.triangle_cache)) return;
+    } else if (!keep) {
       draw_polygon(band, mat, sv, n, r.stats_);
       return;
     }
-    const uint32_t slot = g % scap;
+    const uint16_t slot = free_slots != 0 ? r.setup_free_[--free_slots] : static_cast<uint16_t>(unused++);
     detail::PreparedPolygon* pp = setup_entry(slot);
     prepare_polygon(detail::PolygonTarget{band.width, band.format, band.depth_format}, mat, sv, n, pp);
-    r.setup_tags_[slot] = g + 1;
+    ++fresh;
+    r.setup_tags_[scap - fresh] = g + 1;
+    r.setup_slots_[scap - fresh] = slot;
     ++r.stats_.setups;
     draw_prepared(band, *pp, r.stats_);
+  }
+
+  // Frees the entries whose polygons end in the band that ends at row y1
+  // and merges the band's new entries into the sorted live ones.
+  void end_band(int32_t y1) {
+    cursor = 0;
+    if (fresh == 0 && live_end > y1) return;  // nothing new, nothing ends
+    const uint32_t scap = r.cfg_.setup_cache;
+    uint32_t* const tags = r.setup_tags_;
+    uint16_t* const slots = r.setup_slots_;
+    uint32_t* const out_tags = r.setup_tags2_;
+    uint16_t* const out_slots = r.setup_slots2_;
+    uint32_t a = 0, b = 0, n = 0;
+    live_end = INT32_MAX;
+    while (a < live || b < fresh) {
+      // Live tags ascend from index 0, new ones from index scap - 1 down.
+      const bool from_live = b == fresh || (a < live && tags[a] < tags[scap - 1 - b]);
+      const uint32_t i = from_live ? a++ : scap - 1 - b++;
+      const int32_t end = prepared_row_end(*setup_entry(slots[i]));
+      if (end <= y1) {
+        r.setup_free_[free_slots++] = slots[i];
+      } else {
+        live_end = end < live_end ? end : live_end;
+        out_tags[n] = tags[i];
+        out_slots[n] = slots[i];
+        ++n;
+      }
+    }
+    live = n;
+    fresh = 0;
+    // The merged arrays become the live ones.
+    r.setup_tags_ = out_tags;
+    r.setup_slots_ = out_slots;
+    r.setup_tags2_ = tags;
+    r.setup_slots2_ = slots;
   }
 
   // Draws mesh m into the band; `first_tri` is the running index of its first
@@ -334,14 +438,32 @@ struct RenderFrame {
     const CachedVertex* const cache = r.cache_;
     const uint8_t* const cache_oc = r.cache_outcode_;
     const uint32_t n_cached = cached;
-    const uint32_t scap = r.cfg_.setup_cache;
-    for (uint32_t t = 0; t < m.num_triangles; ++t) {
+    const uint32_t nt = m.num_triangles;
+    // Triangles [0, tc_end) of the mesh are in the triangle cache.
+    const uint32_t tc_end = first_tri >= tcap ? 0 : (tcap - first_tri < nt ? tcap - first_tri : nt);
+    for (uint32_t t = 0; t < nt; ++t) {
+      if (t < tc_end) {
+        // Most triangles miss a band: skip them in a loop of their own.
+        const uint16_t* p = tb + 2 * size_t{first_tri + t};
+        if (band_index < p[0] || band_index > p[1]) {
+          do {
+            ++t;
+            p += 2;
+          } while (t < tc_end && (band_index < p[0] || band_index > p[1]));
+          if (t == nt) break;
+        }
+      }
       const uint32_t g = first_tri + t;
-      if (g < tcap && (band_index < tb[2 * g] || band_index > tb[2 * g + 1])) continue;
-      if (scap && r.setup_tags_[g % scap] == g + 1) {
-        // Set up (and clipped) in an earlier band of this frame.
-        draw_prepared(band, *setup_entry(g % scap), r.stats_);
-        continue;
+      if (cursor < live) {
+        // Live tags ascend and so do the triangles of a band's walk.
+        const uint32_t* const tags = r.setup_tags_;
+        while (cursor < live && tags[cursor] <= g) ++cursor;
+        if (cursor < live && tags[cursor] == g + 1) {
+          // Set up (and clipped) in an earlier band of this frame.
+          draw_prepared(band, *setup_entry(r.setup_slots_[cursor]), r.stats_);
+          ++cursor;
+          continue;
+        }
       }
       const uint16_t* idx = m.indices + 3 * t;
       CachedVertex cv[3];
@@ -386,6 +508,15 @@ struct RenderFrame {
         ScreenVertex screen[kMaxPolyVerts];
       } scratch;
       if (any == 0) {
+        // Off screen sideways, facing and zero area first, as
+        // prepare_polygon decides them (the same products): a rejected
+        // triangle costs no vertex copies, no set-up and no set-up cache
+        // slot. It counts as culled where prepare_polygon would count it.
+        // (Triangles in the triangle cache were tested once per frame.)
+        if (!drawable(m, cv[0], cv[1], cv[2])) {
+          if (on_screen_x(cv[0], cv[1], cv[2])) ++r.stats_.culled;  // then it faces away or has no area
+          continue;
+        }
         ScreenVertex* sv = scratch.screen;
         for (int k = 0; k < 3; ++k) {
           sv[k].x = cv[k].x;
@@ -393,7 +524,7 @@ struct RenderFrame {
           sv[k].q = cv[k].q;
           attributes(m, idx[k], sv[k].a);
         }
-        draw(band, mat, sv, 3, g);
+        draw(band, mat, sv, 3, g, false);
         continue;
       }
       ++r.stats_.clipped;
@@ -403,7 +534,10 @@ struct RenderFrame {
         attributes(m, idx[k], in[k].a);
       }
       const int n = clip_polygon(fc, static_cast<uint8_t>(any & kOutAll), in, 3, out, scratch.clip, mat.num_attribs);
-      if (n < 3) continue;
+      if (n < 3) {
+        if (g < r.cfg_.triangle_cache) set_triangle_rows(g, 0, 0);  // nothing left in any band
+        continue;
+      }
       ScreenVertex* sv = scratch.screen;
       bool ok = true;
       for (int k = 0; k < n && ok; ++k) {
@@ -412,7 +546,11 @@ struct RenderFrame {
         sv[k].q = depth_q(fc, out[k].z);
         for (int j = 0; j < kMaxAttribs; ++j) sv[k].a[j] = out[k].a[j];
       }
-      if (ok) draw(band, mat, sv, n, g);
+      if (ok) {
+        draw(band, mat, sv, n, g, true);
+      } else if (g < r.cfg_.triangle_cache) {
+        set_triangle_rows(g, 0, 0);
+      }
     }
   }
 };
@@ -452,7 +590,8 @@ size_t render_workspace_size(const RenderConfig& cfg) {
   if (cfg.triangle_cache) total += size_t{cfg.triangle_cache} * 2 * sizeof(uint16_t) + kAlignSlack;
   if (cfg.setup_cache) {
     total += size_t{cfg.setup_cache} * setup_entry_bytes() + detail::prepared_polygon_align() - 1;
-    total += size_t{cfg.setup_cache} * sizeof(uint32_t) + kAlignSlack;
+    total += size_t{cfg.setup_cache} * 2 * sizeof(uint32_t) + kAlignSlack;
+    total += size_t{cfg.setup_cache} * 3 * sizeof(uint16_t) + 1;
   }
   return total;
 }
@@ -488,14 +627,20 @@ Status Renderer::init(const RenderConfig& cfg, Arena& arena) {
   }
   uint8_t* setups = nullptr;
   uint32_t* tags = nullptr;
+  uint16_t* slots = nullptr;
   if (cfg.setup_cache) {
     setups = static_cast<uint8_t*>(arena.alloc(size_t{cfg.setup_cache} * setup_entry_bytes(), detail::prepared_polygon_align()));
-    tags = arena.alloc_array<uint32_t>(cfg.setup_cache);
-    if (!setups || !tags) return Status::workspace_too_small;
+    tags = arena.alloc_array<uint32_t>(size_t{cfg.setup_cache} * 2);
+    slots = arena.alloc_array<uint16_t>(size_t{cfg.setup_cache} * 3);
+    if (!setups || !tags || !slots) return Status::workspace_too_small;
   }
   cfg_ = cfg;
   setups_ = setups;
   setup_tags_ = tags;
+  setup_tags2_ = tags ? tags + cfg.setup_cache : nullptr;
+  setup_slots_ = slots;
+  setup_slots2_ = slots ? slots + cfg.setup_cache : nullptr;
+  setup_free_ = slots ? slots + 2 * size_t{cfg.setup_cache} : nullptr;
   setup_bytes_ = static_cast<uint32_t>(setup_entry_bytes());
   color_ = color;
   color_stride_ = stride;
@@ -521,7 +666,6 @@ Status Renderer::render(const Camera& cam, const DrawList& list, uint32_t clear_
   detail::RenderFrame frame{*this, list, {&cam, cam.near_z.raw(), cam.far_z.raw(), kRenderGuardBandPx}};
   frame.fill_cache();
   if (cfg_.triangle_cache) frame.fill_triangle_bands();
-  for (uint32_t i = 0; i < cfg_.setup_cache; ++i) setup_tags_[i] = 0;
 
   const int32_t height = cfg_.height;
   for (int32_t y0 = 0; y0 < height; y0 += cfg_.band_height) {
@@ -543,6 +687,7 @@ Status Renderer::render(const Camera& cam, const DrawList& list, uint32_t clear_
       const uint32_t nt = list.meshes[i].num_triangles;
       first_tri = nt > UINT32_MAX - first_tri ? UINT32_MAX : first_tri + nt;
     }
+    if (frame.live | frame.fresh) frame.end_band(y1);
     if (sink) {
       const Band out{band.color, color_stride_, static_cast<uint16_t>(y0), static_cast<uint16_t>(y1 - y0),
                      cfg_.width, cfg_.format};

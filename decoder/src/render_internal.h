@@ -112,5 +112,7 @@ size_t prepared_polygon_bytes();
 size_t prepared_polygon_align();
 void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const ScreenVertex* v, int n, PreparedPolygon* pp);
 void draw_prepared(const BandTarget& band, const PreparedPolygon& pp, RenderStats& stats);
+// The end (exclusive) of the rows a prepared polygon can cover.
+int32_t prepared_row_end(const PreparedPolygon& pp);
 
 }  // namespace vds::detail

@@ -231,6 +231,7 @@ inline uint32_t texel8888(const TexCtx& t, uint32_t index) {
 template <TexFormat TF, TexAddress A, PixelFormat O>
 struct NearestSampler {
   static constexpr int kFracBits = 0;
+  static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
   // (u, v): the texel containing the sample point.
   static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
     const int32_t col = tx<A>(u, t.wmask, t.wmax);
@@ -257,6 +258,7 @@ constexpr int bilinear_frac_bits(TexFormat tf, PixelFormat o) {
 template <TexFormat TF, TexAddress A, PixelFormat O>
 struct BilinearSampler {
   static constexpr int kFracBits = bilinear_frac_bits(TF, O);
+  static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
   static constexpr uint32_t kFracMask = (1u << kFracBits) - 1;
   // (u, v): the sample point minus half a texel, kFracBits fraction bits.
   static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
@@ -299,6 +301,7 @@ struct BilinearSampler {
 template <TexFormat TF, TexAddress A, PixelFormat O>
 struct BilinearApronSampler {
   static constexpr int kFracBits = bilinear_frac_bits(TF, O);
+  static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
   static constexpr uint32_t kFracMask = (1u << kFracBits) - 1;
   static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
     uint32_t index;
@@ -388,6 +391,7 @@ struct PolySetup {
   int32_t fast_shb;
   int32_t fast_dq, fast_dw, fast_dn[3];
   int32_t wlo, whi;
+  int32_t fast_qlo, fast_qhi;  // [1, kQMax] and [wlo, whi] together (q is W), not empty
 };
 
 // Integer state of one span piece: values at its first pixel and per-pixel
@@ -439,13 +443,15 @@ inline bool in_range(int64_t v, int64_t lo, int64_t hi) {
 // stay inside the limits the exponent was chosen for. false sends the span
 // to the general row_piece(). NN numerators, kProj a separate divisor.
 template <int NN, bool kProj>
-inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
+[[gnu::always_inline]] inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
   if (!s.fast) return false;
   const int32_t dx = x - s.xr, dy = y - s.yr;
   const int64_t last = len - 1;
   const int64_t q0 = row_value(s.q, dx, dy);
   const int64_t q1 = q0 + int64_t{s.fast_dq} * last;
-  if (!in_range(q0, 1, kQMax) || !in_range(q1, 1, kQMax)) return false;
+  // q is also the divisor unless kProj: one check against both ranges.
+  const int64_t qlo = NN > 0 && !kProj ? s.fast_qlo : 1, qhi = NN > 0 && !kProj ? s.fast_qhi : kQMax;
+  if (!in_range(q0, qlo, qhi) || !in_range(q1, qlo, qhi)) return false;
   r.q = static_cast<int32_t>(q0);
   r.dq = s.fast_dq;
   if constexpr (NN > 0) {
@@ -453,8 +459,8 @@ inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowS
     if constexpr (kProj) {
       w0 = row_value(s.w, dx, dy);
       w1 = w0 + int64_t{s.fast_dw} * last;
+      if (!in_range(w0, s.wlo, s.whi) || !in_range(w1, s.wlo, s.whi)) return false;
     }
-    if (!in_range(w0, s.wlo, s.whi) || !in_range(w1, s.wlo, s.whi)) return false;
     r.w = static_cast<int32_t>(w0);
     r.dw = s.fast_dw;
     for (int j = 0; j < NN; ++j) {
@@ -467,6 +473,13 @@ inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowS
     r.sh_base = s.fast_shb;
   }
   return true;
+}
+
+// The same as a function of its own: most span loops call it, so that it is
+// not copied into each of them (see texture_span).
+template <int NN, bool kProj>
+[[gnu::noinline]] bool row_fast_call(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
+  return row_fast<NN, kProj>(s, y, x, len, r);
 }
 
 // Sets up the first `len` pixels of row y from x. false when the numerators
@@ -622,7 +635,16 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
   while (xa < xb) {
     int32_t len = xb - xa;
     RowState r;
-    if (!row_fast<2, kProj>(s, y, xa, len, r)) {
+    // The start values are inlined into the loops of rgb565 textures drawn
+    // to rgb565 (about 1 instruction per pixel less in the scenes of
+    // bench/results/render.md), called from the others (code size).
+    bool fast;
+    if constexpr (Sampler::kInlineStart && !kProj) {
+      fast = row_fast<2, kProj>(s, y, xa, len, r);
+    } else {
+      fast = row_fast_call<2, kProj>(s, y, xa, len, r);
+    }
+    if (!fast) {
       while (!row_piece(s, y, xa, len, r)) len = (len + 1) >> 1;
     }
     // Both buffers are indexed from the piece end with i = -len .. -1.
@@ -882,20 +904,24 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   int64_t wmin = INT64_MAX, wmax = INT64_MIN;
   uint64_t nmax = 0;
   int64_t nref[3][3];
-  auto note = [&](int i, int64_t w, const int64_t* nvals, int count) {
+  auto note = [&](int i, int64_t w, const int64_t* nvals, int count) __attribute__((always_inline)) {
     wmin = w < wmin ? w : wmin;
     wmax = w > wmax ? w : wmax;
+    // Which vertex of the plane fit i is, if any (ref[] holds distinct values).
+    const int k = i == ref[0] ? 0 : (i == ref[1] ? 1 : (i == ref[2] ? 2 : -1));
     for (int j = 0; j < count; ++j) {
-      nmax = abs64(nvals[j]) > nmax ? abs64(nvals[j]) : nmax;
-      for (int k = 0; k < 3; ++k)
-        if (ref[k] == i) nref[j][k] = nvals[j];
+      const uint64_t mag = abs64(nvals[j]);
+      nmax = mag > nmax ? mag : nmax;
+      if (k >= 0) nref[j][k] = nvals[j];
     }
   };
   int g = 0;       // result = N / W * 2^(g + kn - kw)
   int kn = 0, kw = 0;
   int kn_min = 0;  // smallest kn that keeps every |N| below 2^30
   const int32_t(&h)[3][3] = m.view_map.m;
-  int64_t wrow[3] = {0, 0, 0}, nrow[2][3] = {{0, 0, 0}, {0, 0, 0}};
+  // The homography rows (view_mapped only; set there before any use: no
+  // zeroing, which costs a memset call per polygon).
+  int64_t wrow[3], nrow[2][3];
   if (m.shading == Shading::flat) {
     s.flat = target.format == PixelFormat::rgb565 ? pack565(m.color) : (m.color & 0xFFFFFFu);
   } else if (m.shading == Shading::gouraud) {
@@ -1045,8 +1071,14 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
     s.fast = true;  // flat: q only
   }
 
+  s.fast_qlo = s.wlo > 1 ? s.wlo : 1;
+  s.fast_qhi = s.whi < kQMax ? s.whi : kQMax;
+  // Empty: no span of a non-projective polygon passes both checks anyway.
+  if (s.nn && !s.proj && s.fast_qlo > s.fast_qhi) s.fast = false;
   pp->fn = select_span(target, m, repeat);
 }
+
+int32_t prepared_row_end(const PreparedPolygon& pp) { return pp.row_end; }
 
 void draw_prepared(const BandTarget& band, const PreparedPolygon& pp, RenderStats& stats) {
   if (pp.row_end <= band.y0 || pp.row_begin >= band.y1) return;

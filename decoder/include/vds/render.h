@@ -173,12 +173,12 @@ struct RenderConfig {
   // instead of testing their vertices. Needs their vertices in the vertex
   // cache; others are tested per band. A RAM/time trade-off, same picture.
   uint32_t triangle_cache = 0;
-  // Set-up polygons kept for the later bands they cross (a direct-mapped
-  // table indexed by triangle number, as counted for triangle_cache; the
-  // bytes per entry: render_workspace_size). Only triangles that reach below
-  // the current band are kept, so a large triangle is clipped and set up
-  // once per frame instead of once per band. 0..4096; a RAM/time trade-off,
-  // same picture.
+  // Set-up polygons kept for the later bands they cross (the bytes per
+  // entry: render_workspace_size). Only triangles that reach below the
+  // current band are kept, first come first served, and an entry is freed
+  // after the last band its polygon touches, so a large triangle is clipped
+  // and set up once per frame instead of once per band. 0..4096; a RAM/time
+  // trade-off, same picture.
   uint32_t setup_cache = 0;
   // Optional caller-owned whole-frame colour buffer (height rows of
   // target_stride bytes). When set, bands are drawn straight into it and the
@@ -249,8 +249,17 @@ class Renderer {
   detail::CachedVertex* cache_ = nullptr;
   uint8_t* cache_outcode_ = nullptr;
   uint16_t* tri_bands_ = nullptr;  // [first, last] band of each cached triangle
-  uint8_t* setups_ = nullptr;      // setup_cache prepared polygons of setup_bytes_ each
-  uint32_t* setup_tags_ = nullptr; // triangle number + 1 held by each entry; 0 empty
+  // The set-up cache: setup_cache slots of setup_bytes_ each, the entries
+  // kept for the next band as (triangle number + 1, slot) sorted by triangle
+  // (a band finds them with one compare per triangle), entries made in the
+  // current band stored from the end of the same arrays, a second pair of
+  // arrays to merge into, and a stack of free slots.
+  uint8_t* setups_ = nullptr;
+  uint32_t* setup_tags_ = nullptr;
+  uint16_t* setup_slots_ = nullptr;
+  uint32_t* setup_tags2_ = nullptr;
+  uint16_t* setup_slots2_ = nullptr;
+  uint16_t* setup_free_ = nullptr;
   uint32_t setup_bytes_ = 0;
   RenderStats stats_{};
   bool ready_ = false;
