@@ -50,8 +50,9 @@ Window g_window;
 bool g_uart_traffic = false;  // a byte has arrived: the host is there
 bool g_uart_closed = false;   // and has gone since
 
-// Pacing: a UART moves one byte per 10 bit times (start, 8 data, stop).
-double g_rx_credit = 0, g_tx_credit = 0;
+// Receive pacing: a UART moves one byte per 10 bit times (start, 8 data,
+// stop). Transmission is paced by the backend itself (FdBackend::set_pacing).
+double g_rx_credit = 0;
 Clock::time_point g_last_pace;
 constexpr double kBitsPerByte = 10.0;
 constexpr double kMaxCreditBytes = 64.0;  // a UART FIFO's worth of burst
@@ -62,7 +63,6 @@ void refill_credit() {
   g_last_pace = now;
   const double bytes = seconds * g_opt.baud / kBitsPerByte;
   g_rx_credit = std::min(g_rx_credit + bytes, kMaxCreditBytes);
-  g_tx_credit = std::min(g_tx_credit + bytes, kMaxCreditBytes);
 }
 
 // The display.
@@ -165,11 +165,7 @@ void uart_write(const uint8_t* data, size_t n) {
   if (!g_uart || g_uart_closed) return;
   size_t done = 0;
   while (done < n) {
-    size_t take = n - done;
-    if (g_opt.baud) {
-      refill_credit();
-      take = std::min(take, static_cast<size_t>(g_tx_credit));
-    }
+    const size_t take = std::min(n - done, g_uart->write_room());
     if (take) {
       size_t w = 0;
       try {
@@ -182,7 +178,6 @@ void uart_write(const uint8_t* data, size_t n) {
         }
       }
       done += w;
-      if (g_opt.baud) g_tx_credit -= static_cast<double>(w);
       if (w == take) continue;
     }
     std::this_thread::sleep_for(std::chrono::microseconds(200));
@@ -278,9 +273,11 @@ int main(int argc, char** argv) {
     if (g_opt.uart == "pty-new") {
       vds::link::PtyPair pair = vds::link::open_pty_pair();
       std::fprintf(stderr, "uart: %s\n", pair.slave_path.c_str());
+      pair.master->set_pacing(g_opt.baud);  // 0: unpaced
       vds::board::g_uart = std::move(pair.master);
     } else if (!g_opt.uart.empty()) {
-      vds::board::g_uart = vds::link::open_backend(g_opt.uart, g_opt.baud ? g_opt.baud : 115200);
+      // --baud 0: the line's nominal rate, unpaced.
+      vds::board::g_uart = vds::link::open_backend(g_opt.uart, g_opt.baud ? g_opt.baud : 115200, g_opt.baud != 0);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "vds board: %s\n", e.what());

@@ -22,12 +22,13 @@ const char* backend_error_kind_name(BackendError::Kind k) {
   return "?";
 }
 
-std::unique_ptr<Backend> open_backend(const std::string& spec, uint32_t baud) {
+std::unique_ptr<Backend> open_backend(const std::string& spec, uint32_t baud, bool paced) {
+  const uint32_t pace = paced ? baud : 0;  // FdBackend::set_pacing(0): unpaced
   auto rest = [&](size_t n) { return spec.substr(n); };
   if (spec.rfind("pty:", 0) == 0) {
     if (rest(4).empty()) throw BackendError(BackendError::Kind::bad_spec, "pty: needs a path, as in pty:/dev/ttyACM0");
     auto b = open_serial(rest(4), baud);
-    b->set_pacing(baud);
+    b->set_pacing(pace);
     return b;
   }
   if (spec.rfind("tcp:", 0) == 0) {
@@ -39,7 +40,7 @@ std::unique_ptr<Backend> open_backend(const std::string& spec, uint32_t baud) {
     const unsigned long port = std::stoul(hp.substr(c + 1));
     if (port == 0 || port > 65535) throw BackendError(BackendError::Kind::bad_spec, "tcp: port out of range in '" + spec + "'");
     auto b = tcp_connect(hp.substr(0, c), static_cast<uint16_t>(port));
-    b->set_pacing(baud);  // an emulated UART behind a socket is not paced by anyone else
+    b->set_pacing(pace);  // an emulated UART behind a socket is not paced by anyone else
     return b;
   }
   if (spec.rfind("tcp-listen:", 0) == 0) {
@@ -48,7 +49,7 @@ std::unique_ptr<Backend> open_backend(const std::string& spec, uint32_t baud) {
       throw BackendError(BackendError::Kind::bad_spec, "tcp-listen: '" + spec + "' is not tcp-listen:PORT");
     TcpListener l(static_cast<uint16_t>(std::stoul(p)), false);
     auto b = l.accept(-1);
-    if (b) b->set_pacing(baud);
+    if (b) b->set_pacing(pace);
     return b;
   }
   if (spec.rfind("usb:", 0) == 0) return open_usb(parse_usb_spec(rest(4)));

@@ -52,8 +52,9 @@ class Backend {
 // Opens "pty:PATH" (any tty; raw mode at `baud`), "tcp:HOST:PORT" (client),
 // "tcp-listen:PORT" (server, waits for one peer) or "usb:VID:PID[:IFACE]"
 // (hex ids). "loopback" is not a device: see loopback.h. Serial and TCP
-// links are paced at `baud` (10 bits a byte) by the host side.
-std::unique_ptr<Backend> open_backend(const std::string& spec, uint32_t baud);
+// links are paced at `baud` (10 bits a byte) by the host side unless
+// `paced` is false.
+std::unique_ptr<Backend> open_backend(const std::string& spec, uint32_t baud, bool paced = true);
 
 // Moves bytes between a Link and a Backend. Bytes the Link produced but the
 // backend did not take yet are kept here, so the Link never loses a frame.
