@@ -138,30 +138,8 @@ open(sys.argv[2], "w").write("\n".join(L) + "\n")
 PY
 python3 "$ROOT/scripts/client_report.py" --run "$WORK/reel.json" --elf "$CM4/vds_fw_client.elf" \
   --map "$CM4/vds_fw_client.map" --title "The demo reel: twelve OpenArena textures at quality 75" \
-  --images-dir . | sed -e 's/^## /### /' -e 's/^# /## /' -e 's|(./contact_sheet.png)|(firmware_contact_sheet.png)|' -e "s|$WORK/||g" \
+  --images-dir . --budget "$WORK/budget.json" | sed -e 's/^## /### /' -e 's/^# /## /' -e 's|(./contact_sheet.png)|(firmware_contact_sheet.png)|' -e "s|$WORK/||g" \
   >>"$OUT/firmware.md"
-python3 - "$WORK/budget.json" "$CM4/vds_fw_client.elf" >>"$OUT/firmware.md" <<'PY'
-import json, re, subprocess, sys
-b = json.load(open(sys.argv[1]))
-size = subprocess.run(["arm-none-eabi-size", "-A", sys.argv[2]], capture_output=True, text=True).stdout
-secs = {m.group(1): int(m.group(2)) for m in re.finditer(r"^(\.\w+)\s+(\d+)", size, re.M)}
-ws = 131072  # VDS_WORKSPACE_BYTES of the build
-other = secs.get(".data", 0) + secs.get(".bss", 0) - ws
-m4 = b["cortex-m4"]["plays"]
-print("### The smallest budget the reel plays in")
-print()
-print("Found by bisection on each board (`scripts/sim.py` with a workspace budget: `--workspace` on the host board, "
-      "a semihosting argument on the QEMU board), every frame's CRC checked at each step:")
-print()
-print("| board | plays with | refused with |")
-print("|---|---:|---:|")
-for name in ("host", "cortex-m4"):
-    print(f"| {name} | {b[name]['plays']:,} bytes | {b[name]['refused']:,} bytes |")
-print()
-print(f"On the Cortex-M4 the whole client then needs {other:,} bytes of other static data + {m4:,} of workspace + "
-      f"the stack (high-water above): **{other + m4:,} bytes plus stack**. (The host board's workspace is larger: "
-      "pointers are 8 bytes there.)")
-PY
 {
   echo
   echo "## Reproduce"

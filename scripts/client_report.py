@@ -76,6 +76,7 @@ def main():
     ap.add_argument("--mhz", type=float, default=100)
     ap.add_argument("--title", default="vds end-to-end report")
     ap.add_argument("--images-dir", default="", help="where frames/ and contact_sheet.png are, relative to the report")
+    ap.add_argument("--budget", default="", help="JSON of the workspace bisection (bench/run_firmware.sh)")
     a = ap.parse_args()
     r = json.load(open(a.run))
     out = [f"# {a.title}", ""]
@@ -160,6 +161,18 @@ def main():
                    f"outside the workspace ({other:,}) + workspace high-water ({ws_hw:,}) + stack high-water "
                    f"({stack_hw:,}).")
         out.append("")
+        if a.budget:
+            b = json.load(open(a.budget))
+            m4 = b["cortex-m4"]["plays"]
+            out += ["## The smallest budget the stream plays in", "",
+                    "Found by bisection on each board (`scripts/sim.py` with a workspace budget: `--workspace` on the "
+                    "host board, a semihosting argument on the QEMU board), every frame's CRC checked at each step:",
+                    "", "| board | plays with | refused with |", "|---|---:|---:|"]
+            for name in ("host", "cortex-m4"):
+                out.append(f"| {name} | {b[name]['plays']:,} bytes | {b[name]['refused']:,} bytes |")
+            out += ["", f"On the Cortex-M4 the whole client then needs {other:,} bytes of other static data + {m4:,} of "
+                    f"workspace + the stack (high-water above): **{other + m4:,} bytes plus stack**. (The host "
+                    "board's workspace is larger: pointers are 8 bytes there.)", ""]
     if a.images_dir:
         out.append("## Frames")
         out.append("")
