@@ -12,6 +12,7 @@
 #include "vds/arena.h"
 #include "vds/board.h"
 #include "vds/container.h"
+#include "vds/crc32c.h"
 #include "vds/mesh.h"
 
 #ifndef VDS_APP_WORKSPACE_MAX
@@ -43,16 +44,10 @@ struct Run {
 
 Run g_run;
 
-// FNV-1a over positions and corner vertices: the mesh after a level.
+// CRC-32C of the positions and corner vertices: the mesh after a level.
 uint32_t mesh_hash(const vds::MeshState& m) {
-  uint32_t h = 2166136261u;
-  auto mix = [&h](const void* p, size_t n) {
-    const uint8_t* b = static_cast<const uint8_t*>(p);
-    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 16777619u;
-  };
-  mix(m.positions(), static_cast<size_t>(m.vertex_count()) * 3 * sizeof(uint16_t));
-  mix(m.triangles(), static_cast<size_t>(m.triangle_count()) * 3 * sizeof(uint32_t));
-  return h;
+  const uint32_t h = vds::crc32c(m.positions(), static_cast<size_t>(m.vertex_count()) * 3 * sizeof(uint16_t));
+  return vds::crc32c_update(h, m.triangles(), static_cast<size_t>(m.triangle_count()) * 3 * sizeof(uint32_t));
 }
 
 vds::Arena g_arena;
