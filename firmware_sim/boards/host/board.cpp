@@ -55,7 +55,12 @@ bool g_uart_closed = false;   // and has gone since
 double g_rx_credit = 0;
 Clock::time_point g_last_pace;
 constexpr double kBitsPerByte = 10.0;
-constexpr double kMaxCreditBytes = 64.0;  // a UART FIFO's worth of burst
+// Bytes that arrive while the firmware is busy wait in a receive ring filled
+// by the UART interrupt, as on the Cortex-M4 board (4 KiB there too): the
+// firmware then takes them at once. A smaller allowance would throw away
+// line time for every stall, so the board would drain slower than the
+// line delivers.
+constexpr double kMaxCreditBytes = 4096.0;
 
 void refill_credit() {
   const Clock::time_point now = Clock::now();
