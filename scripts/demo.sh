@@ -5,8 +5,10 @@
 # host-native board (which writes the frames, a Y4M video and a contact
 # sheet) and over TCP to the same firmware on the Cortex-M4 board in QEMU
 # (which reports its instruction counts). Both boards' frame CRCs must equal
-# the encoder's reconstruction. Then the client self-test on both boards and
-# the size of the client's parts. Everything goes to out/demo/; the summary
+# the encoder's reconstruction. Then the Stanford bunny (glmark2-data) as a
+# progressive model at 2 KB/s to the host-native board, drawn after every
+# level, then the client self-test on both boards and the size of the
+# client's parts. Everything goes to out/demo/; the summary
 # is out/demo/report.md.
 set -euo pipefail
 BUILD=${1:-build/host-release}
@@ -19,10 +21,10 @@ rm -rf "$OUT"
 mkdir -p "$OUT/src"
 [ -f "$PK3" ] || { echo "demo: $PK3 not found; run scripts/fetch-data.sh" >&2; exit 1; }
 
-echo "demo: 1/5 taking twelve textures from $(basename "$PK3")"
+echo "demo: 1/6 taking twelve textures from $(basename "$PK3")"
 python3 "$ROOT/scripts/demo_reel.py" "$OUT/src" "$PK3"
 
-echo "demo: 2/5 encoding, then streaming to both boards at 115,200 baud (about a minute)"
+echo "demo: 2/6 encoding, then streaming to both boards at 115,200 baud (about a minute)"
 python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
   --qemu qemu-system-arm --elf "$CM4/vds_fw_client.elf" --work "$OUT" --quality 75 \
   --inputs "$OUT"/src/*.tga --report "$OUT/run.json" > "$OUT/end_to_end.log" 2>&1 || {
@@ -32,18 +34,29 @@ python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$ROOT/$BUIL
 }
 grep -E '^(encoder|host|cortex-m4) *:|^end-to-end' "$OUT/end_to_end.log"
 
-echo "demo: 3/5 client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
+echo "demo: 3/6 the Stanford bunny as a progressive model at 2 KB/s to the host-native board (about 40 s)"
+MODEL=/usr/share/glmark2/models/bunny.obj
+[ -f "$MODEL" ] || { echo "demo: $MODEL not found; run scripts/fetch-data.sh" >&2; exit 1; }
+python3 "$ROOT/scripts/demo_model.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
+  --model "$MODEL" --out "$OUT/model" > "$OUT/model.md" || {
+  cat "$OUT/model.md"
+  echo "demo: the model run failed (log: out/demo/model/serve.log)" >&2
+  exit 1
+}
+grep -E '^`' "$OUT/model.md"
+
+echo "demo: 4/6 client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
 BOARDS=$(python3 "$ROOT/tests/tools/compare_boards.py" --host "$ROOT/$BUILD/firmware_sim/vds_fw_selftest_host" \
   --qemu qemu-system-arm --elf "$CM4/vds_fw_selftest.elf")
 echo "$BOARDS" | grep -E '^boards'
 
-echo "demo: 4/5 Cortex-M4 size of the client library and the link"
+echo "demo: 5/6 Cortex-M4 size of the client library and the link"
 SIZE_TABLE=$(python3 "$ROOT/tests/tools/check_freestanding.py" \
   --cxx arm-none-eabi-g++ --nm arm-none-eabi-nm --size arm-none-eabi-size --out "$OUT/linkcheck" \
   --lib "decoder=$ROOT/$BUILD/cm4/decoder/libvds_decoder.a" \
   --lib "transport_core=$ROOT/$BUILD/cm4/transport/libvds_transport_core.a")
 
-echo "demo: 5/5 writing the report"
+echo "demo: 6/6 writing the report"
 {
   python3 "$ROOT/scripts/client_report.py" --run "$OUT/run.json" --elf "$CM4/vds_fw_client.elf" \
     --map "$CM4/vds_fw_client.map" --title "vds demo: twelve textures to a simulated client" --images-dir host |
@@ -51,6 +64,8 @@ echo "demo: 5/5 writing the report"
   echo
   echo "Frames the host-native board displayed: \`out/demo/host/frames/\`, video \`out/demo/host/frames.y4m\`"
   echo "(and \`frames.mp4\` when ffmpeg is installed). Stream: \`out/demo/e2e.vds\`; logs: \`out/demo/end_to_end.log\`."
+  echo
+  cat "$OUT/model.md"
   echo
   echo "## Client self-test, host board against the Cortex-M4 board"
   echo

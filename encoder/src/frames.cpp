@@ -10,6 +10,8 @@
 #include "vds/crc32c.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/image.h"
+#include "vds/mesh.h"
+#include "vds/model_view.h"
 
 namespace vds::enc {
 
@@ -75,6 +77,10 @@ namespace {
 
 struct Replay {
   ImageDecoder decoder;
+  MeshDecoder mesh;  // model streams
+  ModelView view;
+  bool model = false;
+  uint32_t levels_drawn = 0;
   Arena* arena = nullptr;
   std::vector<uint16_t> band;
   uint16_t width = 0, height = 0;
@@ -103,13 +109,57 @@ bool on_band(void* ctx, const PixelRect& r) {
   return true;
 }
 
+// The model view's bands, as the client's on_render_band passes them on.
+bool on_render_band(void* ctx, const Band& b) {
+  return on_band(ctx, PixelRect{0, b.y, b.width, b.height, b.pixels, static_cast<ptrdiff_t>(b.stride)});
+}
+
+// The client firmware's model path (firmware_sim/app/client.cpp): the mesh
+// is drawn once its base is in and after every completed level, the camera
+// turning kModelOrbitStep per frame.
+constexpr uint16_t kModelOrbitStep = 65536 / 64;
+
+bool start_model(Replay& r, const StreamHeader& h) {
+  if (r.mesh.init(*r.arena, h.max_vertices, h.max_triangles) != Status::ok) return false;
+  ModelViewConfig vc;
+  vc.width = h.width;
+  vc.height = h.height;
+  vc.band_height = 16;
+  vc.vertex_cache = h.max_vertices;  // any cache size gives the same picture
+  if (r.view.init(vc, *r.arena, h.max_vertices, h.max_triangles) != Status::ok) return false;
+  r.model = true;
+  return true;
+}
+
+ChunkResult on_model_chunk(Replay& r, uint32_t type, const uint8_t* p, uint32_t n) {
+  if (!MeshDecoder::handles(type)) return ChunkResult::unknown;
+  const Status s = r.mesh.consume(type, p, n);
+  if (is_error(s)) {
+    r.error = s;
+    return ChunkResult::abort;
+  }
+  if (r.mesh.drawable() && (r.crcs.empty() || r.mesh.levels_done() > r.levels_drawn)) {
+    r.levels_drawn = r.mesh.levels_done();
+    r.crc = 0;
+    if (r.frames) r.frames->emplace_back(r.width, r.height, 3);
+    const uint16_t angle = static_cast<uint16_t>(r.crcs.size() * kModelOrbitStep);
+    const Status d = r.view.draw(r.mesh.mesh(), angle, on_render_band, &r);
+    if (d != Status::ok) {
+      r.error = d;
+      return ChunkResult::abort;
+    }
+    r.crcs.push_back(r.crc);
+  }
+  return ChunkResult::consumed;
+}
+
 }  // namespace
 
 std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames) {
   auto rp = std::make_unique<Replay>();
   rp->frames = frames;
   // The chunk buffer, then what the header declares, as on a client.
-  std::vector<uint8_t> ws((1u << 24) + ImageDecoder::kWorkspaceBytes + (1u << 20));
+  std::vector<uint8_t> ws((1u << 24) + ImageDecoder::kWorkspaceBytes + (1u << 23));  // or a model of <= 65,536 vertices
   Arena arena(ws.data(), ws.size());
   rp->arena = &arena;
   StreamParser parser;
@@ -117,15 +167,17 @@ std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::ve
   sink.ctx = rp.get();
   sink.on_header = [](void* ctx, const StreamHeader& h) {
     auto* r = static_cast<Replay*>(ctx);
-    if (h.mode != StreamMode::images) return false;
-    if (r->decoder.init(*r->arena) != Status::ok) return false;
     r->width = h.width;
     r->height = h.height;
+    if (h.mode == StreamMode::model) return start_model(*r, h);
+    if (h.mode != StreamMode::images) return false;
+    if (r->decoder.init(*r->arena) != Status::ok) return false;
     r->band.assign(static_cast<size_t>(h.width) * 16, 0);
     return true;
   };
   sink.on_chunk = [](void* ctx, uint32_t type, const uint8_t* p, uint32_t n) {
     auto* r = static_cast<Replay*>(ctx);
+    if (r->model) return on_model_chunk(*r, type, p, n);
     if (type != chunk::kImageHeader && type != chunk::kImageData) return ChunkResult::unknown;
     if (type == chunk::kImageHeader) {
       r->crc = 0;

@@ -1,8 +1,10 @@
 // The vds client firmware: handshake over the link, receive the stream,
-// verify and parse it, decode each image into bands inside the workspace,
-// present them on the board's display, and report upward a CRC-32C and the
-// per-stage instruction counts of every frame, statistics, and the end of
-// the stream. Talks to the hardware only through vds/board.h.
+// verify and parse it, decode each image into bands inside the workspace
+// (or, for a model stream, decode the progressive mesh and draw it after its
+// base and after every level), present them on the board's display, and
+// report upward a CRC-32C and the per-stage instruction counts of every
+// frame, statistics, and the end of the stream. Talks to the hardware only
+// through vds/board.h.
 #include <cstddef>
 #include <cstdint>
 
@@ -14,6 +16,8 @@
 #include "vds/image.h"
 #include "vds/link/link.h"
 #include "vds/link/messages.h"
+#include "vds/mesh.h"
+#include "vds/model_view.h"
 
 #ifndef VDS_APP_WORKSPACE_MAX
 #error "VDS_APP_WORKSPACE_MAX (the largest workspace this build can use) must be set by the build"
@@ -34,6 +38,8 @@ constexpr uint32_t kStatsPeriodMs = 1000;   // statistics datagram
 constexpr uint32_t kPendingRecords = 8;     // frame records waiting for the checksums channel
 constexpr size_t kStreamReadBytes = 256;    // stream bytes handed to the parser at a time
 constexpr uint32_t kDrainTimeoutMs = 20000;  // after the end, wait this long for the host's acks
+constexpr uint32_t kModelVertexCache = 1024;  // projected vertices the model view keeps (13 bytes each)
+constexpr uint16_t kModelOrbitStep = 65536 / 64;  // the model turns 1/64 turn per frame
 
 alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
 
@@ -42,6 +48,11 @@ struct Client {
   link::Link link;
   vds::StreamParser parser;
   vds::ImageDecoder decoder;
+  // Model streams: the progressive mesh and its picture.
+  vds::MeshDecoder mesh;
+  vds::ModelView view;
+  bool model = false;
+  uint32_t model_levels_drawn = 0;  // levels drawn after the base (frames_shown - 1 once the base is drawn)
   size_t stream_mark = 0;  // arena mark below the per-stream state
   uint32_t epoch = 0;
 
@@ -122,13 +133,56 @@ void finish_frame() {
   g.in_frame = false;
 }
 
+// Snapshot of the counters a frame record is measured from.
+void start_frame_counts(uint64_t parse_total) {
+  g.parse_at_start = parse_total;
+  g.decode_at_start = g.decode_total;
+  g.display_at_start = g.display_total;
+  g.entropy_at_start = g.stages.spent[vds::StageClock::entropy];
+  g.transform_at_start = g.stages.spent[vds::StageClock::transform];
+}
+
+// Band callback of the model view: the same CRC and display path as images.
+bool on_render_band(void*, const vds::Band& b) {
+  const vds::PixelRect r{0, b.y, b.width, b.height, b.pixels, static_cast<ptrdiff_t>(b.stride)};
+  return on_band(nullptr, r);
+}
+
+bool start_model(const vds::StreamHeader& h) {
+  // The parser has checked that the mesh decoder's declared workspace fits;
+  // the picture needs its own buffers on top.
+  Status s = g.mesh.init(g.arena, h.max_vertices, h.max_triangles);
+  if (s != Status::ok) {
+    log_status("mesh decoder", s);
+    return false;
+  }
+  vds::ModelViewConfig vc;
+  vc.width = h.width;
+  vc.height = h.height;
+  vc.band_height = kBandRows;
+  vc.vertex_cache = kModelVertexCache;
+  s = g.view.init(vc, g.arena, h.max_vertices, h.max_triangles);
+  if (s != Status::ok) {
+    Line l;
+    l.str("client: model view: ").str(vds::status_name(s)).str(" (needs ");
+    l.dec(vds::ModelView::workspace_bytes(vc, h.max_vertices, h.max_triangles)).str(" bytes more)\n");
+    board::log(l.c_str());
+    return false;
+  }
+  g.model = true;
+  g.model_levels_drawn = 0;
+  start_frame_counts(g.parse_total);
+  return true;
+}
+
 bool on_header(void*, const vds::StreamHeader& h) {
-  if (h.mode != vds::StreamMode::images) {
-    board::log("client: this firmware plays image streams only\n");
+  if (h.mode != vds::StreamMode::images && h.mode != vds::StreamMode::model) {
+    board::log("client: this firmware plays image and model streams only\n");
     return false;
   }
   g.header = h;
   g.have_header = true;
+  if (h.mode == vds::StreamMode::model) return start_model(h);
   // The parser has checked that the declared workspace fits what is left.
   const Status s = g.decoder.init(g.arena);
   if (s != Status::ok) {
@@ -148,7 +202,44 @@ bool on_header(void*, const vds::StreamHeader& h) {
   return true;
 }
 
+// A model stream: every mesh chunk goes to the decoder; once the base is in,
+// and after every completed level, the mesh is drawn as a frame. A frame's
+// record counts the chunks of its level (decode) and the drawing (display).
+vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t size) {
+  if (!vds::MeshDecoder::handles(type)) return vds::ChunkResult::unknown;
+  const uint64_t t0 = board::instructions();
+  g.parse_total += t0 - g.feed_mark;
+  const Status s = g.mesh.consume(type, payload, size);
+  const uint64_t t1 = board::instructions();
+  g.decode_total += t1 - t0;
+  vds::ChunkResult result = vds::ChunkResult::consumed;
+  if (vds::is_error(s)) {
+    log_status("mesh", s);
+    result = vds::ChunkResult::abort;
+  } else if (g.mesh.drawable() && (g.frames_shown == 0 || g.mesh.levels_done() > g.model_levels_drawn)) {
+    g.model_levels_drawn = g.mesh.levels_done();
+    board::display_begin_frame(g.header.width, g.header.height);
+    g.in_frame = true;
+    g.frame_crc = 0;
+    const uint16_t angle = static_cast<uint16_t>(g.frames_shown * kModelOrbitStep);
+    const uint64_t band_before = g.display_total;
+    const Status d = g.view.draw(g.mesh.mesh(), angle, on_render_band, nullptr);
+    // Drawing counts as display: on_band has added its part, add the renderer's.
+    g.display_total += (board::instructions() - t1) - (g.display_total - band_before);
+    if (d != Status::ok) {
+      log_status("model view", d);
+      result = vds::ChunkResult::abort;
+    } else {
+      finish_frame();
+      start_frame_counts(g.parse_total);
+    }
+  }
+  g.feed_mark = board::instructions();
+  return result;
+}
+
 vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t size) {
+  if (g.model) return on_model_chunk(type, payload, size);
   if (type != vds::chunk::kImageHeader && type != vds::chunk::kImageData) return vds::ChunkResult::unknown;
   const uint64_t t0 = board::instructions();
   const uint64_t parse_before = g.parse_total;
@@ -159,11 +250,7 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
     g.in_frame = true;
     g.frame_crc = 0;
     // The parser checked this chunk's CRC before the call: that belongs to the new frame.
-    g.parse_at_start = parse_before;
-    g.decode_at_start = g.decode_total;
-    g.display_at_start = g.display_total;
-    g.entropy_at_start = g.stages.spent[vds::StageClock::entropy];
-    g.transform_at_start = g.stages.spent[vds::StageClock::transform];
+    start_frame_counts(parse_before);
   }
   const vds::ImageTarget target = vds::ImageTarget::bands(vds::PixelFormat::rgb565, reinterpret_cast<uint8_t*>(g.band),
                                                           static_cast<ptrdiff_t>(g.header.width) * 2, on_band, nullptr);
@@ -185,6 +272,8 @@ Status start_stream() {
   g.arena.rewind(g.stream_mark);
   g.have_header = false;
   g.band = nullptr;
+  g.model = false;
+  g.model_levels_drawn = 0;
   g.stream_status = Status::more_input;
   g.stream_bytes = 0;
   g.stream_crc = 0;
@@ -203,8 +292,18 @@ void feed_stream() {
   uint8_t buf[kStreamReadBytes];
   // Stop taking stream bytes while frame records wait: back-pressure.
   while (g.stream_status == Status::more_input && g.pending_count < kPendingRecords) {
+    // An image frame spans many chunks, but a model draws after every level
+    // and a coarse level can be a single small chunk: take no more bytes than
+    // can finish as many chunks (12 bytes of framing at least) as there are
+    // free frame records.
+    size_t want = sizeof buf;
+    if (g.model) {
+      constexpr size_t kMinChunk = vds::kChunkHeadBytes + vds::kChunkTailBytes;
+      const size_t limit = kMinChunk * (kPendingRecords - g.pending_count - 1) + 1;
+      if (limit < want) want = limit;
+    }
     size_t got = 0;
-    if (g.link.read(link::channel::kStream, buf, sizeof buf, &got) != Status::ok || got == 0) return;
+    if (g.link.read(link::channel::kStream, buf, want, &got) != Status::ok || got == 0) return;
     g.stream_bytes += static_cast<uint32_t>(got);
     g.stream_crc = vds::crc32c_update(g.stream_crc, buf, got);
     g.feed_mark = board::instructions();

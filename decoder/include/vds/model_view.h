@@ -1,0 +1,63 @@
+// vds client library: the model mode's picture. Draws the mesh a
+// MeshDecoder holds — after its base and after every level — as a shaded
+// surface seen from a camera that orbits it, through the scanline renderer,
+// band by band. Integer only; every buffer comes from the caller's arena.
+//
+// Framing depends only on the quantisation grid, not on the current level,
+// so the model keeps its size and place while it refines: the grid's centre
+// is the origin, 2^bits grid steps span two world units, y is up, and the
+// camera sits 3.2 units from the centre, 20 degrees above the horizon,
+// looking at it. Shading is per vertex (Gouraud): an ambient term plus a
+// two-sided diffuse term from a light above and to the left of the camera,
+// with each vertex normal the sum of its faces' cross products. Details in
+// docs/renderer.md ("Model view").
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include "vds/arena.h"
+#include "vds/mesh.h"
+#include "vds/render.h"
+#include "vds/status.h"
+
+namespace vds {
+
+struct ModelViewConfig {
+  uint16_t width = 0;   // frame size, pixels (1..2048)
+  uint16_t height = 0;
+  uint16_t band_height = 16;
+  // Projected vertices the renderer keeps per frame (13 bytes each); fewer
+  // cost time, never change the picture.
+  uint32_t vertex_cache = 0;
+  uint32_t surface_rgb = 0xD8C8A8;    // 0x00RRGGBB at full light
+  uint32_t background_rgb = 0x182028;
+};
+
+class ModelView {
+ public:
+  // Bytes init() carves for meshes of up to max_vertices (<= 65536) and
+  // max_triangles; 0 if the configuration is invalid.
+  static size_t workspace_bytes(const ModelViewConfig& cfg, uint32_t max_vertices, uint32_t max_triangles);
+
+  // invalid_argument for a bad configuration or more than 65536 vertices;
+  // workspace_too_small if the arena cannot hold the buffers.
+  Status init(const ModelViewConfig& cfg, Arena& arena, uint32_t max_vertices, uint32_t max_triangles);
+
+  // Draws `mesh` with the camera at orbit angle `angle` (2^-16 turn, about
+  // the vertical axis) and hands each finished band (RGB565) to `sink`.
+  // invalid_argument before init or for a mesh larger than init's counts.
+  Status draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx);
+
+  const RenderStats& stats() const { return renderer_.stats(); }
+
+ private:
+  ModelViewConfig cfg_{};
+  Renderer renderer_;
+  Vec3<Q16_16>* positions_ = nullptr;  // also the normal accumulators while shading
+  uint32_t* colors_ = nullptr;
+  uint16_t* indices_ = nullptr;
+  uint32_t cap_v_ = 0, cap_t_ = 0;
+  bool ready_ = false;
+};
+
+}  // namespace vds

@@ -1,0 +1,182 @@
+// The model mode's picture (vds/model_view.h): a progressive mesh drawn
+// shaded from an orbiting camera through the scanline renderer.
+#include "vds/model_view.h"
+
+#include "vds/fixed.h"
+#include "vds/render_camera.h"
+
+namespace vds {
+namespace {
+
+constexpr uint32_t kMaxPositions = 65536;  // the renderer's uint16 indices
+constexpr int64_t kCameraDistanceQ16 = 3 * 65536 + 13107;  // 3.2 world units
+constexpr uint32_t kElevation = 238609294u;                // 20 degrees in 2^-32 turn
+// Direction to the light in camera space (x right, y down, z forward), Q15:
+// to the left, above and toward the viewer; about unit length.
+constexpr int32_t kLightCam[3] = {-14746, -18022, -22938};
+constexpr int32_t kAmbientQ8 = 56;   // intensity without light, of 256
+constexpr int32_t kDiffuseQ8 = 200;  // added at normal incidence
+
+int32_t mul_q30(int32_t a, int32_t b) {
+  return static_cast<int32_t>((int64_t{a} * b + (int64_t{1} << 29)) >> 30);
+}
+
+int32_t abs32(int32_t v) { return v < 0 ? -v : v; }
+
+RenderConfig render_config(const ModelViewConfig& cfg, uint32_t max_vertices) {
+  RenderConfig rc;
+  rc.width = cfg.width;
+  rc.height = cfg.height;
+  rc.band_height = cfg.band_height;
+  rc.format = PixelFormat::rgb565;
+  rc.depth = DepthFormat::d16;
+  rc.vertex_cache = cfg.vertex_cache < max_vertices ? cfg.vertex_cache : max_vertices;
+  return rc;
+}
+
+}  // namespace
+
+size_t ModelView::workspace_bytes(const ModelViewConfig& cfg, uint32_t max_vertices, uint32_t max_triangles) {
+  if (max_vertices == 0 || max_vertices > kMaxPositions || max_triangles == 0) return 0;
+  const size_t render = render_workspace_size(render_config(cfg, max_vertices));
+  if (render == 0) return 0;
+  // Positions (12), colours (4) per vertex, three uint16 indices per
+  // triangle, and alignment padding for each array.
+  return render + size_t{16} * max_vertices + size_t{6} * max_triangles + 3 * 8;
+}
+
+Status ModelView::init(const ModelViewConfig& cfg, Arena& arena, uint32_t max_vertices, uint32_t max_triangles) {
+  ready_ = false;
+  if (workspace_bytes(cfg, max_vertices, max_triangles) == 0) return Status::invalid_argument;
+  cfg_ = cfg;
+  positions_ = arena.alloc_array<Vec3<Q16_16>>(max_vertices);
+  colors_ = arena.alloc_array<uint32_t>(max_vertices);
+  indices_ = arena.alloc_array<uint16_t>(size_t{3} * max_triangles);
+  if (!positions_ || !colors_ || !indices_) return Status::workspace_too_small;
+  const Status s = renderer_.init(render_config(cfg, max_vertices), arena);
+  if (s != Status::ok) return s;
+  cap_v_ = max_vertices;
+  cap_t_ = max_triangles;
+  ready_ = true;
+  return Status::ok;
+}
+
+Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx) {
+  const uint32_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
+  if (!ready_ || nv == 0 || nv > cap_v_ || nt > cap_t_) return Status::invalid_argument;
+  const int bits = mesh.bits();
+  if (bits < 2 || bits > 16) return Status::invalid_argument;
+  const uint16_t* pos = mesh.positions();
+  const uint32_t* tri = mesh.triangles();
+
+  // Camera basis (rows: right, down, forward) in Q2.30.
+  const uint32_t theta = static_cast<uint32_t>(angle) << 16;
+  const int32_t st = sin_q2_30(theta).raw(), ct = cos_q2_30(theta).raw();
+  const int32_t sp = sin_q2_30(kElevation).raw(), cp = cos_q2_30(kElevation).raw();
+  const int32_t rows[3][3] = {{ct, 0, -st},
+                              {mul_q30(sp, st), -cp, mul_q30(sp, ct)},
+                              {-mul_q30(cp, st), -sp, -mul_q30(cp, ct)}};
+  Camera cam;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) cam.rotation.m[i][j] = Q2_30::from_raw(rows[i][j]);
+  // The centre of projection: D units back along the forward axis.
+  cam.position.x = Q16_16::from_raw(static_cast<int32_t>((-rows[2][0] * kCameraDistanceQ16) >> 30));
+  cam.position.y = Q16_16::from_raw(static_cast<int32_t>((-rows[2][1] * kCameraDistanceQ16) >> 30));
+  cam.position.z = Q16_16::from_raw(static_cast<int32_t>((-rows[2][2] * kCameraDistanceQ16) >> 30));
+  // Focal length one frame height: a point 1 unit from the centre, on the
+  // near side, lands within 0.46 frame heights of the middle.
+  const int32_t focal = int32_t{cfg_.height} * 65536;
+  cam.fx = cam.fy = Q16_16::from_raw(focal < kCameraMinFocalPx * 65536 ? kCameraMinFocalPx * 65536 : focal);
+  cam.cx = Q16_16::from_raw(int32_t{cfg_.width} << 15);
+  cam.cy = Q16_16::from_raw(int32_t{cfg_.height} << 15);
+  cam.near_z = Q16_16::from_raw(65536 / 2);
+  cam.far_z = Q16_16::from_raw(8 * 65536);
+
+  // The light in world space: R^T applied to its camera-space direction (Q15).
+  int32_t light[3];
+  for (int a = 0; a < 3; ++a)
+    light[a] = static_cast<int32_t>(
+        (int64_t{kLightCam[0]} * rows[0][a] + int64_t{kLightCam[1]} * rows[1][a] + int64_t{kLightCam[2]} * rows[2][a]) >>
+        30);
+
+  // Vertex normals: the sum of the adjacent faces' cross products, each
+  // scaled to at most 2^21 per component so a fan of up to 64 faces (the
+  // decoder's degree limit) stays far inside int32; accumulated in the
+  // positions array, which is filled with positions afterwards.
+  const int shift = bits > 10 ? 2 * (bits - 10) : 0;
+  int32_t* acc = reinterpret_cast<int32_t*>(positions_);
+  for (uint32_t i = 0; i < 3 * nv; ++i) acc[i] = 0;
+  for (uint32_t t = 0; t < nt; ++t) {
+    const uint32_t* c = tri + 3 * t;
+    if (c[0] >= nv || c[1] >= nv || c[2] >= nv) return Status::invalid_argument;
+    int64_t e1[3], e2[3];
+    for (int a = 0; a < 3; ++a) {
+      e1[a] = int64_t{pos[3 * c[1] + a]} - pos[3 * c[0] + a];
+      e2[a] = int64_t{pos[3 * c[2] + a]} - pos[3 * c[0] + a];
+    }
+    const int64_t n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    for (int a = 0; a < 3; ++a) {
+      const int32_t v = static_cast<int32_t>(n[a] / (int64_t{1} << shift));
+      for (int k = 0; k < 3; ++k) {
+        int32_t& s = acc[3 * c[k] + a];
+        // Saturate rather than wrap if a vertex has more faces than the limit.
+        const int64_t sum = int64_t{s} + v;
+        s = sum > INT32_MAX / 2 ? INT32_MAX / 2 : (sum < -(INT32_MAX / 2) ? -(INT32_MAX / 2) : static_cast<int32_t>(sum));
+      }
+    }
+  }
+  const uint32_t base_rgb[3] = {(cfg_.surface_rgb >> 16) & 255, (cfg_.surface_rgb >> 8) & 255, cfg_.surface_rgb & 255};
+  for (uint32_t v = 0; v < nv; ++v) {
+    int32_t n[3] = {acc[3 * v], acc[3 * v + 1], acc[3 * v + 2]};
+    // Down to 15 bits per component so the squared length fits 32 bits... and 64.
+    while (abs32(n[0]) >= 32768 || abs32(n[1]) >= 32768 || abs32(n[2]) >= 32768)
+      for (int32_t& x : n) x /= 2;
+    const uint64_t len2 = static_cast<uint64_t>(int64_t{n[0]} * n[0] + int64_t{n[1]} * n[1] + int64_t{n[2]} * n[2]);
+    int32_t intensity = kAmbientQ8;
+    if (len2 != 0) {
+      const int64_t len = static_cast<int64_t>(isqrt64(len2));
+      int64_t dot = int64_t{n[0]} * light[0] + int64_t{n[1]} * light[1] + int64_t{n[2]} * light[2];
+      if (dot < 0) dot = -dot;  // two-sided: orientation of the input is not assumed
+      if (len > 0) intensity += static_cast<int32_t>((dot * kDiffuseQ8) / (len * 32768));
+    }
+    uint32_t rgb = 0;
+    for (int k = 0; k < 3; ++k) {
+      uint32_t ch = (base_rgb[k] * static_cast<uint32_t>(intensity)) >> 8;
+      if (ch > 255) ch = 255;
+      rgb = (rgb << 8) | ch;
+    }
+    colors_[v] = rgb;
+  }
+
+  // Positions: the centre of the current bounding box at the origin, 2^bits
+  // grid steps = 2 units.
+  uint32_t lo[3] = {65535, 65535, 65535}, hi[3] = {0, 0, 0};
+  for (uint32_t v = 0; v < nv; ++v)
+    for (int a = 0; a < 3; ++a) {
+      const uint32_t p = pos[3 * v + a];
+      if (p < lo[a]) lo[a] = p;
+      if (p > hi[a]) hi[a] = p;
+    }
+  const int up = 16 - bits;
+  for (uint32_t v = 0; v < nv; ++v) {
+    int32_t w[3];
+    for (int a = 0; a < 3; ++a) w[a] = (2 * static_cast<int32_t>(pos[3 * v + a]) - static_cast<int32_t>(lo[a] + hi[a])) * (1 << up);
+    positions_[v] = {Q16_16::from_raw(w[0]), Q16_16::from_raw(w[1]), Q16_16::from_raw(w[2])};
+  }
+  for (uint32_t i = 0; i < 3 * nt; ++i) indices_[i] = static_cast<uint16_t>(tri[i]);
+
+  Mesh m;
+  m.indices = indices_;
+  m.num_triangles = nt;
+  m.shading = Shading::gouraud;
+  m.cull = Cull::none;
+  m.colors = colors_;
+  DrawList list;
+  list.positions = positions_;
+  list.num_positions = nv;
+  list.meshes = &m;
+  list.num_meshes = 1;
+  return renderer_.render(cam, list, cfg_.background_rgb, sink, ctx);
+}
+
+}  // namespace vds

@@ -1,0 +1,120 @@
+// The model mode's picture: the golden mesh stream replayed through the
+// client's display path (container parser, mesh decoder, model view) gives
+// one frame after the base and one per level, with pinned checksums; the
+// model fills a sensible part of the frame and is centred; bad
+// configurations and meshes are refused with a status.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "mesh_test_meshes.h"
+#include "vds/enc/frames.h"
+#include "vds/enc/mesh_encoder.h"
+#include "vds/enc/stream_writer.h"
+#include "vds/mesh.h"
+#include "vds/model_view.h"
+
+namespace {
+
+using vds::Status;
+
+std::vector<uint8_t> golden_mesh_stream() {
+  return vds::enc::read_file(std::string(VDS_SOURCE_DIR) + "/tests/golden/mesh-v1.vds");
+}
+
+// Pixels that differ from the background, and their bounding box.
+struct Coverage {
+  int pixels = 0;
+  int x0 = 1 << 30, y0 = 1 << 30, x1 = -1, y1 = -1;
+};
+
+Coverage coverage(const vds::enc::Image& im) {
+  Coverage c;
+  const uint8_t bg[3] = {im.at(0, 0, 0), im.at(0, 0, 1), im.at(0, 0, 2)};
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      if (im.at(x, y, 0) == bg[0] && im.at(x, y, 1) == bg[1] && im.at(x, y, 2) == bg[2]) continue;
+      ++c.pixels;
+      c.x0 = std::min(c.x0, x);
+      c.y0 = std::min(c.y0, y);
+      c.x1 = std::max(c.x1, x);
+      c.y1 = std::max(c.y1, y);
+    }
+  return c;
+}
+
+TEST(ModelView, GoldenStreamOneFramePerLevel) {
+  std::vector<vds::enc::Image> frames;
+  const std::vector<uint32_t> crcs = vds::enc::client_frame_crcs(golden_mesh_stream(), &frames);
+  // 13 levels after the base: 14 frames.
+  ASSERT_EQ(crcs.size(), 14u);
+  ASSERT_EQ(frames.size(), 14u);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    const Coverage c = coverage(frames[i]);
+    // A sphere of radius ~1 at 3.2 units with a focal length of one frame
+    // height covers roughly a disc of 0.3 frame heights' radius.
+    EXPECT_GT(c.pixels, 240 * 180 / 12) << "frame " << i;
+    EXPECT_LT(c.pixels, 240 * 180 / 2) << "frame " << i;
+    EXPECT_NEAR((c.x0 + c.x1) / 2.0, 120, 12) << "frame " << i;
+    EXPECT_NEAR((c.y0 + c.y1) / 2.0, 90, 12) << "frame " << i;
+    if (i > 0) EXPECT_NE(crcs[i], crcs[i - 1]) << "level " << i << " drew the same picture";
+  }
+  // Pinned: the client's picture is integer arithmetic, the same on every
+  // target (the end-to-end test compares the boards against these replays).
+  EXPECT_EQ(crcs.front(), 0x154289D2u) << std::hex << crcs.front();
+  EXPECT_EQ(crcs.back(), 0xD0251113u) << std::hex << crcs.back();
+}
+
+TEST(ModelView, RefusesWhatItCannotDraw) {
+  vds::ModelViewConfig cfg;
+  cfg.width = 64;
+  cfg.height = 48;
+  EXPECT_EQ(vds::ModelView::workspace_bytes(cfg, 0, 10), 0u);
+  EXPECT_EQ(vds::ModelView::workspace_bytes(cfg, 65537, 10), 0u);
+  vds::ModelViewConfig bad = cfg;
+  bad.width = 0;
+  EXPECT_EQ(vds::ModelView::workspace_bytes(bad, 100, 100), 0u);
+
+  std::vector<uint8_t> ws(vds::ModelView::workspace_bytes(cfg, 162, 320));
+  ASSERT_GT(ws.size(), 0u);
+  vds::ModelView view;
+  {
+    vds::Arena small(ws.data(), ws.size() / 2);
+    EXPECT_EQ(view.init(cfg, small, 162, 320), Status::workspace_too_small);
+  }
+  vds::Arena bad_arena(ws.data(), ws.size());
+  EXPECT_EQ(view.init(bad, bad_arena, 162, 320), Status::invalid_argument);
+
+  // A decoded mesh larger than the view was sized for.
+  std::vector<uint8_t> mesh_ws(vds::MeshDecoder::workspace_bytes(162, 320, 320, vds::MeshCoder::arith) + 4096);
+  vds::Arena mesh_arena(mesh_ws.data(), mesh_ws.size());
+  vds::MeshState mesh;
+  ASSERT_EQ(mesh.init(mesh_arena, 162, 320), Status::ok);
+  mesh.clear(10);
+  const int32_t p[3][3] = {{0, 0, 0}, {1023, 0, 0}, {0, 1023, 0}};
+  for (const auto& q : p) ASSERT_EQ(mesh.add_vertex(q), Status::ok);
+  ASSERT_EQ(mesh.add_triangle(0, 1, 2), Status::ok);
+  ASSERT_EQ(mesh.finish_base(mesh_arena, 12), Status::ok);
+  auto sink = [](void*, const vds::Band&) { return true; };
+  EXPECT_EQ(view.draw(mesh, 0, sink, nullptr), Status::invalid_argument) << "not initialised";
+  vds::Arena one(ws.data(), ws.size());
+  vds::ModelView tiny;
+  ASSERT_EQ(tiny.init(cfg, one, 2, 1), Status::ok);
+  EXPECT_EQ(tiny.draw(mesh, 0, sink, nullptr), Status::invalid_argument) << "3 vertices in a view for 2";
+
+  // The single triangle draws, and a sink that stops the frame is obeyed.
+  vds::Arena fits(ws.data(), ws.size());
+  ASSERT_EQ(view.init(cfg, fits, 162, 320), Status::ok);
+  int bands = 0;
+  auto count = [](void* ctx, const vds::Band&) {
+    ++*static_cast<int*>(ctx);
+    return true;
+  };
+  EXPECT_EQ(view.draw(mesh, 0, count, &bands), Status::ok);
+  EXPECT_EQ(bands, 3);  // 48 rows in bands of 16
+  auto stop = [](void*, const vds::Band&) { return false; };
+  EXPECT_EQ(view.draw(mesh, 0, stop, nullptr), Status::aborted);
+}
+
+}  // namespace
