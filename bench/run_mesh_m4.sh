@@ -5,7 +5,9 @@
 # QEMU mps2-an386 (-icount shift=0; the stream parser and the mesh decoder,
 # instructions counted inside the mesh decoder), and by the same firmware on
 # the host board, whose mesh checksums after every level must be identical.
-# Writes bench/results/mesh_m4.md.
+# The firmware also draws the model after the base and every level as the
+# client does (vds::ModelView, 240x180), counted apart; the frame checksums
+# must be identical on both boards too. Writes bench/results/mesh_m4.md.
 #
 # Usage: bench/run_mesh_m4.sh [BUILD_DIR]   (default build/host-release: it
 #   must hold encoder/vds, firmware_sim/vds_fw_bench_mesh_host and
@@ -52,9 +54,10 @@ for coding in default paper; do
   echo "   $(grep -c '^check ' "$dir/m4.txt") level checksums identical on both boards"
   cat "$dir/names.txt" >>"$ROWS"
   grep '^m4 stream=' "$dir/m4.txt" | sed "s/^/$coding /" >>"$WORK/summary.txt"
+  grep '^m4 view stream=' "$dir/m4.txt" | sed "s/^/$coding /" >>"$WORK/view.txt"
 done
 
-/usr/bin/python3 - "$ROWS" "$WORK/summary.txt" "$OUT" "$(qemu-system-arm --version | head -n 1)" <<'PY'
+/usr/bin/python3 - "$ROWS" "$WORK/summary.txt" "$OUT" "$(qemu-system-arm --version | head -n 1)" "$WORK/view.txt" <<'PY'
 import re, sys, datetime
 rows = [l.split() for l in open(sys.argv[1])]
 summ = {}
@@ -62,6 +65,11 @@ for l in open(sys.argv[2]):
     coding = l.split()[0]
     kv = dict(re.findall(r"(\w+)=(\S+)", l))
     summ[(coding, kv["stream"])] = kv
+view = {}
+for l in open(sys.argv[5]):
+    coding = l.split()[0]
+    kv = dict(re.findall(r"(\w+)=(\S+)", l))
+    view[(coding, kv["stream"])] = kv
 L = ["# Progressive mesh decoding on the Cortex-M4 board", "",
      f"Produced by `bench/run_mesh_m4.sh build/host-release` on {datetime.date.today()}. {sys.argv[4]}, "
      "`-M mps2-an386 -cpu cortex-m4 -icount shift=0`; firmware `vds_fw_bench_mesh` (arm-none-eabi-g++ -O2, "
@@ -83,7 +91,27 @@ for name, model, bits, coding, size in rows:
     L.append(f"| {model} | {bits} | {'vds' if coding == 'default' else 'paper'} | {int(size):,} | {v:,} | {splits:,} | "
              f"{kv['levels']} | {ins:,} | {per:,.0f} | {base:,} | {ws:,} | {ws / v:.1f} |")
 L += ["", "Per vertex split: (instructions - base) / splits. Workspace: the arena's high-water mark (mesh, "
-      "contexts or Huffman tables, split flags, the stream parser's 16 KiB chunk buffer).", ""]
+      "contexts or Huffman tables, split flags, the stream parser's 16 KiB chunk buffer), the model view's "
+      "buffers not included.", "",
+      "## Drawing the model (vds::ModelView, as the client firmware)", "",
+      "After the base and after every level the firmware draws the mesh at 240x180 (shaded, z-buffered, "
+      "16-row bands, every vertex projected once and every triangle's band range found once per frame), as the client does while a model streams in; the "
+      "instructions are counted around `ModelView::draw` (normals, colours, positions and the renderer; "
+      "nothing is displayed). The frame checksums were identical on the host board.", "",
+      "| model | bits | triangles | frames | all frames (instructions) | whole model, one frame | per triangle | "
+      "frames/s at 100 MHz | view workspace bytes |",
+      "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+for name, model, bits, coding, size in rows:
+    if coding != "default" or (coding, name) not in view:
+        continue
+    kv = view[(coding, name)]
+    last = int(kv["last_draw"])
+    L.append(f"| {model} | {bits} | {int(kv['triangles']):,} | {kv['frames']} | {int(kv['draw_instructions']):,} | "
+             f"{last:,} | {last / int(kv['triangles']):,.0f} | {1e8 / last:.1f} | {int(kv['view_workspace']):,} |")
+L += ["", "The last frame draws the whole model. At these sizes its cost is per triangle (vertex normals and "
+      "colours, projection, polygon set-up and clipping against the bands), not per pixel: a model of a few "
+      "thousand triangles draws at a few frames per second on a 100 MHz Cortex-M4, the 69,666-triangle bunny "
+      "at well under one.", ""]
 open(sys.argv[3], "w").write("\n".join(L) + "\n")
 PY
 echo "wrote bench/results/mesh_m4.md"

@@ -23,7 +23,7 @@ int32_t mul_q30(int32_t a, int32_t b) {
 
 int32_t abs32(int32_t v) { return v < 0 ? -v : v; }
 
-RenderConfig render_config(const ModelViewConfig& cfg, uint32_t max_vertices) {
+RenderConfig render_config(const ModelViewConfig& cfg, uint32_t max_vertices, uint32_t max_triangles) {
   RenderConfig rc;
   rc.width = cfg.width;
   rc.height = cfg.height;
@@ -31,6 +31,8 @@ RenderConfig render_config(const ModelViewConfig& cfg, uint32_t max_vertices) {
   rc.format = PixelFormat::rgb565;
   rc.depth = DepthFormat::d16;
   rc.vertex_cache = cfg.vertex_cache < max_vertices ? cfg.vertex_cache : max_vertices;
+  rc.triangle_cache = cfg.triangle_cache < max_triangles ? cfg.triangle_cache : max_triangles;
+  rc.setup_cache = cfg.setup_cache;
   return rc;
 }
 
@@ -38,7 +40,7 @@ RenderConfig render_config(const ModelViewConfig& cfg, uint32_t max_vertices) {
 
 size_t ModelView::workspace_bytes(const ModelViewConfig& cfg, uint32_t max_vertices, uint32_t max_triangles) {
   if (max_vertices == 0 || max_vertices > kMaxPositions || max_triangles == 0) return 0;
-  const size_t render = render_workspace_size(render_config(cfg, max_vertices));
+  const size_t render = render_workspace_size(render_config(cfg, max_vertices, max_triangles));
   if (render == 0) return 0;
   // Positions (12), colours (4) per vertex, three uint16 indices per
   // triangle, and alignment padding for each array.
@@ -53,7 +55,7 @@ Status ModelView::init(const ModelViewConfig& cfg, Arena& arena, uint32_t max_ve
   colors_ = arena.alloc_array<uint32_t>(max_vertices);
   indices_ = arena.alloc_array<uint16_t>(size_t{3} * max_triangles);
   if (!positions_ || !colors_ || !indices_) return Status::workspace_too_small;
-  const Status s = renderer_.init(render_config(cfg, max_vertices), arena);
+  const Status s = renderer_.init(render_config(cfg, max_vertices, max_triangles), arena);
   if (s != Status::ok) return s;
   cap_v_ = max_vertices;
   cap_t_ = max_triangles;

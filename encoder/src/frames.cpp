@@ -125,7 +125,6 @@ bool start_model(Replay& r, const StreamHeader& h) {
   vc.width = h.width;
   vc.height = h.height;
   vc.band_height = 16;
-  vc.vertex_cache = h.max_vertices;  // any cache size gives the same picture
   if (r.view.init(vc, *r.arena, h.max_vertices, h.max_triangles) != Status::ok) return false;
   r.model = true;
   return true;

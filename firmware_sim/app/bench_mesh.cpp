@@ -3,8 +3,11 @@
 // default the golden test stream), decodes each through the stream parser
 // and the mesh decoder, counts the instructions the mesh decoder spends on
 // the base and per level, and prints a checksum of the mesh after every
-// level. The host board and the Cortex-M4 board must print the same
-// "check" lines (ctest); bench/run_mesh.sh reads the "count" lines.
+// level. After the base and every level it also draws the model as the
+// client does (vds::ModelView, 240x180, the client's orbit step) and counts
+// those instructions apart. The host board and the Cortex-M4 board must
+// print the same "check" lines, mesh and frame checksums (ctest);
+// bench/run_mesh_m4.sh reads the "count" lines.
 #include <cstddef>
 #include <cstdint>
 
@@ -14,6 +17,7 @@
 #include "vds/container.h"
 #include "vds/crc32c.h"
 #include "vds/mesh.h"
+#include "vds/model_view.h"
 
 #ifndef VDS_APP_WORKSPACE_MAX
 #error "VDS_APP_WORKSPACE_MAX (the largest workspace this build can use) must be set by the build"
@@ -27,6 +31,8 @@ namespace board = vds::board;
 
 constexpr uint32_t kChunkBytes = 16384;  // the largest chunk payload accepted
 constexpr uint32_t kReadBytes = 4096;     // file bytes fed to the parser at a time
+constexpr uint16_t kFrameWidth = 240, kFrameHeight = 180;
+constexpr uint16_t kOrbitStep = 65536 / 64;    // as the client firmware
 
 alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
 uint8_t g_read[kReadBytes];
@@ -40,6 +46,14 @@ struct Run {
   uint64_t base_instructions = 0;
   uint32_t base_vertices = 0;
   uint32_t levels = 0;
+  // The model view.
+  vds::ModelView view;
+  bool view_ready = false;
+  size_t view_bytes = 0;
+  uint32_t frames = 0;
+  uint64_t draw_instructions = 0;  // all frames
+  uint64_t last_draw = 0;          // the last frame (the whole model)
+  uint32_t frame_crc = 0;
 };
 
 Run g_run;
@@ -54,7 +68,35 @@ vds::Arena g_arena;
 
 bool on_header(void*, const vds::StreamHeader& h) {
   g_run.init_status = g_run.decoder.init(g_arena, h.max_vertices, h.max_triangles);
-  return g_run.init_status == Status::ok;
+  if (g_run.init_status != Status::ok) return false;
+  vds::ModelViewConfig vc;
+  vc.width = kFrameWidth;
+  vc.height = kFrameHeight;
+  const size_t mark = g_arena.mark();
+  g_run.view_ready = g_run.view.init(vc, g_arena, h.max_vertices, h.max_triangles) == Status::ok;
+  g_run.view_bytes = g_arena.mark() - mark;
+  if (!g_run.view_ready) board::log("info: the model view does not fit: decoding only\n");
+  return true;
+}
+
+bool on_frame_band(void*, const vds::Band& b) {
+  for (uint16_t row = 0; row < b.height; ++row)
+    g_run.frame_crc = vds::crc32c_update(g_run.frame_crc, b.pixels + row * b.stride, static_cast<size_t>(b.width) * 2);
+  return true;
+}
+
+// Draws the current mesh as the client would and prints the frame's CRC.
+void draw_frame(uint32_t level) {
+  if (!g_run.view_ready) return;
+  g_run.frame_crc = 0;
+  const uint16_t angle = static_cast<uint16_t>(g_run.frames * kOrbitStep);
+  const uint64_t t0 = board::instructions();
+  const Status s = g_run.view.draw(g_run.decoder.mesh(), angle, on_frame_band, nullptr);
+  g_run.last_draw = board::instructions() - t0;
+  g_run.draw_instructions += g_run.last_draw;
+  ++g_run.frames;
+  board::log(Line().str("check frame level=").dec(level).str(" status=").str(vds::status_name(s)).str(" crc=0x")
+                 .hex32(g_run.frame_crc).str("\n").c_str());
 }
 
 vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t size) {
@@ -78,6 +120,7 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
     g_run.level_vertices = m.vertex_count();
     board::log(Line().str("check level=0 vertices=").dec(m.vertex_count()).str(" triangles=").dec(m.triangle_count())
                    .str(" hash=0x").hex32(mesh_hash(m)).str("\n").c_str());
+    draw_frame(0);
   } else if (g_run.decoder.levels_done() != levels_before) {
     const uint32_t splits = m.vertex_count() - g_run.level_vertices;
     Line l;
@@ -88,6 +131,7 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
     c.str("count level=").dec(g_run.decoder.levels_done()).str(" splits=").dec(splits);
     c.str(" instructions=").dec(g_run.level_instructions).str("\n");
     board::log(c.c_str());
+    draw_frame(g_run.decoder.levels_done());
     g_run.level_instructions = 0;
     g_run.level_vertices = m.vertex_count();
     ++g_run.levels;
@@ -129,8 +173,14 @@ bool run_file(const char* path, int* failures) {
   Line l;
   l.str("m4 stream=").str(base).str(" status=").str(vds::status_name(s)).str(" vertices=").dec(m.vertex_count());
   l.str(" splits=").dec(splits).str(" levels=").dec(g_run.levels).str(" instructions=").dec(g_run.instructions);
-  l.str(" base_instructions=").dec(g_run.base_instructions).str(" workspace=").dec(g_arena.high_water()).str("\n");
+  l.str(" base_instructions=").dec(g_run.base_instructions);
+  l.str(" workspace=").dec(g_arena.high_water() - g_run.view_bytes).str("\n");
   board::log(l.c_str());
+  Line v;
+  v.str("m4 view stream=").str(base).str(" triangles=").dec(m.triangle_count()).str(" view_workspace=").dec(g_run.view_bytes);
+  v.str(" frames=").dec(g_run.frames);
+  v.str(" draw_instructions=").dec(g_run.draw_instructions).str(" last_draw=").dec(g_run.last_draw).str("\n");
+  board::log(v.c_str());
   if (s != Status::ok || !g_run.decoder.complete()) ++*failures;
   return true;
 }

@@ -38,7 +38,6 @@ constexpr uint32_t kStatsPeriodMs = 1000;   // statistics datagram
 constexpr uint32_t kPendingRecords = 8;     // frame records waiting for the checksums channel
 constexpr size_t kStreamReadBytes = 256;    // stream bytes handed to the parser at a time
 constexpr uint32_t kDrainTimeoutMs = 20000;  // after the end, wait this long for the host's acks
-constexpr uint32_t kModelVertexCache = 1024;  // projected vertices the model view keeps (13 bytes each)
 constexpr uint16_t kModelOrbitStep = 65536 / 64;  // the model turns 1/64 turn per frame
 
 alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
@@ -160,7 +159,6 @@ bool start_model(const vds::StreamHeader& h) {
   vc.width = h.width;
   vc.height = h.height;
   vc.band_height = kBandRows;
-  vc.vertex_cache = kModelVertexCache;
   s = g.view.init(vc, g.arena, h.max_vertices, h.max_triangles);
   if (s != Status::ok) {
     Line l;

@@ -26,9 +26,14 @@ struct ModelViewConfig {
   uint16_t width = 0;   // frame size, pixels (1..2048)
   uint16_t height = 0;
   uint16_t band_height = 16;
-  // Projected vertices the renderer keeps per frame (13 bytes each); fewer
-  // cost time, never change the picture.
-  uint32_t vertex_cache = 0;
+  // The renderer's caches (RenderConfig), clamped to the mesh's counts:
+  // projected vertices (13 bytes each), triangles' band ranges (4 bytes
+  // each) and set-ups kept across bands. Smaller ones cost time — without
+  // the first two every band re-tests and re-projects the whole mesh —
+  // and never change the picture.
+  uint32_t vertex_cache = UINT32_MAX;
+  uint32_t triangle_cache = UINT32_MAX;
+  uint32_t setup_cache = 16;
   uint32_t surface_rgb = 0xD8C8A8;    // 0x00RRGGBB at full light
   uint32_t background_rgb = 0x182028;
 };
