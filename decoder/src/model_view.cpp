@@ -14,8 +14,8 @@ constexpr uint32_t kElevation = 238609294u;                // 20 degrees in 2^-3
 // Direction to the light in camera space (x right, y down, z forward), Q15:
 // to the left, above and toward the viewer; about unit length.
 constexpr int32_t kLightCam[3] = {-14746, -18022, -22938};
-constexpr int32_t kAmbientQ8 = 56;   // intensity without light, of 256
-constexpr int32_t kDiffuseQ8 = 200;  // added at normal incidence
+constexpr uint32_t kAmbientQ8 = 56;   // intensity without light, of 256
+constexpr uint32_t kDiffuseQ8 = 200;  // added at normal incidence
 
 int32_t mul_q30(int32_t a, int32_t b) {
   return static_cast<int32_t>((int64_t{a} * b + (int64_t{1} << 29)) >> 30);
@@ -102,48 +102,52 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
         30);
 
   // Vertex normals: the sum of the adjacent faces' cross products, each
-  // scaled to at most 2^21 per component so a fan of up to 64 faces (the
-  // decoder's degree limit) stays far inside int32; accumulated in the
-  // positions array, which is filled with positions afterwards.
+  // brought to at most 2^21 per component (an arithmetic shift by
+  // 2 (bits - 10)); the decoder refuses rings of more than 64 faces
+  // (kMeshMaxDegree), so a sum stays below 2^27. They are accumulated in
+  // the positions array, which is filled with positions afterwards.
   const int shift = bits > 10 ? 2 * (bits - 10) : 0;
   int32_t* acc = reinterpret_cast<int32_t*>(positions_);
   for (uint32_t i = 0; i < 3 * nv; ++i) acc[i] = 0;
   for (uint32_t t = 0; t < nt; ++t) {
     const uint32_t* c = tri + 3 * t;
     if (c[0] >= nv || c[1] >= nv || c[2] >= nv) return Status::invalid_argument;
-    int64_t e1[3], e2[3];
-    for (int a = 0; a < 3; ++a) {
-      e1[a] = int64_t{pos[3 * c[1] + a]} - pos[3 * c[0] + a];
-      e2[a] = int64_t{pos[3 * c[2] + a]} - pos[3 * c[0] + a];
-    }
-    const int64_t n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
-    for (int a = 0; a < 3; ++a) {
-      const int32_t v = static_cast<int32_t>(n[a] / (int64_t{1} << shift));
-      for (int k = 0; k < 3; ++k) {
-        int32_t& s = acc[3 * c[k] + a];
-        // Saturate rather than wrap if a vertex has more faces than the limit.
-        const int64_t sum = int64_t{s} + v;
-        s = sum > INT32_MAX / 2 ? INT32_MAX / 2 : (sum < -(INT32_MAX / 2) ? -(INT32_MAX / 2) : static_cast<int32_t>(sum));
-      }
+    const uint16_t* p0 = pos + 3 * c[0];
+    const uint16_t* p1 = pos + 3 * c[1];
+    const uint16_t* p2 = pos + 3 * c[2];
+    const int32_t e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
+    const int32_t e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
+    const int32_t n[3] = {
+        static_cast<int32_t>((int64_t{e1[1]} * e2[2] - int64_t{e1[2]} * e2[1]) >> shift),
+        static_cast<int32_t>((int64_t{e1[2]} * e2[0] - int64_t{e1[0]} * e2[2]) >> shift),
+        static_cast<int32_t>((int64_t{e1[0]} * e2[1] - int64_t{e1[1]} * e2[0]) >> shift)};
+    for (int k = 0; k < 3; ++k) {
+      int32_t* a = acc + 3 * c[k];
+      a[0] += n[0];
+      a[1] += n[1];
+      a[2] += n[2];
     }
   }
   const uint32_t base_rgb[3] = {(cfg_.surface_rgb >> 16) & 255, (cfg_.surface_rgb >> 8) & 255, cfg_.surface_rgb & 255};
   for (uint32_t v = 0; v < nv; ++v) {
     int32_t n[3] = {acc[3 * v], acc[3 * v + 1], acc[3 * v + 2]};
-    // Down to 15 bits per component so the squared length fits 32 bits... and 64.
-    while (abs32(n[0]) >= 32768 || abs32(n[1]) >= 32768 || abs32(n[2]) >= 32768)
-      for (int32_t& x : n) x /= 2;
-    const uint64_t len2 = static_cast<uint64_t>(int64_t{n[0]} * n[0] + int64_t{n[1]} * n[1] + int64_t{n[2]} * n[2]);
-    int32_t intensity = kAmbientQ8;
-    if (len2 != 0) {
-      const int64_t len = static_cast<int64_t>(isqrt64(len2));
+    // Down to 15 bits a component (arithmetic shift), so the squared length
+    // fits 32 bits and |n . l| <= |n| 2^15 (Cauchy-Schwarz) fits after >> 15.
+    const uint32_t m = static_cast<uint32_t>(abs32(n[0]) | abs32(n[1]) | abs32(n[2]));
+    const int down = m >= 32768 ? 17 - __builtin_clz(m) : 0;
+    for (int32_t& x : n) x >>= down;
+    const uint32_t len = isqrt32(static_cast<uint32_t>(n[0] * n[0]) + static_cast<uint32_t>(n[1] * n[1]) +
+                                 static_cast<uint32_t>(n[2] * n[2]));
+    uint32_t intensity = kAmbientQ8;
+    if (len != 0) {
       int64_t dot = int64_t{n[0]} * light[0] + int64_t{n[1]} * light[1] + int64_t{n[2]} * light[2];
       if (dot < 0) dot = -dot;  // two-sided: orientation of the input is not assumed
-      if (len > 0) intensity += static_cast<int32_t>((dot * kDiffuseQ8) / (len * 32768));
+      const uint32_t cosine = static_cast<uint32_t>(dot >> 15);  // |n| cos, <= len
+      intensity += (cosine * kDiffuseQ8) / len;
     }
     uint32_t rgb = 0;
     for (int k = 0; k < 3; ++k) {
-      uint32_t ch = (base_rgb[k] * static_cast<uint32_t>(intensity)) >> 8;
+      uint32_t ch = (base_rgb[k] * intensity) >> 8;
       if (ch > 255) ch = 255;
       rgb = (rgb << 8) | ch;
     }
