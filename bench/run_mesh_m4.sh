@@ -74,7 +74,7 @@ L = ["# Progressive mesh decoding on the Cortex-M4 board", "",
      f"Produced by `bench/run_mesh_m4.sh build/host-release` on {datetime.date.today()}. {sys.argv[4]}, "
      "`-M mps2-an386 -cpu cortex-m4 -icount shift=0`; firmware `vds_fw_bench_mesh` (arm-none-eabi-g++ -O2, "
      "the Release Cortex-M4 sub-build, 4 MiB RAM linker script). Streams written by `vds encode-mesh IN --bits B` "
-     "(vds: arithmetic coding, parallelogram predictor) and `vds encode-mesh IN --bits B --paper` (Huffman, "
+     "(vds: arithmetic coding, area predictor) and `vds encode-mesh IN --bits B --paper` (Huffman, "
      "Laplacian predictor) from glmark2-data's models. Instructions are counted inside `MeshDecoder::consume` "
      "(chunk parsing and CRC checks excluded). The same firmware on the host board printed the same mesh "
      "checksum after every level.", "",

@@ -247,7 +247,7 @@ int main(int argc, char** argv) {
       row.workspace = r.stream_header.workspace_bytes;
       row.chunk = r.stream_header.max_chunk_payload;
       row.workspace_per_vertex = double(row.workspace + row.chunk) / double(row.vertices);
-      md_levels += fmt("### %s, %d bits — vds (arithmetic coder, parallelogram predictor)\n\n```\n", name.c_str(), bits) +
+      md_levels += fmt("### %s, %d bits — vds (arithmetic coder, area predictor)\n\n```\n", name.c_str(), bits) +
                    format_mesh_table(r.levels, r.stream.size()) + "```\n\n";
       md_levels += fmt("### %s, %d bits — the paper's coding (Huffman, Laplacian predictor, eq. 1 priority)\n\n```\n",
                        name.c_str(), bits) +

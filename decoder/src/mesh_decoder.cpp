@@ -74,7 +74,7 @@ Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out) 
   MeshHeader h;
   h.version = p[0];
   if (h.version != kMeshCodecVersion) return Status::unsupported_version;
-  if (p[1] > static_cast<uint8_t>(MeshCoder::arith) || p[2] > static_cast<uint8_t>(MeshPredictor::parallelogram))
+  if (p[1] > static_cast<uint8_t>(MeshCoder::arith) || p[2] > static_cast<uint8_t>(MeshPredictor::area))
     return Status::unsupported_feature;
   h.coder = static_cast<MeshCoder>(p[1]);
   h.predictor = static_cast<MeshPredictor>(p[2]);

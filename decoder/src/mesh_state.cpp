@@ -312,6 +312,52 @@ Status MeshState::split(uint32_t u, const SplitChoice& ch, uint32_t* new_vertex)
   return Status::ok;
 }
 
+// The area centroid of an interior ring in Q8: the fan of triangles
+// (c, r_j, r_j+1) around the vertex centroid c = s / d, each weighted by
+// its area (the largest component of the cross product, which does as well
+// as its length and needs no square root) at its centroid. With
+// A_j = d r_j - s (exact), triangle j's centroid is c + (A_j + A_j+1) / 3d
+// and its weight |A_j x A_j+1| / d^2; the weights are shifted down to at
+// most 2^20 so every sum below fits 64 bits. false for a boundary ring or a
+// flat fan (the caller then uses c).
+bool MeshState::area_centroid_q8(const Ring& r, const int64_t s[3], int64_t out[3]) const {
+  const uint32_t d = r.degree;
+  if (r.boundary || d < 3) return false;
+  int64_t wgt[kMeshMaxDegree + 1];
+  int64_t biggest = 0;
+  for (uint32_t j = 0; j < d; ++j) {
+    const uint16_t* p0 = pos_ + 3 * r.vertex[j];
+    const uint16_t* p1 = pos_ + 3 * r.vertex[(j + 1) % d];
+    int64_t a0[3], a1[3];
+    for (int k = 0; k < 3; ++k) {
+      a0[k] = int64_t{d} * p0[k] - s[k];
+      a1[k] = int64_t{d} * p1[k] - s[k];
+    }
+    int64_t c0 = a0[1] * a1[2] - a0[2] * a1[1], c1 = a0[2] * a1[0] - a0[0] * a1[2], c2 = a0[0] * a1[1] - a0[1] * a1[0];
+    if (c0 < 0) c0 = -c0;
+    if (c1 < 0) c1 = -c1;
+    if (c2 < 0) c2 = -c2;
+    wgt[j] = c0 > c1 ? (c0 > c2 ? c0 : c2) : (c1 > c2 ? c1 : c2);
+    if (wgt[j] > biggest) biggest = wgt[j];
+  }
+  if (biggest == 0) return false;
+  int shift = 0;
+  while ((biggest >> shift) >= (int64_t{1} << 20)) ++shift;
+  int64_t sum_w = 0, num[3] = {0, 0, 0};
+  for (uint32_t j = 0; j < d; ++j) {
+    const int64_t w = wgt[j] >> shift;
+    sum_w += w;
+    const uint16_t* p0 = pos_ + 3 * r.vertex[j];
+    const uint16_t* p1 = pos_ + 3 * r.vertex[(j + 1) % d];
+    for (int k = 0; k < 3; ++k) num[k] += w * (int64_t{d} * (int64_t{p0[k]} + p1[k]) - 2 * s[k]);
+  }
+  if (sum_w == 0) return false;
+  // a = s / d + num / (3 d sum_w) = (3 sum_w s + num) / (3 d sum_w), in Q8.
+  const int64_t den = 3 * int64_t{d} * sum_w;
+  for (int k = 0; k < 3; ++k) out[k] = div_round((3 * sum_w * s[k] + num[k]) * 256, den);
+  return true;
+}
+
 Status MeshState::predict(uint32_t v, MeshPredictor predictor, int weight_q4, int32_t out[3]) {
   Ring r;
   Status st = ring(v, &r, 0);
@@ -359,6 +405,15 @@ Status MeshState::predict(uint32_t v, MeshPredictor predictor, int weight_q4, in
       ++m;
     }
     const int64_t w = weight_q4 < 0 ? 0 : (weight_q4 > 16 ? 16 : weight_q4);
+    int64_t area_q8[3];
+    if (predictor == MeshPredictor::area && area_centroid_q8(r, s, area_q8)) {
+      // a + w (p - a): ((16 - w) a m + w p) / (16 m), a in Q8.
+      for (int a = 0; a < 3; ++a) {
+        const int64_t num = ((int64_t{1} << kWeightFracBits) - w) * area_q8[a] * m + w * (p[a] << 8);
+        pred[a] = m == 0 ? div_round(area_q8[a], int64_t{1} << 8)
+                         : div_round(num, (int64_t{m} << kWeightFracBits) << 8);
+      }
+    } else {
     for (int a = 0; a < 3; ++a) {
       if (m == 0 || w == 0) {
         pred[a] = div_round(s[a], d);
@@ -367,6 +422,7 @@ Status MeshState::predict(uint32_t v, MeshPredictor predictor, int weight_q4, in
         const int64_t num = ((int64_t{1} << kWeightFracBits) - w) * s[a] * m + w * p[a] * d;
         pred[a] = div_round(num, (int64_t{d} * m) << kWeightFracBits);
       }
+    }
     }
   }
   const int64_t top = (int64_t{1} << bits_) - 1;

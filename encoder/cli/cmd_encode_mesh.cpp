@@ -21,7 +21,7 @@ struct EncodeMeshOptions {
   int bits = 10;
   int levels = 0;
   std::string coder = "arith";
-  std::string predictor = "parallelogram";
+  std::string predictor = "area";
   bool paper = false;
   double max_error = -1;
   double removal_ratio = -1;
@@ -44,10 +44,12 @@ void run_encode_mesh(const EncodeMeshOptions& o) {
       throw Failure(kExitUsage, "--coder must be arith or huffman, not '" + o.coder + "'");
     if (o.predictor == "parallelogram")
       e.predictor = MeshPredictor::parallelogram;
+    else if (o.predictor == "area")
+      e.predictor = MeshPredictor::area;
     else if (o.predictor == "laplacian")
       e.predictor = MeshPredictor::laplacian;
     else
-      throw Failure(kExitUsage, "--predictor must be parallelogram or laplacian, not '" + o.predictor + "'");
+      throw Failure(kExitUsage, "--predictor must be area, parallelogram or laplacian, not '" + o.predictor + "'");
   }
   if (o.levels > 0) e.simplify.max_levels = o.levels;
   if (o.max_error > 0) e.simplify.max_error = o.max_error;
@@ -75,7 +77,7 @@ void run_encode_mesh(const EncodeMeshOptions& o) {
   std::printf("%s", report.summary().c_str());
   std::printf("%s: %zu bytes, %u-bit grid, %s coder, %s predictor, base %u vertices (%.2f %%), %zu levels\n",
               o.output.c_str(), r.stream.size(), e.bits, e.coder == MeshCoder::arith ? "arithmetic" : "Huffman",
-              e.predictor == MeshPredictor::laplacian ? "Laplacian" : "parallelogram", r.mesh_header.base_vertices,
+              vds::enc::mesh_predictor_name(e.predictor), r.mesh_header.base_vertices,
               100.0 * r.mesh_header.base_vertices / r.mesh_header.vertices, r.levels.size() - 1);
   std::printf("%s", enc::format_mesh_table(r.levels, r.stream.size()).c_str());
   const double nv = r.mesh_header.vertices;
@@ -100,7 +102,7 @@ void add_encode_mesh(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sub->add_option("--coder", o->coder, "arith (context-adaptive arithmetic) or huffman (the paper's)")
       ->capture_default_str();
-  sub->add_option("--predictor", o->predictor, "parallelogram or laplacian (the paper's eq. 13)")
+  sub->add_option("--predictor", o->predictor, "area (the ring's area centroid) or parallelogram (its vertex centroid), moved toward the parallelogram predictions by a per-level weight; or laplacian (the paper's eq. 13)")
       ->capture_default_str();
   sub->add_flag("--paper", o->paper,
                 "The paper's choices throughout: Huffman, Laplacian predictor, priority of eq. 1 only");

@@ -498,7 +498,7 @@ void Encoder::trace_level(const SimplifyLevel& lvl, uint32_t level_index, Segmen
     } else {
       for (const int w : weights) {
         int32_t p[3];
-        if (st_.predict(v, MeshPredictor::parallelogram, w, p) != Status::ok)
+        if (st_.predict(v, opt_.predictor, w, p) != Status::ok)
           throw std::logic_error("predict failed");
         g.pred.push_back({p[0], p[1], p[2]});
       }
@@ -510,7 +510,7 @@ void Encoder::trace_level(const SimplifyLevel& lvl, uint32_t level_index, Segmen
 
   // Weight: the one with the smallest sum of |correction| over the level.
   size_t wi = 0;
-  if (opt_.predictor == MeshPredictor::parallelogram && opt_.weight_q4 < 0) {
+  if (opt_.predictor != MeshPredictor::laplacian && opt_.weight_q4 < 0) {
     uint64_t best = UINT64_MAX;
     for (size_t w = 0; w < weights.size(); ++w) {
       uint64_t sum = 0;
@@ -523,7 +523,7 @@ void Encoder::trace_level(const SimplifyLevel& lvl, uint32_t level_index, Segmen
     }
     seg.weight_q4 = weights[wi];
   } else {
-    seg.weight_q4 = opt_.predictor == MeshPredictor::parallelogram ? opt_.weight_q4 : 0;
+    seg.weight_q4 = opt_.predictor != MeshPredictor::laplacian ? opt_.weight_q4 : 0;
   }
   // Geometry ops per split item (the conn ops of pass B are already in
   // place item by item; the geometry substream is separate, so its ops can
@@ -656,9 +656,7 @@ MeshEncodeResult Encoder::run() {
   MeshEncodeResult res;
   quant_ = make_quantisation(mesh_bounds(mesh_), opt_.bits);
   q_ = quantise(mesh_, quant_);
-  SimplifyOptions so = opt_.simplify;
-  so.max_degree = std::min<int>(so.max_degree, static_cast<int>(kMeshMaxDegree) - 2);
-  const SimplifyResult sr = simplify_progressive(q_, mesh_.triangles, so);
+  const SimplifyResult sr = simplify_progressive(q_, mesh_.triangles, mesh_simplify_options(opt_));
   const uint32_t nv = static_cast<uint32_t>(mesh_.positions.size());
   const uint32_t nt = static_cast<uint32_t>(mesh_.triangles.size());
   workspace_.assign(MeshState::workspace_bytes(nv, nt) + 12 * size_t{nt} + 256, 0);
@@ -787,6 +785,22 @@ uint64_t mesh_checksum(const MeshState& m) {
   return h;
 }
 
+SimplifyOptions mesh_simplify_options(const MeshEncodeOptions& o) {
+  SimplifyOptions so = o.simplify;
+  so.max_degree = std::min<int>(so.max_degree, static_cast<int>(kMeshMaxDegree) - 2);
+  so.area_centroid = o.predictor == MeshPredictor::area;
+  return so;
+}
+
+const char* mesh_predictor_name(MeshPredictor p) {
+  switch (p) {
+    case MeshPredictor::laplacian: return "Laplacian";
+    case MeshPredictor::parallelogram: return "parallelogram";
+    case MeshPredictor::area: return "area";
+  }
+  return "unknown";
+}
+
 MeshEncodeOptions paper_mesh_options() {
   MeshEncodeOptions o;
   o.coder = MeshCoder::huffman;
@@ -903,7 +917,7 @@ std::string MeshChunkSummary::table() const {
   char line[200];
   std::snprintf(line, sizeof line, "progressive mesh: %u-bit grid, %s coder, %s predictor, %u levels, max degree %u\n",
                 header_.bits, header_.coder == MeshCoder::arith ? "arithmetic" : "Huffman",
-                header_.predictor == MeshPredictor::laplacian ? "Laplacian" : "parallelogram", header_.levels,
+                mesh_predictor_name(header_.predictor), header_.levels,
                 header_.max_degree);
   uint64_t bytes = 0;
   for (const MeshLevelStats& r : rows) bytes += r.chunk_bytes;

@@ -150,7 +150,7 @@ class Simplifier {
   }
 
   double priority(uint32_t v) {
-    ring(v, ring_tmp_);
+    const bool on_boundary = ring(v, ring_tmp_);
     double mn = INFINITY, mx = 0;
     for (uint32_t w : ring_tmp_) {
       const double e = norm(sub(P_[w], P_[v]));
@@ -163,11 +163,31 @@ class Simplifier {
       for (size_t j = 0; j < ring_tmp_.size(); ++j)
         for (int k = 0; k < 3; ++k) c[k] += P_[ring_tmp_[j]][k];
       for (int k = 0; k < 3; ++k) c[k] /= double(ring_tmp_.size());
-      // v's distance from its ring centroid is what coding v costs at this
-      // level (the client predicts it there): cheap vertices go first.
+      if (opt_.area_centroid && !on_boundary) c = area_centroid(c);
+      // v's distance from where the client will predict it is what coding
+      // v costs at this level: cheap vertices go first.
       pr += opt_.rate_weight * norm(sub(P_[v], c));
     }
     return pr;
+  }
+
+  // The area centroid of the closed ring in ring_tmp_ (fan around its
+  // vertex centroid c), as the client's area predictor places v.
+  Vec area_centroid(const Vec& c) {
+    Vec acc{0, 0, 0};
+    double total = 0;
+    const size_t d = ring_tmp_.size();
+    for (size_t j = 0; j < d; ++j) {
+      const Vec& a = P_[ring_tmp_[j]];
+      const Vec& b = P_[ring_tmp_[(j + 1) % d]];
+      const Vec x = cross(sub(a, c), sub(b, c));
+      const double w = std::max({std::fabs(x[0]), std::fabs(x[1]), std::fabs(x[2])});
+      total += w;
+      for (int k = 0; k < 3; ++k) acc[k] += w * (a[k] + b[k] + c[k]) / 3;
+    }
+    if (total <= 0) return c;
+    for (int k = 0; k < 3; ++k) acc[k] /= total;
+    return acc;
   }
 
   // Cone volume of collapsing v onto its ring vertex at index k (eq. 2).

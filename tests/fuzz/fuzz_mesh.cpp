@@ -120,7 +120,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const int nx = 3 + data[0] % 6, ny = 3 + (data[0] >> 4) % 6;
     vds::enc::MeshEncodeOptions o;
     o.coder = (data[1] & 1) ? vds::MeshCoder::huffman : vds::MeshCoder::arith;
-    o.predictor = (data[1] & 2) ? vds::MeshPredictor::laplacian : vds::MeshPredictor::parallelogram;
+    o.predictor = (data[1] & 2) ? vds::MeshPredictor::laplacian
+                                : ((data[1] & 0x80) ? vds::MeshPredictor::parallelogram : vds::MeshPredictor::area);
     o.bits = 4 + (data[1] >> 2) % 13;
     const vds::enc::Mesh m = grid(nx, ny, data + 2, size > 2 ? size - 2 : 0);
     vds::enc::MeshEncodeResult r;

@@ -56,6 +56,7 @@ enum class MeshCoder : uint8_t {
 enum class MeshPredictor : uint8_t {
   laplacian = 0,      // the paper's eq. 13: w = 1/m Σ (u_j + L(u_j))
   parallelogram = 1,  // ring centroid moved toward the mean parallelogram prediction by a per-level weight
+  area = 2,           // the same with the ring's area centroid in place of its vertex centroid
 };
 
 // MSHH payload (docs/stream-format.md).
@@ -166,6 +167,8 @@ class MeshState {
   void face_llr(const Ring& r, uint32_t u, int32_t* llr) const;
 
   uint32_t max_degree() const { return max_degree_; }
+  // The area predictor's base point (docs/mesh-codec.md); s = sum of the ring.
+  bool area_centroid_q8(const Ring& r, const int64_t s[3], int64_t out[3]) const;
   // Largest ring seen by ring() since clear() (the encoder declares it).
   uint32_t max_degree_seen() const { return max_degree_seen_; }
 

@@ -25,7 +25,7 @@ struct MeshEncodeOptions {
   }
   int bits = 10;  // quantisation bits per axis, 2..16
   MeshCoder coder = MeshCoder::arith;
-  MeshPredictor predictor = MeshPredictor::parallelogram;
+  MeshPredictor predictor = MeshPredictor::area;
   // Parallelogram weight in sixteenths; -1 picks the best per level.
   int weight_q4 = -1;
   SimplifyOptions simplify;
@@ -39,6 +39,14 @@ struct MeshEncodeOptions {
 // predictor, add the prediction residual to the priority and visit the
 // vertices of a level so that its independent sets come out larger.
 MeshEncodeOptions paper_mesh_options();
+
+// The simplification encode_mesh runs for `o`: o.simplify with the degree
+// limit the client can hold, and the priority's rate term measured from
+// where the chosen predictor places a vertex.
+SimplifyOptions mesh_simplify_options(const MeshEncodeOptions& o);
+
+// "Laplacian", "parallelogram" or "area", for tables and messages.
+const char* mesh_predictor_name(MeshPredictor p);
 
 // One row of the per-level table; row 0 is the base mesh.
 struct MeshLevelStats {

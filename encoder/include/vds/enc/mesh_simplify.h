@@ -46,6 +46,7 @@ struct SimplifyOptions {
   double alpha = 1.0;          // weight of the shortest edge in the priority (paper: 1.0)
   double beta = 0.01;          // weight of the longest edge (paper: 0.01)
   double rate_weight = 0;      // weight of the prediction residual |v - centroid(ring)| (0: the paper's priority)
+  bool area_centroid = false;  // the residual from the ring's area centroid (the area predictor's base point)
   double packing_weight = 0;   // visiting order: priority rank + this per unlocked neighbour (0: by priority)
   double removal_ratio = 0.2;  // R: minimum fraction of a level's vertices removed (paper: 1/5..1/4)
   double max_error = 0.1;      // E as a fraction of the bounding-box diagonal
