@@ -162,8 +162,9 @@ bool start_model(const vds::StreamHeader& h) {
   s = g.view.init(vc, g.arena, h.max_vertices, h.max_triangles);
   if (s != Status::ok) {
     Line l;
-    l.str("client: model view: ").str(vds::status_name(s)).str(" (needs ");
-    l.dec(vds::ModelView::workspace_bytes(vc, h.max_vertices, h.max_triangles)).str(" bytes more)\n");
+    l.str("client: model view: ").str(vds::status_name(s)).str(": it needs ");
+    l.dec(vds::ModelView::workspace_bytes(vc, h.max_vertices, h.max_triangles)).str(" bytes, ");
+    l.dec(g.arena.remaining()).str(" are left after the mesh decoder\n");
     board::log(l.c_str());
     return false;
   }
