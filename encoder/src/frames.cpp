@@ -80,7 +80,7 @@ struct Replay {
   MeshDecoder mesh;  // model streams
   ModelView view;
   bool model = false;
-  uint32_t levels_drawn = 0;
+  ModelFrames shown;
   Arena* arena = nullptr;
   std::vector<uint16_t> band;
   uint16_t width = 0, height = 0;
@@ -114,11 +114,8 @@ bool on_render_band(void* ctx, const Band& b) {
   return on_band(ctx, PixelRect{0, b.y, b.width, b.height, b.pixels, static_cast<ptrdiff_t>(b.stride)});
 }
 
-// The client firmware's model path (firmware_sim/app/client.cpp): the mesh
-// is drawn once its base is in and after every completed level, the camera
-// turning kModelOrbitStep per frame.
-constexpr uint16_t kModelOrbitStep = 65536 / 64;
-
+// The client firmware's model path (firmware_sim/app/client.cpp), frames
+// drawn by the same rule (vds::ModelFrames).
 bool start_model(Replay& r, const StreamHeader& h) {
   if (r.mesh.init(*r.arena, h.max_vertices, h.max_triangles) != Status::ok) return false;
   ModelViewConfig vc;
@@ -137,12 +134,11 @@ ChunkResult on_model_chunk(Replay& r, uint32_t type, const uint8_t* p, uint32_t 
     r.error = s;
     return ChunkResult::abort;
   }
-  if (r.mesh.drawable() && (r.crcs.empty() || r.mesh.levels_done() > r.levels_drawn)) {
-    r.levels_drawn = r.mesh.levels_done();
+  if (r.shown.due(r.mesh)) {
     r.crc = 0;
     if (r.frames) r.frames->emplace_back(r.width, r.height, 3);
-    const uint16_t angle = static_cast<uint16_t>(r.crcs.size() * kModelOrbitStep);
-    const Status d = r.view.draw(r.mesh.mesh(), angle, on_render_band, &r);
+    const Status d = r.view.draw(r.mesh.mesh(), r.shown.angle(), on_render_band, &r);
+    r.shown.mark_drawn(r.mesh);
     if (d != Status::ok) {
       r.error = d;
       return ChunkResult::abort;

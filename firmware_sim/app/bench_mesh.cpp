@@ -32,7 +32,6 @@ namespace board = vds::board;
 constexpr uint32_t kChunkBytes = 16384;  // the largest chunk payload accepted
 constexpr uint32_t kReadBytes = 4096;     // file bytes fed to the parser at a time
 constexpr uint16_t kFrameWidth = 240, kFrameHeight = 180;
-constexpr uint16_t kOrbitStep = 65536 / 64;    // as the client firmware
 
 alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
 uint8_t g_read[kReadBytes];
@@ -50,7 +49,7 @@ struct Run {
   vds::ModelView view;
   bool view_ready = false;
   size_t view_bytes = 0;
-  uint32_t frames = 0;
+  vds::ModelFrames shown;  // drawn as the client draws
   uint64_t draw_instructions = 0;  // all frames
   uint64_t last_draw = 0;          // the last frame (the whole model)
   uint32_t frame_crc = 0;
@@ -85,18 +84,17 @@ bool on_frame_band(void*, const vds::Band& b) {
   return true;
 }
 
-// Draws the current mesh as the client would and prints the frame's CRC.
-void draw_frame(uint32_t level) {
-  if (!g_run.view_ready) return;
+// Draws the current mesh when the client would and prints the frame's CRC.
+void draw_frame_if_due() {
+  if (!g_run.view_ready || !g_run.shown.due(g_run.decoder)) return;
   g_run.frame_crc = 0;
-  const uint16_t angle = static_cast<uint16_t>(g_run.frames * kOrbitStep);
   const uint64_t t0 = board::instructions();
-  const Status s = g_run.view.draw(g_run.decoder.mesh(), angle, on_frame_band, nullptr);
+  const Status s = g_run.view.draw(g_run.decoder.mesh(), g_run.shown.angle(), on_frame_band, nullptr);
   g_run.last_draw = board::instructions() - t0;
   g_run.draw_instructions += g_run.last_draw;
-  ++g_run.frames;
-  board::log(Line().str("check frame level=").dec(level).str(" status=").str(vds::status_name(s)).str(" crc=0x")
-                 .hex32(g_run.frame_crc).str("\n").c_str());
+  g_run.shown.mark_drawn(g_run.decoder);
+  board::log(Line().str("check frame level=").dec(g_run.decoder.levels_done()).str(" status=").str(vds::status_name(s))
+                 .str(" crc=0x").hex32(g_run.frame_crc).str("\n").c_str());
 }
 
 vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t size) {
@@ -120,7 +118,6 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
     g_run.level_vertices = m.vertex_count();
     board::log(Line().str("check level=0 vertices=").dec(m.vertex_count()).str(" triangles=").dec(m.triangle_count())
                    .str(" hash=0x").hex32(mesh_hash(m)).str("\n").c_str());
-    draw_frame(0);
   } else if (g_run.decoder.levels_done() != levels_before) {
     const uint32_t splits = m.vertex_count() - g_run.level_vertices;
     Line l;
@@ -131,11 +128,11 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
     c.str("count level=").dec(g_run.decoder.levels_done()).str(" splits=").dec(splits);
     c.str(" instructions=").dec(g_run.level_instructions).str("\n");
     board::log(c.c_str());
-    draw_frame(g_run.decoder.levels_done());
     g_run.level_instructions = 0;
     g_run.level_vertices = m.vertex_count();
     ++g_run.levels;
   }
+  draw_frame_if_due();
   return vds::ChunkResult::consumed;
 }
 
@@ -178,7 +175,7 @@ bool run_file(const char* path, int* failures) {
   board::log(l.c_str());
   Line v;
   v.str("m4 view stream=").str(base).str(" triangles=").dec(m.triangle_count()).str(" view_workspace=").dec(g_run.view_bytes);
-  v.str(" frames=").dec(g_run.frames);
+  v.str(" frames=").dec(g_run.shown.drawn);
   v.str(" draw_instructions=").dec(g_run.draw_instructions).str(" last_draw=").dec(g_run.last_draw).str("\n");
   board::log(v.c_str());
   if (s != Status::ok || !g_run.decoder.complete()) ++*failures;

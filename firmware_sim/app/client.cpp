@@ -38,7 +38,6 @@ constexpr uint32_t kStatsPeriodMs = 1000;   // statistics datagram
 constexpr uint32_t kPendingRecords = 8;     // frame records waiting for the checksums channel
 constexpr size_t kStreamReadBytes = 256;    // stream bytes handed to the parser at a time
 constexpr uint32_t kDrainTimeoutMs = 20000;  // after the end, wait this long for the host's acks
-constexpr uint16_t kModelOrbitStep = 65536 / 64;  // the model turns 1/64 turn per frame
 
 alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
 
@@ -51,7 +50,7 @@ struct Client {
   vds::MeshDecoder mesh;
   vds::ModelView view;
   bool model = false;
-  uint32_t model_levels_drawn = 0;  // levels drawn after the base (frames_shown - 1 once the base is drawn)
+  vds::ModelFrames model_frames;
   size_t stream_mark = 0;  // arena mark below the per-stream state
   uint32_t epoch = 0;
 
@@ -169,7 +168,7 @@ bool start_model(const vds::StreamHeader& h) {
     return false;
   }
   g.model = true;
-  g.model_levels_drawn = 0;
+  g.model_frames = vds::ModelFrames{};
   start_frame_counts(g.parse_total);
   return true;
 }
@@ -215,14 +214,13 @@ vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t 
   if (vds::is_error(s)) {
     log_status("mesh", s);
     result = vds::ChunkResult::abort;
-  } else if (g.mesh.drawable() && (g.frames_shown == 0 || g.mesh.levels_done() > g.model_levels_drawn)) {
-    g.model_levels_drawn = g.mesh.levels_done();
+  } else if (g.model_frames.due(g.mesh)) {
     board::display_begin_frame(g.header.width, g.header.height);
     g.in_frame = true;
     g.frame_crc = 0;
-    const uint16_t angle = static_cast<uint16_t>(g.frames_shown * kModelOrbitStep);
     const uint64_t band_before = g.display_total;
-    const Status d = g.view.draw(g.mesh.mesh(), angle, on_render_band, nullptr);
+    const Status d = g.view.draw(g.mesh.mesh(), g.model_frames.angle(), on_render_band, nullptr);
+    g.model_frames.mark_drawn(g.mesh);
     // Drawing counts as display: on_band has added its part, add the renderer's.
     g.display_total += (board::instructions() - t1) - (g.display_total - band_before);
     if (d != Status::ok) {
@@ -272,7 +270,6 @@ Status start_stream() {
   g.have_header = false;
   g.band = nullptr;
   g.model = false;
-  g.model_levels_drawn = 0;
   g.stream_status = Status::more_input;
   g.stream_bytes = 0;
   g.stream_crc = 0;

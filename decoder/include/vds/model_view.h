@@ -65,4 +65,25 @@ class ModelView {
   bool ready_ = false;
 };
 
+// When the model mode draws, for the client firmware, its host replay
+// (`vds frames`) and the mesh benchmark alike: once the base mesh is in and
+// after every level completed since the previous frame, with the camera a
+// further kModelOrbitStep round the model each frame.
+constexpr uint16_t kModelOrbitStep = 65536 / 64;  // 1/64 turn
+
+struct ModelFrames {
+  uint32_t drawn = 0;   // frames drawn so far
+  uint32_t levels = 0;  // levels complete when the last one was drawn
+
+  // True when the decoder holds a mesh no frame has shown yet.
+  bool due(const MeshDecoder& d) const { return d.drawable() && (drawn == 0 || d.levels_done() > levels); }
+  // The orbit angle of the next frame (2^-16 turn).
+  uint16_t angle() const { return static_cast<uint16_t>(drawn * kModelOrbitStep); }
+  // Records that the decoder's current mesh has been drawn.
+  void mark_drawn(const MeshDecoder& d) {
+    ++drawn;
+    levels = d.levels_done();
+  }
+};
+
 }  // namespace vds
