@@ -406,23 +406,20 @@ Status MeshState::predict(uint32_t v, MeshPredictor predictor, int weight_q4, in
     }
     const int64_t w = weight_q4 < 0 ? 0 : (weight_q4 > 16 ? 16 : weight_q4);
     int64_t area_q8[3];
-    if (predictor == MeshPredictor::area && area_centroid_q8(r, s, area_q8)) {
-      // a + w (p - a): ((16 - w) a m + w p) / (16 m), a in Q8.
-      for (int a = 0; a < 3; ++a) {
+    const bool area = predictor == MeshPredictor::area && area_centroid_q8(r, s, area_q8);
+    for (int a = 0; a < 3; ++a) {
+      if (area) {
+        // a + w (p - a): ((16 - w) a m + w p) / (16 m), a in Q8.
         const int64_t num = ((int64_t{1} << kWeightFracBits) - w) * area_q8[a] * m + w * (p[a] << 8);
         pred[a] = m == 0 ? div_round(area_q8[a], int64_t{1} << 8)
                          : div_round(num, (int64_t{m} << kWeightFracBits) << 8);
-      }
-    } else {
-    for (int a = 0; a < 3; ++a) {
-      if (m == 0 || w == 0) {
+      } else if (m == 0 || w == 0) {
         pred[a] = div_round(s[a], d);
       } else {
         // ((16 - w) s / d + w p / m) / 16 over the common denominator 16 d m.
         const int64_t num = ((int64_t{1} << kWeightFracBits) - w) * s[a] * m + w * p[a] * d;
         pred[a] = div_round(num, (int64_t{d} * m) << kWeightFracBits);
       }
-    }
     }
   }
   const int64_t top = (int64_t{1} << bits_) - 1;
