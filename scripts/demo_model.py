@@ -29,10 +29,6 @@ def level_table(info_stdout):
     return rows
 
 
-def frame_times_ms(serve_stdout):
-    return [int(m.group(1)) for m in re.finditer(r"^\s*frame\s+\d+\s+crc\s+\S+.*\sat\s+(\d+)\s+ms", serve_stdout, re.M)]
-
-
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--vds", required=True)
@@ -53,15 +49,15 @@ def main():
         return 1
     info = subprocess.run([a.vds, "info", stream], capture_output=True, text=True, check=True).stdout
     levels = level_table(info)
-    replay = subprocess.run([a.vds, "frames", stream, "--png", os.path.join(a.out, "replay")], capture_output=True,
-                            text=True, check=True)
-    want = replay.stdout.split()
+    want = sim.replay_crcs(a.vds, stream, os.path.join(a.out, "replay"))
+    if want is None:
+        return 1
     # The whole model in the client's workspace: the host board can be given more than a Cortex-M4 holds.
     run = sim.run_host(a.vds, a.host_board, stream, a.baud, a.timeout, os.path.join(a.out, "host"), workspace=8 << 20)
     with open(os.path.join(a.out, "serve.log"), "w") as f:
         f.write(run.serve.stdout + run.serve.stderr + "\n== host-native board\n" + run.board_log)
     got = sim.frame_crcs(run.serve.stdout)
-    times = frame_times_ms(run.serve.stdout)
+    times = sim.frame_times_ms(run.serve.stdout)
     failures = []
     if not run.ok:
         failures.append(run.failure or f"the run failed (serve {run.serve.returncode}, board {run.board_rc})")

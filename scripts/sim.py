@@ -53,6 +53,21 @@ def frame_instructions(serve_stdout):
     return rows
 
 
+def frame_times_ms(serve_stdout):
+    """The client's clock (ms) when it finished each frame."""
+    return [int(m.group(1)) for m in re.finditer(r"^\s*frame\s+\d+\s+crc\s+\S+.*\sat\s+(\d+)\s+ms", serve_stdout, re.M)]
+
+
+def replay_crcs(vds, stream, png_dir=None):
+    """The CRC of every frame a client must display (`vds frames`), or None if it fails."""
+    cmd = [vds, "frames", stream] + (["--png", png_dir] if png_dir else [])
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        print(r.stdout + r.stderr)
+        return None
+    return r.stdout.split()
+
+
 class Run:
     """What one board run produced."""
 

@@ -34,6 +34,29 @@ def write_ppm(path, w, h, k):
         f.write(b"P6\n%d %d\n255\n" % (w, h) + bytes(px))
 
 
+def encode_frames(a, failures):
+    """Encodes the input images (or synthetic frames) into one stream:
+    (stream, the encoder's frame CRCs or None, its output)."""
+    inputs = list(a.inputs)
+    if not inputs:
+        for k in range(a.frames):
+            p = os.path.join(a.work, f"src{k}.ppm")
+            write_ppm(p, 240, 180, k)
+            inputs.append(p)
+    stream = os.path.join(a.work, "e2e.vds")
+    crc_file = os.path.join(a.work, "encoder.crc")
+    rate = ["--psnr", str(a.psnr)] if a.psnr else ["--quality", str(a.quality)]
+    enc = subprocess.run([a.vds, "encode-frames", *inputs, "-o", stream, "--size", "240x180", *rate,
+                          "--max-chunk", "1024", "--crc-out", crc_file], capture_output=True, text=True)
+    print(enc.stdout + enc.stderr)
+    if enc.returncode != 0:
+        return stream, None, enc.stdout
+    want = open(crc_file).read().split()
+    if len(want) != len(inputs) or not want:
+        failures.append(f"the encoder reports {len(want)} frames for {len(inputs)} inputs")
+    return stream, want, enc.stdout
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--vds", required=True)
@@ -53,32 +76,15 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     failures = []
 
-    inputs = list(a.inputs)
     if a.stream:
-        stream = a.stream
-        enc = subprocess.run([a.vds, "frames", stream], capture_output=True, text=True)
-        print(enc.stdout + enc.stderr)
-        if enc.returncode != 0:
-            print("vds frames failed")
-            return 1
-        want = enc.stdout.split()
-        inputs = want
-    elif not inputs:
-        for k in range(a.frames):
-            p = os.path.join(a.work, f"src{k}.ppm")
-            write_ppm(p, 240, 180, k)
-            inputs.append(p)
-    if not a.stream:
-        stream = os.path.join(a.work, "e2e.vds")
-        crc_file = os.path.join(a.work, "encoder.crc")
-        rate = ["--psnr", str(a.psnr)] if a.psnr else ["--quality", str(a.quality)]
-        enc = subprocess.run([a.vds, "encode-frames", *inputs, "-o", stream, "--size", "240x180", *rate,
-                              "--max-chunk", "1024", "--crc-out", crc_file], capture_output=True, text=True)
-        print(enc.stdout + enc.stderr)
-        if enc.returncode != 0:
-            print("encode-frames failed")
-            return 1
-        want = open(crc_file).read().split()
+        stream, want, encoder_log = a.stream, sim.replay_crcs(a.vds, a.stream), ""
+        if not want:
+            failures.append("`vds frames` gave no frames for the stream")
+    else:
+        stream, want, encoder_log = encode_frames(a, failures)
+    if want is None:
+        print("the encoder side failed")
+        return 1
 
     # The live window too, on SDL's headless video driver.
     env = dict(os.environ, SDL_VIDEODRIVER="dummy")
@@ -100,8 +106,6 @@ def main():
     print(f"encoder  : {' '.join(want)}")
     print(f"host     : {' '.join(host_crcs)}")
     print(f"cortex-m4: {' '.join(qemu_crcs)}")
-    if len(want) != len(inputs) or not want:
-        failures.append(f"the encoder reports {len(want)} frames for {len(inputs)} inputs")
     if host_crcs != want:
         failures.append("host-native board frame CRCs differ from the encoder's reconstruction")
     if qemu_crcs != want:
@@ -122,7 +126,7 @@ def main():
             json.dump({"stream_bytes": os.path.getsize(stream), "frames": len(want), "encoder_crcs": want,
                        "host_crcs": host_crcs, "qemu_crcs": qemu_crcs, "baud": a.baud,
                        "host_seconds": host.seconds, "qemu_seconds": qemu.seconds,
-                       "qemu_instructions": instr, "encoder": enc.stdout,
+                       "qemu_instructions": instr, "encoder": encoder_log,
                        "serve_host": host.serve.stdout, "serve_qemu": qemu.serve.stdout,
                        "qemu_log": qemu.board_log}, f, indent=1)
     for f in failures:
