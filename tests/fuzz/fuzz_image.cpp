@@ -9,6 +9,7 @@
 #include <cstring>
 #include <vector>
 
+#include "pixel_bounds.h"
 #include "vds/enc/image_codec.h"
 #include "vds/image.h"
 
@@ -17,19 +18,7 @@ namespace {
 using vds::ChromaFormat;
 using vds::Status;
 
-struct Bounds {
-  uint32_t width, height;
-  uint32_t calls;
-};
-
-bool check_rect(void* ctx, const vds::PixelRect& r) {
-  Bounds& b = *static_cast<Bounds*>(ctx);
-  if (r.w == 0 || r.h == 0 || r.x + r.w > b.width || r.y + r.h > b.height) __builtin_trap();
-  volatile uint8_t sink = 0;
-  for (int y = 0; y < r.h; ++y)
-    for (int x = 0; x < r.w * 3; ++x) sink = static_cast<uint8_t>(sink + r.pixels[y * r.stride + x]);
-  return ++b.calls < 100000;
-}
+using vds::fuzz::check_rect;
 
 bool grey_prediction(void*, uint16_t, uint16_t, uint16_t w, uint16_t h, uint8_t* y, ptrdiff_t ys, uint8_t* cb,
                      uint8_t* cr, ptrdiff_t cs) {
@@ -51,7 +40,7 @@ void decode(const std::vector<uint8_t>& imgh, const std::vector<std::vector<uint
   vds::ImageHeader h;
   const bool valid = vds::image_header_from_bytes(imgh.data(), static_cast<uint32_t>(imgh.size()), &h) == Status::ok;
   const bool small = valid && static_cast<uint32_t>(h.width) * h.height <= (1u << 16);
-  Bounds bounds{valid ? h.width : 0u, valid ? h.height : 0u, 0};
+  vds::fuzz::PixelBounds bounds{valid ? h.width : 0u, valid ? h.height : 0u, 3, 0};  // rgb888
   std::vector<uint8_t> frame, planes[3], band;
   vds::ImageTarget t = vds::ImageTarget::rects(vds::PixelFormat::rgb888, check_rect, &bounds);
   if (small && kind == 1) {

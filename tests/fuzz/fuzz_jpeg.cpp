@@ -9,6 +9,7 @@
 #include <cstring>
 #include <vector>
 
+#include "pixel_bounds.h"
 #include "vds/jpeg.h"
 #include "../unit/jpeg_sample_422.h"
 
@@ -68,19 +69,7 @@ const uint8_t kSeed420[] = {
 // The 4:2:2 sample of the unit tests (cjpeg -quality 70 -sample 2x1,1x1,1x1 -optimize).
 using vds::test::kJpeg422;
 
-struct Bounds {
-  uint32_t width, height;
-  uint32_t calls;
-};
-
-bool check_rect(void* ctx, const vds::PixelRect& r) {
-  Bounds& b = *static_cast<Bounds*>(ctx);
-  if (r.w == 0 || r.h == 0 || r.x + r.w > b.width || r.y + r.h > b.height) __builtin_trap();
-  volatile uint8_t sink = 0;
-  for (int y = 0; y < r.h; ++y)
-    for (int x = 0; x < r.w * 2; ++x) sink = static_cast<uint8_t>(sink + r.pixels[y * r.stride + x]);
-  return ++b.calls < 100000;
-}
+using vds::fuzz::check_rect;
 
 void decode(const std::vector<uint8_t>& file, size_t piece, int target_kind) {
   static std::vector<uint8_t> ws(vds::JpegDecoder::kWorkspaceBytes);
@@ -89,7 +78,7 @@ void decode(const std::vector<uint8_t>& file, size_t piece, int target_kind) {
   if (dec.init(arena) != vds::Status::ok) __builtin_trap();
   vds::JpegInfo info;
   const vds::Status peek = vds::jpeg_peek_info(file.data(), file.size(), &info);
-  Bounds bounds{info.width, info.height, 0};
+  vds::fuzz::PixelBounds bounds{info.width, info.height, 2, 0};  // rgb565
   std::vector<uint8_t> frame;
   std::vector<uint8_t> planes[3];
   vds::ImageTarget t = vds::ImageTarget::rects(vds::PixelFormat::rgb565, check_rect, &bounds);
