@@ -10,12 +10,6 @@
 namespace vds {
 namespace {
 
-#if VDS_CONFIG_STATUS_NAMES
-#define VDS_DETAIL(text) text
-#else
-#define VDS_DETAIL(text) ""
-#endif
-
 constexpr uint32_t kMaxFrameSide = 16384;
 constexpr uint32_t kMaxChunkPayloadLimit = 1u << 24;  // 16 MiB: far beyond any client
 

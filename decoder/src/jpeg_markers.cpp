@@ -7,12 +7,6 @@
 #include "vds/config.h"
 #include "vds/jpeg.h"
 
-#if VDS_CONFIG_STATUS_NAMES
-#define VDS_JPEG_DETAIL(s) s
-#else
-#define VDS_JPEG_DETAIL(s) ""
-#endif
-
 namespace vds {
 
 namespace {
@@ -32,11 +26,11 @@ uint16_t be16(const uint8_t* p) { return static_cast<uint16_t>((p[0] << 8) | p[1
 // Why a frame header is refused, or nullptr if this decoder takes it.
 const char* refusal(uint8_t m) {
   if (is_progressive(m))
-    return is_arithmetic(m) ? VDS_JPEG_DETAIL("progressive arithmetic-coded JPEG is not supported")
-                            : VDS_JPEG_DETAIL("progressive JPEG is not supported");
-  if (is_arithmetic(m)) return VDS_JPEG_DETAIL("arithmetic-coded JPEG is not supported");
-  if (m == 0xC3 || m == 0xC7 || m == 0xCB || m == 0xCF) return VDS_JPEG_DETAIL("lossless JPEG is not supported");
-  if (m == 0xC5 || m == 0xC6 || m == 0xC7) return VDS_JPEG_DETAIL("hierarchical JPEG is not supported");
+    return is_arithmetic(m) ? VDS_DETAIL("progressive arithmetic-coded JPEG is not supported")
+                            : VDS_DETAIL("progressive JPEG is not supported");
+  if (is_arithmetic(m)) return VDS_DETAIL("arithmetic-coded JPEG is not supported");
+  if (m == 0xC3 || m == 0xC7 || m == 0xCB || m == 0xCF) return VDS_DETAIL("lossless JPEG is not supported");
+  if (m == 0xC5 || m == 0xC6 || m == 0xC7) return VDS_DETAIL("hierarchical JPEG is not supported");
   return nullptr;
 }
 
@@ -44,36 +38,36 @@ const char* refusal(uint8_t m) {
 Status parse_frame(const uint8_t* s, uint32_t n, JpegInfo* info, uint8_t ids[3], uint8_t hv[3], uint8_t tq[3],
                    const char** why) {
   if (n < 6) {
-    *why = VDS_JPEG_DETAIL("frame header too short");
+    *why = VDS_DETAIL("frame header too short");
     return Status::malformed;
   }
   const int nf = s[5];
   if (n != 6u + 3u * nf) {
-    *why = VDS_JPEG_DETAIL("frame header length does not match its component count");
+    *why = VDS_DETAIL("frame header length does not match its component count");
     return Status::malformed;
   }
   if (s[0] != 8) {
-    *why = VDS_JPEG_DETAIL("only 8-bit samples are supported");
+    *why = VDS_DETAIL("only 8-bit samples are supported");
     return Status::unsupported_feature;
   }
   const uint16_t height = be16(s + 1), width = be16(s + 3);
   if (width == 0) {
-    *why = VDS_JPEG_DETAIL("frame width is zero");
+    *why = VDS_DETAIL("frame width is zero");
     return Status::malformed;
   }
   if (height == 0) {
-    *why = VDS_JPEG_DETAIL("height defined by DNL is not supported");
+    *why = VDS_DETAIL("height defined by DNL is not supported");
     return Status::unsupported_feature;
   }
   if (nf != 1 && nf != 3) {
-    *why = VDS_JPEG_DETAIL("only 1- and 3-component JPEG is supported");
+    *why = VDS_DETAIL("only 1- and 3-component JPEG is supported");
     return Status::unsupported_feature;
   }
   for (int i = 0; i < nf; ++i) {
     const uint8_t* c = s + 6 + 3 * i;
     const int h = c[1] >> 4, v = c[1] & 15;
     if (h < 1 || h > 4 || v < 1 || v > 4 || c[2] > 3) {
-      *why = VDS_JPEG_DETAIL("bad sampling factor or quantisation table in the frame header");
+      *why = VDS_DETAIL("bad sampling factor or quantisation table in the frame header");
       return Status::malformed;
     }
     ids[i] = c[0];
@@ -87,11 +81,11 @@ Status parse_frame(const uint8_t* s, uint32_t n, JpegInfo* info, uint8_t ids[3],
   if (nf == 3) {
     const int h0 = hv[0] >> 4, v0 = hv[0] & 15;
     if (h0 > 2 || v0 > 2 || hv[1] != 0x11 || hv[2] != 0x11) {
-      *why = VDS_JPEG_DETAIL("sampling factors other than 4:4:4, 4:2:2, 4:4:0 and 4:2:0 are not supported");
+      *why = VDS_DETAIL("sampling factors other than 4:4:4, 4:2:2, 4:4:0 and 4:2:0 are not supported");
       return Status::unsupported_feature;
     }
     if ((ids[0] == 'R' && ids[1] == 'G' && ids[2] == 'B')) {
-      *why = VDS_JPEG_DETAIL("RGB-coded JPEG is not supported");
+      *why = VDS_DETAIL("RGB-coded JPEG is not supported");
       return Status::unsupported_feature;
     }
     info->sub_x = static_cast<uint8_t>(h0 - 1);
@@ -108,7 +102,7 @@ Status jpeg_peek_info(const uint8_t* data, size_t size, JpegInfo* info, const ch
   if (info == nullptr || (data == nullptr && size != 0)) return Status::invalid_argument;
   if (size < 2) return Status::truncated;
   if (data[0] != 0xFF || data[1] != kSoi) {
-    if (detail != nullptr) *detail = VDS_JPEG_DETAIL("not a JPEG file (no SOI marker)");
+    if (detail != nullptr) *detail = VDS_DETAIL("not a JPEG file (no SOI marker)");
     return Status::malformed;
   }
   JpegInfo out;
@@ -117,7 +111,7 @@ Status jpeg_peek_info(const uint8_t* data, size_t size, JpegInfo* info, const ch
   for (;;) {
     if (i + 2 > size) break;
     if (data[i] != 0xFF) {
-      if (detail != nullptr) *detail = VDS_JPEG_DETAIL("data between markers");
+      if (detail != nullptr) *detail = VDS_DETAIL("data between markers");
       return Status::malformed;
     }
     const uint8_t m = data[i + 1];
@@ -128,17 +122,17 @@ Status jpeg_peek_info(const uint8_t* data, size_t size, JpegInfo* info, const ch
     i += 2;
     if (m == kTem || (m >= kRst0 && m <= kRst7)) continue;
     if (m == kEoi || m == kSoi) {
-      if (detail != nullptr) *detail = VDS_JPEG_DETAIL("no frame header before EOI");
+      if (detail != nullptr) *detail = VDS_DETAIL("no frame header before EOI");
       return Status::malformed;
     }
     if (i + 2 > size) break;
     const uint16_t len = be16(data + i);
     if (len < 2) {
-      if (detail != nullptr) *detail = VDS_JPEG_DETAIL("marker segment length below 2");
+      if (detail != nullptr) *detail = VDS_DETAIL("marker segment length below 2");
       return Status::malformed;
     }
     if (m == kDac) {
-      if (detail != nullptr) *detail = VDS_JPEG_DETAIL("arithmetic-coded JPEG is not supported");
+      if (detail != nullptr) *detail = VDS_DETAIL("arithmetic-coded JPEG is not supported");
       return Status::unsupported_feature;
     }
     if (is_sof(m)) {
@@ -236,7 +230,7 @@ Status JpegDecoder::decode(const uint8_t* data, size_t size, const ImageTarget& 
   Status s = start(target);
   if (s != Status::ok) return s;
   s = feed(data, size);
-  if (s == Status::more_input) return fail(Status::truncated, VDS_JPEG_DETAIL("the file ends before EOI"));
+  if (s == Status::more_input) return fail(Status::truncated, VDS_DETAIL("the file ends before EOI"));
   return s;
 }
 
@@ -275,7 +269,7 @@ Status JpegDecoder::consume_markers(const uint8_t*& p, const uint8_t* end) {
       len_bytes_[len_have_++] = *p++;
       if (len_have_ < 2) continue;
       const uint16_t len = be16(len_bytes_);
-      if (len < 2) return fail(Status::malformed, VDS_JPEG_DETAIL("marker segment length below 2"));
+      if (len < 2) return fail(Status::malformed, VDS_DETAIL("marker segment length below 2"));
       seg_left_ = static_cast<uint16_t>(len - 2);
       have_ = 0;
       part_ = 0;
@@ -284,7 +278,7 @@ Status JpegDecoder::consume_markers(const uint8_t*& p, const uint8_t* end) {
         case kSof1:
         case kSos:
         case kDri:
-          if (seg_left_ > kSegmentBytes) return fail(Status::malformed, VDS_JPEG_DETAIL("marker segment too long"));
+          if (seg_left_ > kSegmentBytes) return fail(Status::malformed, VDS_DETAIL("marker segment too long"));
           need_ = seg_left_;
           break;
         case kDqt:
@@ -303,8 +297,8 @@ Status JpegDecoder::consume_markers(const uint8_t*& p, const uint8_t* end) {
     const uint8_t b = *p++;
     if (!ff_seen_) {
       if (b != 0xFF)
-        return fail(Status::malformed, state_ == State::soi ? VDS_JPEG_DETAIL("not a JPEG file (no SOI marker)")
-                                                            : VDS_JPEG_DETAIL("data between markers"));
+        return fail(Status::malformed, state_ == State::soi ? VDS_DETAIL("not a JPEG file (no SOI marker)")
+                                                            : VDS_DETAIL("data between markers"));
       ff_seen_ = 1;
       continue;
     }
@@ -312,32 +306,32 @@ Status JpegDecoder::consume_markers(const uint8_t*& p, const uint8_t* end) {
     ff_seen_ = 0;
     marker_ = b;
     if (state_ == State::soi) {
-      if (b != kSoi) return fail(Status::malformed, VDS_JPEG_DETAIL("not a JPEG file (no SOI marker)"));
+      if (b != kSoi) return fail(Status::malformed, VDS_DETAIL("not a JPEG file (no SOI marker)"));
       state_ = State::marker;
       continue;
     }
     if (b == kTem) continue;
     if (b == kEoi) {
       if (!have_scan_ || mcu_ != mcu_total_)
-        return fail(Status::malformed, VDS_JPEG_DETAIL("EOI before the image data is complete"));
+        return fail(Status::malformed, VDS_DETAIL("EOI before the image data is complete"));
       state_ = State::done;
       return Status::ok;
     }
     if (b == kSoi || b == 0x00 || (b >= kRst0 && b <= kRst7))
-      return fail(Status::malformed, VDS_JPEG_DETAIL("unexpected marker"));
-    if (b == kDac) return fail(Status::unsupported_feature, VDS_JPEG_DETAIL("arithmetic-coded JPEG is not supported"));
+      return fail(Status::malformed, VDS_DETAIL("unexpected marker"));
+    if (b == kDac) return fail(Status::unsupported_feature, VDS_DETAIL("arithmetic-coded JPEG is not supported"));
     if (is_sof(b)) {
       if (const char* r = refusal(b)) return fail(Status::unsupported_feature, r);
     }
-    if (b == kDnl) return fail(Status::unsupported_feature, VDS_JPEG_DETAIL("DNL marker is not supported"));
+    if (b == kDnl) return fail(Status::unsupported_feature, VDS_DETAIL("DNL marker is not supported"));
     if (b == kDhp || b == kExp)
-      return fail(Status::unsupported_feature, VDS_JPEG_DETAIL("hierarchical JPEG is not supported"));
-    if (b == kJpgExt) return fail(Status::unsupported_feature, VDS_JPEG_DETAIL("JPEG extension marker"));
+      return fail(Status::unsupported_feature, VDS_DETAIL("hierarchical JPEG is not supported"));
+    if (b == kJpgExt) return fail(Status::unsupported_feature, VDS_DETAIL("JPEG extension marker"));
     if (b == kSos && have_scan_)
-      return fail(Status::unsupported_feature, VDS_JPEG_DETAIL("more than one scan is not supported"));
+      return fail(Status::unsupported_feature, VDS_DETAIL("more than one scan is not supported"));
     const bool known = b == kSof0 || b == kSof1 || b == kDht || b == kDqt || b == kDri || b == kSos ||
                        (b >= kApp0 && b <= kApp15) || b == kCom || (b >= kJpg0 && b <= kJpg13);
-    if (!known) return fail(Status::malformed, VDS_JPEG_DETAIL("unknown marker"));
+    if (!known) return fail(Status::malformed, VDS_DETAIL("unknown marker"));
     len_have_ = 0;
     state_ = State::length;
   }
@@ -355,7 +349,7 @@ Status JpegDecoder::segment_bytes(const uint8_t*& p, const uint8_t* end) {
       state_ = State::marker;
       return Status::ok;
     }
-    if (need_ - have_ > seg_left_) return fail(Status::malformed, VDS_JPEG_DETAIL("marker segment too short"));
+    if (need_ - have_ > seg_left_) return fail(Status::malformed, VDS_DETAIL("marker segment too short"));
     while (have_ < need_) {
       if (p == end) return Status::more_input;
       seg_[have_++] = *p++;
@@ -372,15 +366,15 @@ Status JpegDecoder::segment_bytes(const uint8_t*& p, const uint8_t* end) {
         if (s == Status::ok) return Status::ok;  // state is scan
         break;
       case kDri:
-        if (have_ != 2) return fail(Status::malformed, VDS_JPEG_DETAIL("DRI segment length is not 4"));
+        if (have_ != 2) return fail(Status::malformed, VDS_DETAIL("DRI segment length is not 4"));
         restart_interval_ = be16(seg_);
         if (!have_scan_) info_.restart_interval = restart_interval_;
         break;
       case kDqt:
         if (part_ == 0) {
           const int pq = seg_[0] >> 4;
-          if (pq > 1) return fail(Status::malformed, VDS_JPEG_DETAIL("DQT precision above 16 bits"));
-          if ((seg_[0] & 15) >= kQuantTables) return fail(Status::malformed, VDS_JPEG_DETAIL("DQT table index above 3"));
+          if (pq > 1) return fail(Status::malformed, VDS_DETAIL("DQT precision above 16 bits"));
+          if ((seg_[0] & 15) >= kQuantTables) return fail(Status::malformed, VDS_DETAIL("DQT table index above 3"));
           part_ = 1;
           need_ = static_cast<uint16_t>(1 + (pq ? 128 : 64));
           continue;
@@ -397,7 +391,7 @@ Status JpegDecoder::segment_bytes(const uint8_t*& p, const uint8_t* end) {
         if (part_ == 0) {
           uint32_t total = 0;
           for (int i = 0; i < 16; ++i) total += seg_[1 + i];
-          if (total > kAcSymbols) return fail(Status::malformed, VDS_JPEG_DETAIL("DHT with more than 256 codes"));
+          if (total > kAcSymbols) return fail(Status::malformed, VDS_DETAIL("DHT with more than 256 codes"));
           part_ = 1;
           need_ = static_cast<uint16_t>(17 + total);
           continue;
@@ -414,14 +408,14 @@ Status JpegDecoder::segment_bytes(const uint8_t*& p, const uint8_t* end) {
         break;
     }
     if (s != Status::ok) return s;
-    if (seg_left_ != 0) return fail(Status::malformed, VDS_JPEG_DETAIL("marker segment longer than its content"));
+    if (seg_left_ != 0) return fail(Status::malformed, VDS_DETAIL("marker segment longer than its content"));
     state_ = State::marker;
     return Status::ok;
   }
 }
 
 Status JpegDecoder::on_sof(const uint8_t* s, uint32_t n) {
-  if (have_frame_) return fail(Status::malformed, VDS_JPEG_DETAIL("second frame header"));
+  if (have_frame_) return fail(Status::malformed, VDS_DETAIL("second frame header"));
   uint8_t ids[3], hv[3], tq[3];
   const char* why = "";
   JpegInfo info = info_;
@@ -440,7 +434,7 @@ Status JpegDecoder::on_sof(const uint8_t* s, uint32_t n) {
   }
   const detail::OutputGeometry g{info_.width, info_.height, 8 * hmax_, 8 * vmax_, ncomp_, info_.sub_x, info_.sub_y};
   if (detail::check_target(target_, g, false) != Status::ok)
-    return fail(Status::invalid_argument, VDS_JPEG_DETAIL("the target does not suit the image"));
+    return fail(Status::invalid_argument, VDS_DETAIL("the target does not suit the image"));
   mcus_x_ = (info_.width + 8u * hmax_ - 1) / (8u * hmax_);
   mcu_total_ = mcus_x_ * ((info_.height + 8u * vmax_ - 1) / (8u * vmax_));
   have_frame_ = true;
@@ -448,29 +442,29 @@ Status JpegDecoder::on_sof(const uint8_t* s, uint32_t n) {
 }
 
 Status JpegDecoder::on_sos(const uint8_t* s, uint32_t n) {
-  if (!have_frame_) return fail(Status::malformed, VDS_JPEG_DETAIL("scan before the frame header"));
+  if (!have_frame_) return fail(Status::malformed, VDS_DETAIL("scan before the frame header"));
   const int ns = n > 0 ? s[0] : 0;
-  if (ns < 1 || n != 1u + 2u * ns + 3u) return fail(Status::malformed, VDS_JPEG_DETAIL("bad scan header length"));
+  if (ns < 1 || n != 1u + 2u * ns + 3u) return fail(Status::malformed, VDS_DETAIL("bad scan header length"));
   if (ns != ncomp_)
-    return fail(Status::unsupported_feature, VDS_JPEG_DETAIL("non-interleaved scans are not supported"));
+    return fail(Status::unsupported_feature, VDS_DETAIL("non-interleaved scans are not supported"));
   for (int i = 0; i < ns; ++i) {
     const uint8_t id = s[1 + 2 * i], tables = s[2 + 2 * i];
-    if (id != comp_[i].id) return fail(Status::malformed, VDS_JPEG_DETAIL("scan component not in frame order"));
+    if (id != comp_[i].id) return fail(Status::malformed, VDS_DETAIL("scan component not in frame order"));
     const int td = tables >> 4, ta = tables & 15;
-    if (td > 3 || ta > 3) return fail(Status::malformed, VDS_JPEG_DETAIL("bad Huffman table selector"));
+    if (td > 3 || ta > 3) return fail(Status::malformed, VDS_DETAIL("bad Huffman table selector"));
     if (td >= kTables || ta >= kTables)
-      return fail(Status::unsupported_feature, VDS_JPEG_DETAIL("Huffman tables 2 and 3 are not supported"));
+      return fail(Status::unsupported_feature, VDS_DETAIL("Huffman tables 2 and 3 are not supported"));
     if (!(dc_defined_ & (1u << td)) || !(ac_defined_ & (1u << ta)))
-      return fail(Status::malformed, VDS_JPEG_DETAIL("scan uses an undefined Huffman table"));
+      return fail(Status::malformed, VDS_DETAIL("scan uses an undefined Huffman table"));
     if (!(quant_defined_ & (1u << comp_[i].tq)))
-      return fail(Status::malformed, VDS_JPEG_DETAIL("component uses an undefined quantisation table"));
+      return fail(Status::malformed, VDS_DETAIL("component uses an undefined quantisation table"));
     comp_[i].td = static_cast<uint8_t>(td);
     comp_[i].ta = static_cast<uint8_t>(ta);
     comp_[i].pred = 0;
   }
   const uint8_t* t = s + 1 + 2 * ns;
   if (t[0] != 0 || t[1] != 63 || t[2] != 0)
-    return fail(Status::malformed, VDS_JPEG_DETAIL("spectral selection or approximation in a sequential scan"));
+    return fail(Status::malformed, VDS_DETAIL("spectral selection or approximation in a sequential scan"));
   have_scan_ = true;
   acc_ = 0;
   bits_ = zeros_ = 0;
@@ -494,20 +488,20 @@ Status JpegDecoder::on_dqt_table(const uint8_t* s) {
 
 Status JpegDecoder::on_dht_table(const uint8_t* s) {
   const int tc = s[0] >> 4, th = s[0] & 15;
-  if (tc > 1 || th > 3) return fail(Status::malformed, VDS_JPEG_DETAIL("bad DHT table class or index"));
-  if (th >= kTables) return fail(Status::unsupported_feature, VDS_JPEG_DETAIL("Huffman tables 2 and 3 are not supported"));
+  if (tc > 1 || th > 3) return fail(Status::malformed, VDS_DETAIL("bad DHT table class or index"));
+  if (th >= kTables) return fail(Status::unsupported_feature, VDS_DETAIL("Huffman tables 2 and 3 are not supported"));
   const uint8_t* counts = s + 1;
   const uint8_t* symbols = s + 17;
   size_t total = 0;
   for (int i = 0; i < 16; ++i) total += counts[i];
   if (tc == 0) {
-    if (total > kDcSymbols) return fail(Status::malformed, VDS_JPEG_DETAIL("DC table with more than 16 codes"));
+    if (total > kDcSymbols) return fail(Status::malformed, VDS_DETAIL("DC table with more than 16 codes"));
     if (dc_[th].build_from_counts(counts, symbols, total) != Status::ok)
-      return fail(Status::malformed, VDS_JPEG_DETAIL("bad Huffman table"));
+      return fail(Status::malformed, VDS_DETAIL("bad Huffman table"));
     dc_defined_ = static_cast<uint8_t>(dc_defined_ | (1u << th));
   } else {
     if (ac_[th].build_from_counts(counts, symbols, total) != Status::ok)
-      return fail(Status::malformed, VDS_JPEG_DETAIL("bad Huffman table"));
+      return fail(Status::malformed, VDS_DETAIL("bad Huffman table"));
     build_fast(th, counts, symbols);
     ac_defined_ = static_cast<uint8_t>(ac_defined_ | (1u << th));
   }

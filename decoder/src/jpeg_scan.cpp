@@ -10,12 +10,6 @@
 #include "vds/image_model.h"
 #include "vds/jpeg.h"
 
-#if VDS_CONFIG_STATUS_NAMES
-#define VDS_JPEG_DETAIL(s) s
-#else
-#define VDS_JPEG_DETAIL(s) ""
-#endif
-
 namespace vds {
 
 namespace {
@@ -329,12 +323,12 @@ Status JpegDecoder::scan(const uint8_t*& p, const uint8_t* end) {
       const int bx = comp == 0 ? blk_ % hmax_ : 0, by = comp == 0 ? blk_ / hmax_ : 0;
       const int r = decode_block(p, end, comp_[comp]);
       if (r == 0) return Status::more_input;
-      if (r < 0) return fail(Status::malformed, VDS_JPEG_DETAIL("corrupt entropy-coded data"));
+      if (r < 0) return fail(Status::malformed, VDS_DETAIL("corrupt entropy-coded data"));
       finish_block(comp, bx, by);
       ++blk_;
     }
     const Status s = output_mcu();
-    if (s != Status::ok) return fail(s, VDS_JPEG_DETAIL("output callback aborted"));
+    if (s != Status::ok) return fail(s, VDS_DETAIL("output callback aborted"));
     blk_ = 0;
     ++mcu_;
     if (restart_interval_ != 0 && mcu_ < mcu_total_ && --restarts_left_ == 0) {
@@ -363,13 +357,13 @@ Status JpegDecoder::restart(const uint8_t*& p, const uint8_t* end) {
     if (p == end) return Status::more_input;
     const uint8_t b = *p++;
     if (!ff_seen_) {
-      if (b != 0xFF) return fail(Status::malformed, VDS_JPEG_DETAIL("restart marker missing"));
+      if (b != 0xFF) return fail(Status::malformed, VDS_DETAIL("restart marker missing"));
       ff_seen_ = 1;
       continue;
     }
     if (b == 0xFF) continue;
     ff_seen_ = 0;
-    if (b != 0xD0 + next_rst_) return fail(Status::malformed, VDS_JPEG_DETAIL("restart marker missing or out of order"));
+    if (b != 0xD0 + next_rst_) return fail(Status::malformed, VDS_DETAIL("restart marker missing or out of order"));
     break;
   }
   next_rst_ = static_cast<uint8_t>((next_rst_ + 1) & 7);

@@ -10,6 +10,14 @@
 #define VDS_CONFIG_STATUS_NAMES 1
 #endif
 
+// Error detail text inside the library (parsers' error_detail()): the text,
+// or "" when status names are off, so the strings cost no flash either.
+#if VDS_CONFIG_STATUS_NAMES
+#define VDS_DETAIL(text) text
+#else
+#define VDS_DETAIL(text) ""
+#endif
+
 // CRC-32C implementation.
 //  1024: four tables (slicing by 4), 4 KiB .rodata, about 3 instructions per byte
 //   256: byte-wise table, 1 KiB .rodata, about 7 instructions per byte
