@@ -332,21 +332,20 @@ Status JpegDecoder::scan(const uint8_t*& p, const uint8_t* end) {
     blk_ = 0;
     ++mcu_;
     if (restart_interval_ != 0 && mcu_ < mcu_total_ && --restarts_left_ == 0) {
-      // The interval's last byte is padded with 1 bits; what is left in the
-      // bit buffer is that padding.
-      if (pending_ff_) ff_seen_ = 1;
-      acc_ = 0;
-      bits_ = zeros_ = 0;
-      marker_hit_ = pending_ff_ = false;
-      state_ = State::restart;
-      return Status::ok;
+      return end_segment(State::restart);
     }
   }
+  return end_segment(State::marker);
+}
+
+Status JpegDecoder::end_segment(State next) {
+  // The segment's last byte is padded with 1 bits; what is left in the bit
+  // buffer is that padding.
   if (pending_ff_) ff_seen_ = 1;
   acc_ = 0;
   bits_ = zeros_ = 0;
   marker_hit_ = pending_ff_ = false;
-  state_ = State::marker;
+  state_ = next;
   return Status::ok;
 }
 

@@ -106,6 +106,8 @@ class JpegDecoder {
   int decode_block(const uint8_t*& p, const uint8_t* end, Component& c);
   Status finish_block(int comp, int bx, int by);
   Status output_mcu();
+  // Ends an entropy-coded segment: drops the bit buffer (its padding) and goes on in `next`.
+  Status end_segment(State next);
   void build_fast(int t, const uint8_t* counts, const uint8_t* symbols);
 
   // Workspace.
