@@ -12,6 +12,7 @@
 
 #include "vds/enc/dct.h"
 #include "vds/idct.h"
+#include "../unit/xorshift.h"
 
 namespace {
 
@@ -135,15 +136,8 @@ TEST(Ieee1180, ZeroInZeroOut) {
 // ---------------------------------------------------------------------------
 // The other entry points, the domain edges and the host DCT.
 
-// Small deterministic generator for the remaining tests (xorshift32).
-struct Xorshift {
-  uint32_t s = 0x9e3779b9u;
-  uint32_t next() {
-    s ^= s << 13;
-    s ^= s >> 17;
-    s ^= s << 5;
-    return s;
-  }
+// Small deterministic generator for the remaining tests.
+struct Xorshift : vds::test::Xorshift32 {
   int range(int lo, int hi) { return lo + static_cast<int>(next() % static_cast<uint32_t>(hi - lo + 1)); }
 };
 

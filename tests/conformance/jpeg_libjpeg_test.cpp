@@ -31,6 +31,7 @@
 #include "vds/enc/image_io.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/jpeg.h"
+#include "../unit/xorshift.h"
 
 namespace {
 
@@ -58,15 +59,7 @@ void write_ppm(const std::string& path, const Image& img) {
   std::fclose(f);
 }
 
-struct Rng {
-  uint32_t s;
-  uint32_t next() {
-    s ^= s << 13;
-    s ^= s >> 17;
-    s ^= s << 5;
-    return s;
-  }
-};
+using Rng = vds::test::Xorshift32;
 
 Image synth(int w, int h, uint32_t seed) {
   Image img(w, h, 3);

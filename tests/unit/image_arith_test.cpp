@@ -10,6 +10,7 @@
 #include "vds/arith.h"
 #include "vds/enc/arith_encoder.h"
 #include "vds/image_model.h"
+#include "xorshift.h"
 
 namespace {
 
@@ -17,15 +18,7 @@ using vds::ArithContext;
 using vds::Status;
 using vds::image_model::RangeDecoder;
 
-struct Rng {
-  uint32_t s;
-  uint32_t next() {
-    s ^= s << 13;
-    s ^= s >> 17;
-    s ^= s << 5;
-    return s;
-  }
-};
+using Rng = vds::test::Xorshift32;
 
 // What the image codec's contexts look like: past the warm-up, default shifts.
 ArithContext warm(uint32_t p0_q15) {

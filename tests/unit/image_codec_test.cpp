@@ -15,6 +15,7 @@
 #include "vds/enc/image_codec.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/image.h"
+#include "xorshift.h"
 
 namespace {
 
@@ -28,22 +29,13 @@ using vds::enc::Image;
 using vds::enc::ImageEncodeOptions;
 using vds::enc::Planes;
 
-struct Rng {
-  uint32_t s;
-  explicit Rng(uint32_t seed) : s(seed) {}
-  uint32_t next() {
-    s ^= s << 13;
-    s ^= s >> 17;
-    s ^= s << 5;
-    return s;
-  }
-};
+using Rng = vds::test::Xorshift32;
 
 // A test picture with what textures have: smooth shading, periodic detail,
 // noise and hard edges (a few dark "letters").
 Image synth(int w, int h, uint32_t seed) {
   Image img(w, h, 3);
-  Rng r(seed);
+  Rng r{seed};
   const double fx = 0.05 + (seed % 7) * 0.03, fy = 0.04 + (seed % 5) * 0.02;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -480,7 +472,7 @@ TEST(ImageCodec, CorruptPayloadsNeverCrash) {
   ASSERT_GE(e.imgd.size(), 2u);
   std::vector<uint8_t> frame(48 * 40 * 3);
   const ImageTarget t = ImageTarget::frame(PixelFormat::rgb888, frame.data(), 48 * 3);
-  Rng r(99);
+  Rng r{99};
   int errors = 0;
   for (int trial = 0; trial < 300; ++trial) {
     EncodedImage bad = e;
