@@ -5,9 +5,13 @@ on the host-native board, which draws it after its base and after every
 level. Every frame's CRC must equal the host replay of the client's display
 path (`vds frames`). Prints a markdown section for the demo report: per
 level, the vertices, the bytes so far, when that is at 2 KB/s, and when the
-board showed it.
+board showed it. With --qemu and --elf, the same stream also goes to the
+client on the Cortex-M4 board at 115,200 baud: its workspace holds only the
+first levels, which it must show exactly as the replay does, skipping the
+rest.
 
-Usage: demo_model.py --vds VDS --host-board EXE --model MESH --out DIR [--baud B]"""
+Usage: demo_model.py --vds VDS --host-board EXE --model MESH --out DIR [--baud B]
+       [--qemu QEMU --elf CLIENT.elf]"""
 import argparse
 import os
 import re
@@ -29,6 +33,34 @@ def level_table(info_stdout):
     return rows
 
 
+def cortex_m4_prefix(a, stream, want):
+    """The stream on the Cortex-M4 board with its own workspace: the frames
+    of the levels it holds, each equal to the replay's. Returns failures."""
+    run = sim.run_qemu(a.vds, a.qemu, a.elf, stream, 115200, a.timeout)
+    with open(os.path.join(a.out, "serve_cortex_m4.log"), "w") as f:
+        f.write(run.serve.stdout + run.serve.stderr + "\n== Cortex-M4 board\n" + run.board_log)
+    got = sim.frame_crcs(run.serve.stdout)
+    held = re.search(r"the workspace holds (\d+) of its (\d+) vertices", run.board_log)
+    full = re.search(r"workspace full after level (\d+) of (\d+) \((\d+) vertices\)", run.board_log)
+    budget = re.search(r"ready, workspace (\d+) bytes", run.board_log)
+    failures = []
+    if not run.ok:
+        failures.append("Cortex-M4 board: " + (run.failure or f"the run failed (serve {run.serve.returncode})"))
+    if not full:
+        failures.append("the Cortex-M4 board did not report where its workspace ran out")
+    elif got != want[:int(full.group(1)) + 1]:
+        failures.append(f"the Cortex-M4 board's {len(got)} frames are not the replay's first {int(full.group(1)) + 1}")
+    if full and held and budget:
+        print(f"The same stream at 115,200 baud to the client on the **Cortex-M4 board** (QEMU mps2-an386), "
+              f"whose {int(budget.group(1)) // 1024} KiB workspace holds {held.group(1)} of the "
+              f"{held.group(2)} vertices: it drew the base and levels 1-{full.group(1)} ({full.group(3)} vertices), "
+              f"{len(got)} frames, each identical to the replay's: "
+              f"{'yes' if not failures else 'NO'}; it received and checked the other "
+              f"{int(full.group(2)) - int(full.group(1))} levels and skipped them "
+              f"(log: `out/demo/model/serve_cortex_m4.log`).\n")
+    return failures
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--vds", required=True)
@@ -37,6 +69,8 @@ def main():
     ap.add_argument("--out", required=True)
     ap.add_argument("--baud", type=int, default=19200)
     ap.add_argument("--timeout", type=float, default=600)
+    ap.add_argument("--qemu", default="", help="also play the stream on the Cortex-M4 board in this QEMU")
+    ap.add_argument("--elf", default="", help="the Cortex-M4 client firmware")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     name = os.path.splitext(os.path.basename(a.model))[0]
@@ -82,6 +116,8 @@ def main():
         if vertices <= 1000 or i % 3 == 0 or i == len(levels) - 1:
             print(f"| {'base' if level == 0 else level} | {vertices} | {cum} | {cum / 2048:.2f} | {shown} |")
     print()
+    if a.qemu and a.elf:
+        failures += cortex_m4_prefix(a, stream, want)
     for f in failures:
         print("FAIL " + f)
     return 1 if failures else 0

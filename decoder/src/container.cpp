@@ -127,7 +127,8 @@ Status StreamParser::on_chunk_complete() {
     if (s != Status::ok) return fail(s, item_offset_, VDS_DETAIL("invalid HEAD field"));
     if (header_.max_chunk_payload > capacity_)
       return fail(Status::workspace_too_small, item_offset_, VDS_DETAIL("stream's max_chunk_payload exceeds the chunk buffer"));
-    if (header_.workspace_bytes > arena_->remaining())
+    const bool prefix = sink_.model_prefix && header_.mode == StreamMode::model;
+    if (header_.workspace_bytes > arena_->remaining() && !prefix)
       return fail(Status::workspace_too_small, item_offset_, VDS_DETAIL("stream's workspace_bytes exceed the workspace left"));
     have_header_ = true;
     limit_ = header_.max_chunk_payload;

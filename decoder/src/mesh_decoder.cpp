@@ -142,7 +142,7 @@ Status MeshDecoder::init(Arena& arena, uint32_t max_vertices, uint32_t max_trian
   cap_v_ = cap_t_ = 0;
   header_ = MeshHeader();
   status_ = Status::invalid_argument;
-  have_header_ = base_done_ = in_level_ = false;
+  have_header_ = base_done_ = in_level_ = full_ = false;
   base_items_ = base_next_ = levels_done_ = 0;
   items_ = pass_a_ = dv_ = dt_ = old_v_ = old_t_ = marked_ = last_mark_ = cursor_ = 0;
   weight_q4_ = 0;
@@ -161,7 +161,7 @@ Status MeshDecoder::init(Arena& arena, uint32_t max_vertices, uint32_t max_trian
 
 Status MeshDecoder::finish() const {
   if (status_ != Status::ok) return status_;
-  return complete() ? Status::ok : Status::truncated;
+  return complete() || full_ ? Status::ok : Status::truncated;
 }
 
 Status MeshDecoder::consume(uint32_t type, const uint8_t* payload, uint32_t size) {
@@ -180,7 +180,9 @@ Status MeshDecoder::on_header(const uint8_t* p, uint32_t size) {
   MeshHeader h;
   Status s = mesh_header_from_bytes(p, size, &h);
   if (s != Status::ok) return fail(s);
-  if (h.vertices > cap_v_ || h.triangles > cap_t_) return fail(Status::workspace_too_small);
+  // Only the base must fit: a level that would not is where this client
+  // stops refining (on_level).
+  if (h.base_vertices > cap_v_ || h.base_triangles > cap_t_) return fail(Status::workspace_too_small);
   if (h.coder == MeshCoder::huffman) {
     lengths_ = arena_->alloc_array<uint8_t>(kHuffTableMax);
     if (lengths_ == nullptr) return fail(Status::workspace_too_small);
@@ -310,6 +312,7 @@ void MeshDecoder::start_level() {
 }
 
 Status MeshDecoder::on_level(const uint8_t* p, uint32_t size) {
+  if (full_) return Status::ok;  // past what this client holds: skipped
   if (!base_done_ || levels_done_ >= header_.levels) return fail(Status::malformed);
   const uint8_t* end = p + size;
   uint32_t level = 0, first = 0, count = 0;
@@ -329,6 +332,11 @@ Status MeshDecoder::on_level(const uint8_t* p, uint32_t size) {
     if (dv == 0 || dv > nv || dv > header_.vertices - nv || dt > 2 * dv || dt > header_.triangles - nt ||
         weight > 16)
       return fail(Status::malformed);
+    if (dv > cap_v_ - nv || dt > cap_t_ - nt) {
+      // The workspace is full: keep the mesh as it is, skip the rest.
+      full_ = true;
+      return Status::ok;
+    }
     dv_ = dv;
     dt_ = dt;
     weight_q4_ = weight;

@@ -185,4 +185,64 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
   return renderer_.render(cam, list, cfg_.background_rgb, sink, ctx);
 }
 
+namespace {
+
+// Most triangles a level with v vertices can have (v >= base vertices).
+uint32_t triangles_for(const MeshHeader& h, uint32_t v) {
+  const uint64_t t = uint64_t{h.base_triangles} + 2 * uint64_t{v - h.base_vertices};
+  return t < h.triangles ? static_cast<uint32_t>(t) : h.triangles;
+}
+
+// Decoder and view bytes for v vertices; SIZE_MAX if they cannot be had.
+size_t model_bytes(const MeshHeader& h, const ModelViewConfig& cfg, uint32_t v) {
+  const uint32_t t = triangles_for(h, v);
+  const size_t dec = MeshDecoder::workspace_bytes(v, t, h.base_triangles, h.coder);
+  const size_t view = ModelView::workspace_bytes(cfg, v, t);
+  if (dec == SIZE_MAX || view == 0 || dec > SIZE_MAX - view) return SIZE_MAX;
+  return dec + view;
+}
+
+}  // namespace
+
+Status plan_model_capacity(const MeshHeader& h, const ModelViewConfig& cfg, size_t bytes, ModelCapacity* out) {
+  if (out == nullptr) return Status::invalid_argument;
+  *out = ModelCapacity{};
+  if (ModelView::workspace_bytes(cfg, 1, 1) == 0 || h.base_vertices == 0 || h.base_vertices > h.vertices ||
+      h.base_triangles > h.triangles)
+    return Status::invalid_argument;
+  if (h.base_vertices > kMaxPositions) return Status::unsupported_feature;
+  const size_t base = model_bytes(h, cfg, h.base_vertices);
+  if (base > bytes) {
+    out->bytes = base;
+    return Status::workspace_too_small;
+  }
+  // The largest vertex count that fits: the bytes grow with the count.
+  uint32_t lo = h.base_vertices;
+  uint32_t hi = h.vertices < kMaxPositions ? h.vertices : kMaxPositions;
+  while (lo < hi) {
+    const uint32_t mid = lo + (hi - lo + 1) / 2;
+    if (model_bytes(h, cfg, mid) <= bytes)
+      lo = mid;
+    else
+      hi = mid - 1;
+  }
+  out->vertices = lo;
+  out->triangles = triangles_for(h, lo);
+  out->bytes = model_bytes(h, cfg, lo);
+  return Status::ok;
+}
+
+Status start_model(Arena& arena, const uint8_t* mshh, uint32_t size, const ModelViewConfig& cfg, MeshDecoder& mesh,
+                   ModelView& view, ModelCapacity* cap) {
+  ModelCapacity local;
+  ModelCapacity* c = cap != nullptr ? cap : &local;
+  *c = ModelCapacity{};
+  MeshHeader h;
+  Status s = mesh_header_from_bytes(mshh, size, &h);
+  if (s != Status::ok) return s;
+  if ((s = plan_model_capacity(h, cfg, arena.remaining(), c)) != Status::ok) return s;
+  if ((s = mesh.init(arena, c->vertices, c->triangles)) != Status::ok) return s;
+  return view.init(cfg, arena, c->vertices, c->triangles);
+}
+
 }  // namespace vds

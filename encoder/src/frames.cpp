@@ -80,6 +80,7 @@ struct Replay {
   MeshDecoder mesh;  // model streams
   ModelView view;
   bool model = false;
+  bool model_started = false;  // MSHH seen
   ModelFrames shown;
   Arena* arena = nullptr;
   std::vector<uint16_t> band;
@@ -114,21 +115,26 @@ bool on_render_band(void* ctx, const Band& b) {
   return on_band(ctx, PixelRect{0, b.y, b.width, b.height, b.pixels, static_cast<ptrdiff_t>(b.stride)});
 }
 
-// The client firmware's model path (firmware_sim/app/client.cpp), frames
-// drawn by the same rule (vds::ModelFrames).
-bool start_model(Replay& r, const StreamHeader& h) {
-  if (r.mesh.init(*r.arena, h.max_vertices, h.max_triangles) != Status::ok) return false;
+// The client firmware's model path (firmware_sim/app/client.cpp): decoder
+// and view set up at MSHH (vds::start_model), frames drawn by the same rule
+// (vds::ModelFrames).
+bool start_model(Replay& r, const uint8_t* p, uint32_t n) {
   ModelViewConfig vc;
-  vc.width = h.width;
-  vc.height = h.height;
+  vc.width = r.width;
+  vc.height = r.height;
   vc.band_height = 16;
-  if (r.view.init(vc, *r.arena, h.max_vertices, h.max_triangles) != Status::ok) return false;
-  r.model = true;
-  return true;
+  const Status s = vds::start_model(*r.arena, p, n, vc, r.mesh, r.view, nullptr);
+  if (s != Status::ok) r.error = s;
+  return s == Status::ok;
 }
 
 ChunkResult on_model_chunk(Replay& r, uint32_t type, const uint8_t* p, uint32_t n) {
   if (!MeshDecoder::handles(type)) return ChunkResult::unknown;
+  if (!r.model_started) {
+    if (type != chunk::kMeshHeader) r.error = Status::malformed;
+    if (type != chunk::kMeshHeader || !start_model(r, p, n)) return ChunkResult::abort;
+    r.model_started = true;
+  }
   const Status s = r.mesh.consume(type, p, n);
   if (is_error(s)) {
     r.error = s;
@@ -164,7 +170,7 @@ std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::ve
     auto* r = static_cast<Replay*>(ctx);
     r->width = h.width;
     r->height = h.height;
-    if (h.mode == StreamMode::model) return start_model(*r, h);
+    if (h.mode == StreamMode::model) return r->model = true;
     if (h.mode != StreamMode::images) return false;
     if (r->decoder.init(*r->arena) != Status::ok) return false;
     r->band.assign(static_cast<size_t>(h.width) * 16, 0);

@@ -50,6 +50,8 @@ struct Client {
   vds::MeshDecoder mesh;
   vds::ModelView view;
   bool model = false;
+  bool model_started = false;  // MSHH seen: decoder and view set up
+  bool model_full_logged = false;
   vds::ModelFrames model_frames;
   size_t stream_mark = 0;  // arena mark below the per-stream state
   uint32_t epoch = 0;
@@ -146,30 +148,35 @@ bool on_render_band(void*, const vds::Band& b) {
   return on_band(nullptr, r);
 }
 
-bool start_model(const vds::StreamHeader& h) {
-  // The parser has checked that the mesh decoder's declared workspace fits;
-  // the picture needs its own buffers on top.
-  Status s = g.mesh.init(g.arena, h.max_vertices, h.max_triangles);
-  if (s != Status::ok) {
-    log_status("mesh decoder", s);
-    return false;
-  }
+// A model stream's mesh decoder and view are set up when its MSHH arrives,
+// for as much of the model as the workspace holds (vds::start_model): a
+// client smaller than the full resolution plays the levels that fit.
+bool start_model(const uint8_t* mshh, uint32_t size) {
   vds::ModelViewConfig vc;
-  vc.width = h.width;
-  vc.height = h.height;
+  vc.width = g.header.width;
+  vc.height = g.header.height;
   vc.band_height = kBandRows;
-  s = g.view.init(vc, g.arena, h.max_vertices, h.max_triangles);
-  if (s != Status::ok) {
+  vds::ModelCapacity cap;
+  const size_t left = g.arena.remaining();
+  const Status s = vds::start_model(g.arena, mshh, size, vc, g.mesh, g.view, &cap);
+  if (s == Status::workspace_too_small && cap.bytes > 0) {
     Line l;
-    l.str("client: model view: ").str(vds::status_name(s)).str(": it needs ");
-    l.dec(vds::ModelView::workspace_bytes(vc, h.max_vertices, h.max_triangles)).str(" bytes, ");
-    l.dec(g.arena.remaining()).str(" are left after the mesh decoder\n");
+    l.str("client: model: the base mesh needs ").dec(cap.bytes).str(" bytes of workspace, ");
+    l.dec(left).str(" are left\n");
     board::log(l.c_str());
     return false;
   }
-  g.model = true;
-  g.model_frames = vds::ModelFrames{};
-  start_frame_counts(g.parse_total);
+  if (s != Status::ok) {
+    log_status("model", s);
+    return false;
+  }
+  if (cap.vertices < g.header.max_vertices) {
+    Line l;
+    l.str("client: model: the workspace holds ").dec(cap.vertices).str(" of its ");
+    l.dec(g.header.max_vertices).str(" vertices; later levels are skipped\n");
+    board::log(l.c_str());
+  }
+  g.model_started = true;
   return true;
 }
 
@@ -180,7 +187,14 @@ bool on_header(void*, const vds::StreamHeader& h) {
   }
   g.header = h;
   g.have_header = true;
-  if (h.mode == vds::StreamMode::model) return start_model(h);
+  if (h.mode == vds::StreamMode::model) {
+    g.model = true;
+    g.model_started = false;
+    g.model_full_logged = false;
+    g.model_frames = vds::ModelFrames{};
+    start_frame_counts(g.parse_total);
+    return true;
+  }
   // The parser has checked that the declared workspace fits what is left.
   const Status s = g.decoder.init(g.arena);
   if (s != Status::ok) {
@@ -205,6 +219,10 @@ bool on_header(void*, const vds::StreamHeader& h) {
 // record counts the chunks of its level (decode) and the drawing (display).
 vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t size) {
   if (!vds::MeshDecoder::handles(type)) return vds::ChunkResult::unknown;
+  if (!g.model_started && (type != vds::chunk::kMeshHeader || !start_model(payload, size))) {
+    if (type != vds::chunk::kMeshHeader) log_status("mesh: first mesh chunk is not MSHH", Status::malformed);
+    return vds::ChunkResult::abort;
+  }
   const uint64_t t0 = board::instructions();
   g.parse_total += t0 - g.feed_mark;
   const Status s = g.mesh.consume(type, payload, size);
@@ -214,6 +232,12 @@ vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t 
   if (vds::is_error(s)) {
     log_status("mesh", s);
     result = vds::ChunkResult::abort;
+  } else if (g.mesh.capacity_reached() && !g.model_full_logged) {
+    g.model_full_logged = true;
+    Line l;
+    l.str("client: model: workspace full after level ").dec(g.mesh.levels_done()).str(" of ");
+    l.dec(g.mesh.header().levels).str(" (").dec(g.mesh.mesh().vertex_count()).str(" vertices)\n");
+    board::log(l.c_str());
   } else if (g.model_frames.due(g.mesh)) {
     board::display_begin_frame(g.header.width, g.header.height);
     g.in_frame = true;
@@ -281,6 +305,7 @@ Status start_stream() {
   vds::ChunkSink sink;
   sink.on_header = on_header;
   sink.on_chunk = on_chunk;
+  sink.model_prefix = true;  // a model larger than the workspace plays the levels that fit
   return g.parser.init(g.arena, VDS_APP_CHUNK_BYTES, sink);
 }
 

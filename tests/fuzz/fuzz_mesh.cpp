@@ -1,7 +1,8 @@
 // libFuzzer: the progressive mesh decoder on hostile input, three ways
 // (first byte): raw chunk records straight into MeshDecoder; byte flips in
 // the chunks of valid streams (both coders), past any CRC; and round trips
-// of small meshes built from the input, which must come back exactly.
+// of small meshes built from the input, which must come back exactly, in
+// full and in a client that holds only the levels that fit.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -143,6 +144,22 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (dec.consume(c.type, c.payload.data(), static_cast<uint32_t>(c.payload.size())) != vds::Status::ok)
         __builtin_trap();
     if (!dec.complete() || vds::enc::mesh_checksum(dec.mesh()) != r.levels.back().checksum) __builtin_trap();
+    // A client that holds fewer vertices (from the input) stops at the last
+    // level that fits, with exactly the encoder's mesh of that level.
+    const uint32_t base_v = r.levels.front().vertices, full_v = r.stream_header.max_vertices;
+    const uint32_t limit = base_v + (size > 2 ? data[2] : 0) % (full_v - base_v + 1);
+    vds::Arena small(ws.data(), ws.size());
+    vds::MeshDecoder part;
+    if (part.init(small, limit, r.stream_header.max_triangles) != vds::Status::ok) __builtin_trap();
+    for (const Chunk& c : mesh_chunks(r.stream))
+      if (part.consume(c.type, c.payload.data(), static_cast<uint32_t>(c.payload.size())) != vds::Status::ok)
+        __builtin_trap();
+    const uint32_t k = part.levels_done();
+    if (part.finish() != vds::Status::ok || part.mesh().vertex_count() > limit ||
+        vds::enc::mesh_checksum(part.mesh()) != r.levels[k].checksum ||
+        (k + 1 < r.levels.size() && r.levels[k + 1].vertices <= limit) ||
+        part.capacity_reached() == (k + 1 == r.levels.size()))
+      __builtin_trap();
   }
   return 0;
 }

@@ -7,11 +7,14 @@ reconstruction (the client library's decode replayed on the host): the
 client is bit-exact across architectures.
 
 With --stream, an existing stream (e.g. a progressive model) is served
-instead, and the encoder side is `vds frames STREAM`.
+instead, and the encoder side is `vds frames STREAM`. With --prefix and a
+--workspace too small for the whole model, each board must show the
+replay's frames up to the level where it reports its workspace full.
 
 Usage: e2e_boards.py --vds VDS --host-board EXE --qemu QEMU --elf ELF --work DIR
        [--frames N | --inputs IMAGE... | --stream VDS_STREAM] [--report FILE.json]"""
 import argparse
+import re
 import json
 import os
 import subprocess
@@ -72,6 +75,10 @@ def main():
     ap.add_argument("--stream", default="", help="serve this stream instead of encoding frames")
     ap.add_argument("--report", default="", help="write the measurements as JSON")
     ap.add_argument("--timeout", type=float, default=300)
+    ap.add_argument("--workspace", type=int, default=0, help="both boards' workspace budget, bytes (default: theirs)")
+    ap.add_argument("--prefix", action="store_true",
+                    help="a model stream larger than the workspace: each board must show the replay's first frames, "
+                         "one per level it reports holding, and not all of them")
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
     failures = []
@@ -89,10 +96,10 @@ def main():
     # The live window too, on SDL's headless video driver.
     env = dict(os.environ, SDL_VIDEODRIVER="dummy")
     host = sim.run_host(a.vds, a.host_board, stream, a.baud, a.timeout, os.path.join(a.work, "host"), window=True,
-                        env=env)
+                        env=env, workspace=a.workspace)
     print("== vds serve over a pty (host-native board)\n" + host.serve.stdout + host.serve.stderr)
     print("== host-native board\n" + host.board_log)
-    qemu = sim.run_qemu(a.vds, a.qemu, a.elf, stream, a.baud, a.timeout)
+    qemu = sim.run_qemu(a.vds, a.qemu, a.elf, stream, a.baud, a.timeout, workspace=a.workspace)
     print("== vds serve over TCP (Cortex-M4 board in QEMU)\n" + qemu.serve.stdout + qemu.serve.stderr)
     print("== Cortex-M4 board\n" + qemu.board_log)
 
@@ -106,14 +113,25 @@ def main():
     print(f"encoder  : {' '.join(want)}")
     print(f"host     : {' '.join(host_crcs)}")
     print(f"cortex-m4: {' '.join(qemu_crcs)}")
-    if host_crcs != want:
-        failures.append("host-native board frame CRCs differ from the encoder's reconstruction")
-    if qemu_crcs != want:
-        failures.append("Cortex-M4 board frame CRCs differ from the encoder's reconstruction")
+    shown = {"host-native": (host_crcs, host.board_log), "Cortex-M4": (qemu_crcs, qemu.board_log)}
+    for name, (crcs, log) in shown.items():
+        expect = want
+        if a.prefix:
+            # The client says where its workspace ran out; it shows the base
+            # and every level up to there, as the replay does.
+            m = re.search(r"workspace full after level (\d+) of (\d+)", log)
+            if not m:
+                failures.append(f"{name} board did not report a full workspace")
+            else:
+                expect = want[:int(m.group(1)) + 1]
+                if len(expect) >= len(want):
+                    failures.append(f"{name} board held every level: the stream does not test a prefix")
+        if crcs != expect:
+            failures.append(f"{name} board frame CRCs differ from the encoder's reconstruction")
     instr = sim.frame_instructions(qemu.serve.stdout)
     # Image frames split their decode into entropy and transform; a model's
     # frames (mesh decoding, then drawing) have no such split.
-    if len(instr) != len(want) or any(d == 0 or (not a.stream and (e == 0 or t == 0)) or e + t > d
+    if len(instr) != len(qemu_crcs) or any(d == 0 or (not a.stream and (e == 0 or t == 0)) or e + t > d
                                       for _, d, _, e, t in instr):
         failures.append("the Cortex-M4 board's per-stage instruction counts are missing or inconsistent")
     if "window:" in host.board_log:

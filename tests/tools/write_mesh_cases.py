@@ -2,7 +2,8 @@
 """Writes the mesh firmware benchmark's test cases into DIR: mesh_case0.vds,
 the golden stream of mesh format v1 (vertex-centroid predictor), and
 mesh_case1.vds, a torus encoded now by `vds encode-mesh` with the default
-options (area predictor), so the boards compare both predictors.
+options (area predictor), so the boards compare both predictors; and
+model_prefix.vds, a finer torus for a client too small to hold all of it.
 
 Usage: write_mesh_cases.py --vds VDS --golden GOLDEN.vds --out DIR"""
 import argparse
@@ -52,6 +53,14 @@ def main():
     print(enc.stdout + enc.stderr)
     if enc.returncode != 0 or "area predictor" not in enc.stdout:
         print("write_mesh_cases: the torus was not encoded with the area predictor")
+        return 1
+    fine = os.path.join(a.out, "torus_fine.obj")
+    torus_obj(fine, rings=48, sides=24)
+    enc = subprocess.run([a.vds, "encode-mesh", fine, "-o", os.path.join(a.out, "model_prefix.vds"), "--max-chunk", "1024"],
+                         capture_output=True, text=True)
+    print(enc.stdout + enc.stderr)
+    if enc.returncode != 0:
+        print("write_mesh_cases: the fine torus was not encoded")
         return 1
     return 0
 

@@ -42,6 +42,7 @@ struct Client {
   vds::StreamParser parser;
   MeshDecoder decoder;
   std::vector<uint64_t> checksums;
+  std::vector<uint32_t> vertices;  // vertex count at each checksum
   Status init_status = Status::ok;
   uint32_t limit_vertices = 0;  // if set, the decoder gets this capacity instead of HEAD's
 
@@ -61,8 +62,10 @@ struct Client {
       const uint32_t before = c->decoder.levels_done();
       const bool had_base = c->decoder.drawable();
       if (c->decoder.consume(type, payload, size) != Status::ok) return ChunkResult::abort;
-      if ((!had_base && c->decoder.drawable()) || c->decoder.levels_done() != before)
+      if ((!had_base && c->decoder.drawable()) || c->decoder.levels_done() != before) {
         c->checksums.push_back(vds::enc::mesh_checksum(c->decoder.mesh()));
+        c->vertices.push_back(c->decoder.mesh().vertex_count());
+      }
       return ChunkResult::consumed;
     };
     EXPECT_EQ(parser.init(arena, 1u << 13, sink), Status::ok);
@@ -402,20 +405,53 @@ TEST(MeshCodec, CorruptPayloadsNeverCrash) {
   }
 }
 
-TEST(MeshCodec, RefusesWhatItCannotHold) {
+TEST(MeshCodec, ASmallClientPlaysTheLevelsThatFit) {
   const std::vector<uint8_t> s = small_stream(vds::MeshCoder::arith);
-  Client c;
-  c.limit_vertices = 10;  // the client's own limit below the stream's vertex count
-  EXPECT_EQ(c.feed(s, s.size()), Status::aborted);
-  EXPECT_EQ(c.decoder.status(), Status::workspace_too_small);
-  EXPECT_EQ(c.decoder.mesh().vertex_count(), 0u);  // nothing decoded
+  Client full;
+  ASSERT_EQ(full.feed(s, s.size()), Status::ok);
+  const vds::MeshHeader& h = full.decoder.header();
+  ASSERT_GE(h.levels, 3u);
+  ASSERT_EQ(full.vertices.size(), h.levels + 1u);
+  for (uint32_t limit = h.base_vertices; limit <= h.vertices; ++limit) {
+    Client k;
+    k.limit_vertices = limit;
+    ASSERT_EQ(k.feed(s, s.size()), Status::ok) << "limit " << limit;
+    EXPECT_EQ(k.decoder.finish(), Status::ok) << "limit " << limit;
+    // Every level whose vertices fit, and no more.
+    uint32_t fit = 0;
+    while (fit < h.levels && full.vertices[fit + 1] <= limit) ++fit;
+    ASSERT_EQ(k.decoder.levels_done(), fit) << "limit " << limit;
+    EXPECT_EQ(k.decoder.capacity_reached(), fit < h.levels) << "limit " << limit;
+    EXPECT_EQ(k.decoder.complete(), fit == h.levels) << "limit " << limit;
+    // Exactly the full decode's meshes up to there.
+    ASSERT_EQ(k.checksums.size(), fit + 1u);
+    for (size_t i = 0; i < k.checksums.size(); ++i) EXPECT_EQ(k.checksums[i], full.checksums[i]) << i;
+  }
 
-  // A workspace smaller than HEAD declares: refused by the parser up front.
-  vds::StreamParser p;
+  // Not even the base fits: refused before anything is decoded.
+  Client tiny;
+  tiny.limit_vertices = h.base_vertices - 1;
+  EXPECT_EQ(tiny.feed(s, s.size()), Status::aborted);
+  EXPECT_EQ(tiny.decoder.status(), Status::workspace_too_small);
+  EXPECT_EQ(tiny.decoder.mesh().vertex_count(), 0u);  // nothing decoded
+
+  // A workspace smaller than HEAD declares: refused by the parser up front,
+  // unless the sink takes a model prefix.
   std::vector<uint8_t> ws(4096);
-  vds::Arena a(ws.data(), ws.size());
-  ASSERT_EQ(p.init(a, 1024, vds::ChunkSink{}), Status::ok);
-  EXPECT_EQ(p.feed(s.data(), s.size()), Status::workspace_too_small);
+  {
+    vds::StreamParser p;
+    vds::Arena a(ws.data(), ws.size());
+    ASSERT_EQ(p.init(a, 1024, vds::ChunkSink{}), Status::ok);
+    EXPECT_EQ(p.feed(s.data(), s.size()), Status::workspace_too_small);
+  }
+  {
+    vds::StreamParser p;
+    vds::Arena a(ws.data(), ws.size());
+    vds::ChunkSink sink;
+    sink.model_prefix = true;
+    ASSERT_EQ(p.init(a, 1024, sink), Status::ok);
+    EXPECT_EQ(p.feed(s.data(), s.size()), Status::ok);  // no consumer: every chunk skipped
+  }
 }
 
 TEST(MeshCodec, HeaderChecks) {

@@ -11,6 +11,8 @@
 #include "mesh_test_meshes.h"
 #include "vds/enc/frames.h"
 #include "vds/enc/mesh_encoder.h"
+#include "vds/container.h"
+#include "vds/crc32c.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/mesh.h"
 #include "vds/model_view.h"
@@ -64,6 +66,108 @@ TEST(ModelView, GoldenStreamOneFramePerLevel) {
   // target (the end-to-end test compares the boards against these replays).
   EXPECT_EQ(crcs.front(), 0x154289D2u) << std::hex << crcs.front();
   EXPECT_EQ(crcs.back(), 0xDA449086u) << std::hex << crcs.back();
+}
+
+// A client with `bytes` of workspace for the model (the chunk buffer apart),
+// as the firmware plays a stream: set up at MSHH, a frame per level.
+struct SmallClient {
+  std::vector<uint8_t> chunk_ws = std::vector<uint8_t>(1u << 16);
+  std::vector<uint8_t> model_ws;
+  vds::Arena model_arena;
+  vds::MeshDecoder mesh;
+  vds::ModelView view;
+  vds::ModelFrames shown;
+  vds::ModelCapacity cap;
+  Status start = Status::more_input;
+  uint32_t crc = 0;
+  std::vector<uint32_t> crcs, vertices;
+
+  explicit SmallClient(size_t bytes) : model_ws(bytes), model_arena(model_ws.data(), model_ws.size()) {}
+
+  Status play(const std::vector<uint8_t>& s) {
+    vds::Arena chunk_arena(chunk_ws.data(), chunk_ws.size());
+    vds::StreamParser parser;
+    vds::ChunkSink sink;
+    sink.ctx = this;
+    sink.model_prefix = true;
+    sink.on_chunk = [](void* ctx, uint32_t type, const uint8_t* p, uint32_t n) {
+      auto* c = static_cast<SmallClient*>(ctx);
+      if (!vds::MeshDecoder::handles(type)) return vds::ChunkResult::unknown;
+      if (type == vds::chunk::kMeshHeader) {
+        vds::ModelViewConfig vc;
+        vc.width = 240;
+        vc.height = 180;
+        c->start = vds::start_model(c->model_arena, p, n, vc, c->mesh, c->view, &c->cap);
+        if (c->start != Status::ok) return vds::ChunkResult::abort;
+      }
+      if (c->mesh.consume(type, p, n) != Status::ok) return vds::ChunkResult::abort;
+      if (c->shown.due(c->mesh)) {
+        c->crc = 0;
+        auto band = [](void* ctx, const vds::Band& b) {
+          auto* cc = static_cast<SmallClient*>(ctx);
+          for (uint16_t y = 0; y < b.height; ++y)
+            cc->crc = vds::crc32c_update(cc->crc, reinterpret_cast<const uint8_t*>(b.pixels) + y * b.stride,
+                                         size_t{b.width} * 2);
+          return true;
+        };
+        if (c->view.draw(c->mesh.mesh(), c->shown.angle(), band, c) != Status::ok) return vds::ChunkResult::abort;
+        c->shown.mark_drawn(c->mesh);
+        c->crcs.push_back(c->crc);
+        c->vertices.push_back(c->mesh.mesh().vertex_count());
+      }
+      return vds::ChunkResult::consumed;
+    };
+    if (parser.init(chunk_arena, 1u << 15, sink) != Status::ok) return Status::invalid_argument;
+    Status st = parser.feed(s.data(), s.size());
+    if (st == Status::more_input) st = parser.finish();
+    return st;
+  }
+};
+
+TEST(ModelView, ASmallClientShowsTheLevelsThatFit) {
+  const std::vector<uint8_t> s = golden_mesh_stream();
+  const std::vector<uint32_t> full_crcs = vds::enc::client_frame_crcs(s);
+  SmallClient full(8u << 20);
+  ASSERT_EQ(full.play(s), Status::ok);
+  ASSERT_EQ(full.crcs, full_crcs) << "the same frames as the host replay";
+  ASSERT_TRUE(full.mesh.complete());
+  const vds::MeshHeader h = full.mesh.header();
+  ASSERT_EQ(full.cap.vertices, h.vertices);
+  const size_t base_bytes = [&] {
+    vds::ModelCapacity c;
+    vds::ModelViewConfig vc;
+    vc.width = 240;
+    vc.height = 180;
+    EXPECT_EQ(vds::plan_model_capacity(h, vc, 0, &c), Status::workspace_too_small);
+    return c.bytes;
+  }();
+  ASSERT_GT(base_bytes, 0u);
+  ASSERT_LT(base_bytes, full.cap.bytes);
+
+  // Budgets from the base's need up to the full model's: each client shows
+  // the full replay's first frames, one per level that fits, and stops only
+  // where the next level's vertices exceed what it planned for.
+  size_t sizes_seen = 0;
+  for (size_t bytes = base_bytes; bytes < full.cap.bytes + 64; bytes += (full.cap.bytes - base_bytes) / 23 + 1) {
+    SmallClient c(bytes);
+    ASSERT_EQ(c.play(s), Status::ok) << bytes << " bytes";
+    EXPECT_LE(c.cap.bytes, bytes);
+    EXPECT_LE(c.model_arena.high_water(), bytes);
+    const uint32_t levels = c.mesh.levels_done();
+    ASSERT_EQ(c.crcs.size(), levels + 1u) << bytes << " bytes";
+    for (size_t i = 0; i < c.crcs.size(); ++i) EXPECT_EQ(c.crcs[i], full_crcs[i]) << bytes << " bytes, frame " << i;
+    EXPECT_EQ(c.mesh.capacity_reached(), levels < h.levels);
+    if (levels < h.levels) EXPECT_GT(full.vertices[levels + 1], c.cap.vertices) << bytes << " bytes";
+    if (c.crcs.size() != full_crcs.size()) ++sizes_seen;
+  }
+  EXPECT_GE(sizes_seen, 10u) << "the sweep should cover many partial clients";
+
+  // Below the base: refused at MSHH with what the base needs.
+  SmallClient none(base_bytes - 1);
+  EXPECT_EQ(none.play(s), Status::aborted);
+  EXPECT_EQ(none.start, Status::workspace_too_small);
+  EXPECT_EQ(none.cap.bytes, base_bytes);
+  EXPECT_TRUE(none.crcs.empty());
 }
 
 TEST(ModelView, RefusesWhatItCannotDraw) {

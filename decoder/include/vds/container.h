@@ -98,6 +98,12 @@ struct ChunkSink {
   // Every verified chunk after HEAD except END. The payload pointer is valid
   // only during the call. A null callback skips every chunk as unknown.
   ChunkResult (*on_chunk)(void* ctx, uint32_t type, const uint8_t* payload, uint32_t size) = nullptr;
+  // A model stream is progressive: a client can stop refining where its
+  // workspace ends. With this set, a model stream whose HEAD workspace_bytes
+  // (its full resolution) exceed what the arena has left is passed on
+  // anyway, and the sink decides what it holds (vds/model_view.h,
+  // plan_model_capacity). Other streams are refused as always.
+  bool model_prefix = false;
 };
 
 // Pull-style input for StreamParser::pump: fills up to `max` bytes and
@@ -108,7 +114,8 @@ class StreamParser {
  public:
   // Carves the chunk buffer (chunk_capacity bytes) from the arena; a stream
   // whose max_chunk_payload exceeds it, or whose workspace_bytes exceed what
-  // the arena has left, is refused with workspace_too_small.
+  // the arena has left (unless ChunkSink::model_prefix lets a model stream
+  // through), is refused with workspace_too_small.
   Status init(Arena& arena, uint32_t chunk_capacity, const ChunkSink& sink);
 
   // Consumes bytes. Returns more_input while the stream is unfinished, ok

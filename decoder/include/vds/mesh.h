@@ -299,9 +299,11 @@ class MeshDecoder {
   static size_t workspace_bytes(uint32_t max_vertices, uint32_t max_triangles, uint32_t max_base_triangles,
                                 MeshCoder coder);
 
-  // Carves the mesh, the contexts and the split flags from `arena`; the
-  // Huffman tables and the base scratch are carved when MSHH / the base
-  // arrive (workspace_too_small then if the arena cannot hold them).
+  // Carves the mesh, the contexts and the split flags from `arena` for a
+  // mesh of up to max_vertices / max_triangles (the stream's full counts, or
+  // fewer: see capacity_reached()); the Huffman tables and the base scratch
+  // are carved when MSHH / the base arrive (workspace_too_small then if the
+  // arena cannot hold them).
   Status init(Arena& arena, uint32_t max_vertices, uint32_t max_triangles);
 
   // True for the chunk types this decoder consumes.
@@ -311,7 +313,8 @@ class MeshDecoder {
   // Consumes one verified chunk payload (MSHH, then MSHB chunks, then MSHL
   // chunks level by level). The first error is latched and returned again.
   Status consume(uint32_t type, const uint8_t* payload, uint32_t size);
-  // ok once every level of the header is in; truncated before that.
+  // ok once every level of the header is in, or once the workspace is full
+  // (capacity_reached()); truncated before that.
   Status finish() const;
 
   Status status() const { return status_; }
@@ -322,6 +325,10 @@ class MeshDecoder {
   // Complete levels applied after the base.
   uint32_t levels_done() const { return levels_done_; }
   bool complete() const { return base_done_ && levels_done_ == header_.levels; }
+  // A level did not fit init's counts: the mesh stays at levels_done() and
+  // every later level chunk is skipped unread. Only the base has to fit
+  // (workspace_too_small otherwise), so a small client plays a prefix.
+  bool capacity_reached() const { return full_; }
   const MeshState& mesh() const { return mesh_; }
   // Numbers of the level completed last (level 0 = the base).
   const MeshLevelInfo& last_level() const { return last_; }
@@ -355,6 +362,7 @@ class MeshDecoder {
   Status status_ = Status::invalid_argument;
   bool have_header_ = false;
   bool base_done_ = false;
+  bool full_ = false;
   uint32_t base_items_ = 0;  // base items decoded
   uint32_t base_next_ = 0;   // next base vertex a triangle may introduce
   uint32_t levels_done_ = 0;

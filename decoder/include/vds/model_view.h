@@ -65,6 +65,33 @@ class ModelView {
   bool ready_ = false;
 };
 
+// --- What a client holds of a model stream ----------------------------------------
+// A model stream is progressive, so a client smaller than HEAD's
+// workspace_bytes (the full resolution) can still play it: up to the last
+// level that fits, with later levels skipped (MeshDecoder::capacity_reached).
+struct ModelCapacity {
+  uint32_t vertices = 0;   // the most the mesh holds
+  uint32_t triangles = 0;  // the most any level with that many vertices has
+  size_t bytes = 0;        // what the mesh decoder and the view carve for them
+};
+
+// The most a client with `bytes` of workspace holds of the model whose mesh
+// header is `h`: MeshDecoder::init, its Huffman tables and base scratch, and
+// ModelView::init, all for `vertices` and `triangles` = base triangles plus
+// two per vertex above the base (no split adds more), at most the stream's
+// counts and 65,536 vertices (the view's limit). workspace_too_small when not
+// even the base fits (then `out->bytes` is what the base needs),
+// unsupported_feature for a base above the view's limit, invalid_argument for
+// a bad configuration.
+Status plan_model_capacity(const MeshHeader& h, const ModelViewConfig& cfg, size_t bytes, ModelCapacity* out);
+
+// A client's set-up when a model stream's MSHH arrives (pass it to
+// mesh.consume() next): parses it, plans for what `arena` has left, then
+// initialises `mesh` and `view` for that capacity. The status of the first
+// step that fails; `cap` says what was planned.
+Status start_model(Arena& arena, const uint8_t* mshh, uint32_t size, const ModelViewConfig& cfg, MeshDecoder& mesh,
+                   ModelView& view, ModelCapacity* cap);
+
 // When the model mode draws, for the client firmware, its host replay
 // (`vds frames`) and the mesh benchmark alike: once the base mesh is in and
 // after every level completed since the previous frame, with the camera a
