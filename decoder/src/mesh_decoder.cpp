@@ -53,7 +53,7 @@ bool marked(const uint8_t* marks, uint32_t v) { return (marks[v >> 3] >> (v & 7)
 
 }  // namespace
 
-void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderBytes]) {
+void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderViewBytes]) {
   out[0] = h.version;
   out[1] = static_cast<uint8_t>(h.coder);
   out[2] = static_cast<uint8_t>(h.predictor);
@@ -66,6 +66,10 @@ void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderBytes]) {
   wr_u32(out + 20, h.triangles);
   for (int k = 0; k < 3; ++k) wr_u32(out + 24 + 4 * k, h.origin_f32[k]);
   wr_u32(out + 36, h.step_f32);
+  if (h.up != MeshUp::y_plus) {
+    out[40] = static_cast<uint8_t>(h.up);
+    out[41] = out[42] = out[43] = 0;
+  }
 }
 
 Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out) {
@@ -87,6 +91,12 @@ Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out) 
   h.triangles = rd_u32(p + 20);
   for (int k = 0; k < 3; ++k) h.origin_f32[k] = rd_u32(p + 24 + 4 * k);
   h.step_f32 = rd_u32(p + 36);
+  // The view block: absent (+y up), or the up axis and three zero bytes.
+  if (size != kMeshHeaderBytes) {
+    if (size < kMeshHeaderViewBytes || p[41] != 0 || p[42] != 0 || p[43] != 0) return Status::malformed;
+    if (p[40] > static_cast<uint8_t>(MeshUp::x_minus)) return Status::unsupported_feature;
+    h.up = static_cast<MeshUp>(p[40]);
+  }
   if (h.bits < 2 || h.bits > 16) return Status::malformed;
   if (h.max_degree < 3) return Status::malformed;
   if (h.max_degree > kMeshMaxDegree) return Status::unsupported_feature;

@@ -75,9 +75,18 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
   const uint32_t theta = static_cast<uint32_t>(angle) << 16;
   const int32_t st = sin_q2_30(theta).raw(), ct = cos_q2_30(theta).raw();
   const int32_t sp = sin_q2_30(kElevation).raw(), cp = cos_q2_30(kElevation).raw();
-  const int32_t rows[3][3] = {{ct, 0, -st},
-                              {mul_q30(sp, st), -cp, mul_q30(sp, ct)},
-                              {-mul_q30(cp, st), -sp, -mul_q30(cp, ct)}};
+  const int32_t view_rows[3][3] = {{ct, 0, -st},
+                                   {mul_q30(sp, st), -cp, mul_q30(sp, ct)},
+                                   {-mul_q30(cp, st), -sp, -mul_q30(cp, ct)}};
+  // Those rows act on view axes (y up); the grid's axes reach them by a
+  // rotation that takes the stream's up axis to y: view axis k is
+  // sign[k] times grid axis axis[k], so rows = view_rows x that rotation.
+  static constexpr int8_t kAxis[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {0, 1, 2}, {0, 2, 1}, {1, 0, 2}};
+  static constexpr int8_t kSign[6][3] = {{1, 1, 1}, {1, 1, -1}, {-1, 1, 1}, {-1, -1, 1}, {1, -1, 1}, {1, -1, 1}};
+  const uint32_t u = static_cast<uint32_t>(cfg_.up) < 6 ? static_cast<uint32_t>(cfg_.up) : 0;
+  int32_t rows[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) rows[i][kAxis[u][k]] = kSign[u][k] * view_rows[i][k];
   Camera cam;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) cam.rotation.m[i][j] = Q2_30::from_raw(rows[i][j]);
@@ -240,9 +249,11 @@ Status start_model(Arena& arena, const uint8_t* mshh, uint32_t size, const Model
   MeshHeader h;
   Status s = mesh_header_from_bytes(mshh, size, &h);
   if (s != Status::ok) return s;
-  if ((s = plan_model_capacity(h, cfg, arena.remaining(), c)) != Status::ok) return s;
+  ModelViewConfig vc = cfg;
+  vc.up = h.up;
+  if ((s = plan_model_capacity(h, vc, arena.remaining(), c)) != Status::ok) return s;
   if ((s = mesh.init(arena, c->vertices, c->triangles)) != Status::ok) return s;
-  return view.init(cfg, arena, c->vertices, c->triangles);
+  return view.init(vc, arena, c->vertices, c->triangles);
 }
 
 }  // namespace vds

@@ -22,6 +22,7 @@ struct EncodeMeshOptions {
   int levels = 0;
   std::string coder = "arith";
   std::string predictor = "area";
+  std::string up = "+y";
   bool paper = false;
   double max_error = -1;
   double removal_ratio = -1;
@@ -51,6 +52,8 @@ void run_encode_mesh(const EncodeMeshOptions& o) {
     else
       throw Failure(kExitUsage, "--predictor must be area, parallelogram or laplacian, not '" + o.predictor + "'");
   }
+  if (!enc::mesh_up_from_name(o.up, &e.up))
+    throw Failure(kExitUsage, "--up must be +y, +z, +x, -y, -z or -x (or y, z, x), not '" + o.up + "'");
   if (o.levels > 0) e.simplify.max_levels = o.levels;
   if (o.max_error > 0) e.simplify.max_error = o.max_error;
   if (o.removal_ratio > 0) e.simplify.removal_ratio = o.removal_ratio;
@@ -75,10 +78,11 @@ void run_encode_mesh(const EncodeMeshOptions& o) {
   enc::write_file(o.output, r.stream);
   if (o.quiet) return;
   std::printf("%s", report.summary().c_str());
-  std::printf("%s: %zu bytes, %u-bit grid, %s coder, %s predictor, base %u vertices (%.2f %%), %zu levels\n",
+  std::printf("%s: %zu bytes, %u-bit grid, %s coder, %s predictor, base %u vertices (%.2f %%), %zu levels, up %s\n",
               o.output.c_str(), r.stream.size(), e.bits, e.coder == MeshCoder::arith ? "arithmetic" : "Huffman",
               vds::enc::mesh_predictor_name(e.predictor), r.mesh_header.base_vertices,
-              100.0 * r.mesh_header.base_vertices / r.mesh_header.vertices, r.levels.size() - 1);
+              100.0 * r.mesh_header.base_vertices / r.mesh_header.vertices, r.levels.size() - 1,
+              enc::mesh_up_name(e.up));
   std::printf("%s", enc::format_mesh_table(r.levels, r.stream.size()).c_str());
   const double nv = r.mesh_header.vertices;
   std::printf("bits/vertex: split flags %.2f, arc %.2f, rotation %.2f, positions %.2f, base %.2f\n",
@@ -103,6 +107,10 @@ void add_encode_mesh(CLI::App& app) {
   sub->add_option("--coder", o->coder, "arith (context-adaptive arithmetic) or huffman (the paper's)")
       ->capture_default_str();
   sub->add_option("--predictor", o->predictor, "area (the ring's area centroid) or parallelogram (its vertex centroid), moved toward the parallelogram predictions by a per-level weight; or laplacian (the paper's eq. 13)")
+      ->capture_default_str();
+  sub->add_option("--up", o->up,
+                  "The model's up axis, for viewers: +y (default, as glTF), +z (common in CAD and scans), +x, -y, -z "
+                  "or -x; stored in the stream, positions unchanged")
       ->capture_default_str();
   sub->add_flag("--paper", o->paper,
                 "The paper's choices throughout: Huffman, Laplacian predictor, priority of eq. 1 only");

@@ -703,6 +703,7 @@ MeshEncodeResult Encoder::run() {
   MeshHeader mh;
   mh.coder = opt_.coder;
   mh.predictor = opt_.predictor;
+  mh.up = opt_.up;
   mh.bits = static_cast<uint8_t>(opt_.bits);
   if (levels > 0xFFFF) throw std::invalid_argument("encode_mesh: too many levels");
   mh.levels = static_cast<uint16_t>(levels);
@@ -727,9 +728,9 @@ MeshEncodeResult Encoder::run() {
   if (ws > 0xFFFFFFFFu) throw std::invalid_argument("encode_mesh: mesh too large for a client workspace");
   hdr.workspace_bytes = static_cast<uint32_t>(ws);
   StreamWriter w(hdr);
-  uint8_t mhb[kMeshHeaderBytes];
+  uint8_t mhb[kMeshHeaderViewBytes];
   mesh_header_to_bytes(mh, mhb);
-  w.add_chunk(chunk::kMeshHeader, std::span<const uint8_t>(mhb, kMeshHeaderBytes));
+  w.add_chunk(chunk::kMeshHeader, std::span<const uint8_t>(mhb, mesh_header_size(mh)));
 
   ctx_.reset();
   res.levels.resize(levels + 1);
@@ -761,7 +762,7 @@ MeshEncodeResult Encoder::run() {
   res.mesh_header = mh;
   res.quantisation = quant_;
   res.fixed_bytes = kPreambleBytes + (kChunkHeadBytes + kHeaderPayloadV1 + kChunkTailBytes) +
-                    (kChunkHeadBytes + kMeshHeaderBytes + kChunkTailBytes) + (kChunkHeadBytes + 4 + kChunkTailBytes);
+                    (kChunkHeadBytes + mesh_header_size(mh) + kChunkTailBytes) + (kChunkHeadBytes + 4 + kChunkTailBytes);
   res.vertex_order = orig_of_;
   res.max_degree = mh.max_degree;
   res.error_limit = sr.error_limit;
@@ -790,6 +791,22 @@ SimplifyOptions mesh_simplify_options(const MeshEncodeOptions& o) {
   so.max_degree = std::min<int>(so.max_degree, static_cast<int>(kMeshMaxDegree) - 2);
   so.area_centroid = o.predictor == MeshPredictor::area;
   return so;
+}
+
+const char* mesh_up_name(MeshUp up) {
+  static const char* const kNames[6] = {"+y", "+z", "+x", "-y", "-z", "-x"};
+  const auto i = static_cast<size_t>(up);
+  return i < 6 ? kNames[i] : "unknown";
+}
+
+bool mesh_up_from_name(const std::string& name, MeshUp* up) {
+  const std::string n = name.size() == 1 ? "+" + name : name;
+  for (uint8_t i = 0; i < 6; ++i)
+    if (n == mesh_up_name(static_cast<MeshUp>(i))) {
+      *up = static_cast<MeshUp>(i);
+      return true;
+    }
+  return false;
 }
 
 const char* mesh_predictor_name(MeshPredictor p) {
@@ -915,10 +932,11 @@ std::string MeshChunkSummary::table() const {
     r.triangles = t;
   }
   char line[200];
-  std::snprintf(line, sizeof line, "progressive mesh: %u-bit grid, %s coder, %s predictor, %u levels, max degree %u\n",
+  std::snprintf(line, sizeof line,
+                "progressive mesh: %u-bit grid, %s coder, %s predictor, %u levels, max degree %u, up %s\n",
                 header_.bits, header_.coder == MeshCoder::arith ? "arithmetic" : "Huffman",
-                mesh_predictor_name(header_.predictor), header_.levels,
-                header_.max_degree);
+                mesh_predictor_name(header_.predictor), header_.levels, header_.max_degree,
+                mesh_up_name(header_.up));
   uint64_t bytes = 0;
   for (const MeshLevelStats& r : rows) bytes += r.chunk_bytes;
   return std::string(line) + format_mesh_table(rows, bytes) +

@@ -89,6 +89,7 @@ void draw_frame_if_due() {
   if (!g_run.view_ready || !g_run.shown.due(g_run.decoder)) return;
   g_run.frame_crc = 0;
   const uint64_t t0 = board::instructions();
+  g_run.view.set_up(g_run.decoder.header().up);  // the stream's up axis, as the client shows it
   const Status s = g_run.view.draw(g_run.decoder.mesh(), g_run.shown.angle(), on_frame_band, nullptr);
   g_run.last_draw = board::instructions() - t0;
   g_run.draw_instructions += g_run.last_draw;

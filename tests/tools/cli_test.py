@@ -85,5 +85,19 @@ check(code == 2 and "--size" in err, "bad size is a usage error")
 code, out, err = run("pack", "-o", stream, "--max-chunk", "100", "--chunk", f"DATA={payload}")
 check(code == 1 and "do not fit" in err and os.path.getsize(stream) == before, "oversized chunk refused, output untouched")
 
+# A model with its up axis: stored in MSHH, shown by `info`; a bad axis is a
+# usage error that writes nothing.
+obj = os.path.join(TMP, "cli_octahedron.obj")
+with open(obj, "w") as f:
+    f.write("v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n"
+            "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n")
+model = os.path.join(TMP, "cli_model.vds")
+code, out, err = run("encode-mesh", obj, "-o", model, "--up", "z")
+check(code == 0 and "up +z" in out, "encode-mesh --up z reports the axis")
+code, out, err = run("info", model)
+check(code == 0 and "up +z" in out, "info shows the stored up axis")
+code, out, err = run("encode-mesh", obj, "-o", model + ".bad", "--up", "w")
+check(code == 2 and "--up must be" in err and not os.path.exists(model + ".bad"), "a bad --up is refused, nothing written")
+
 print(f"{len(failures)} failed" if failures else "all CLI checks passed")
 sys.exit(1 if failures else 0)

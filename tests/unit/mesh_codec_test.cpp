@@ -463,12 +463,14 @@ TEST(MeshCodec, HeaderChecks) {
   h.vertices = 10;
   h.triangles = 16;
   h.levels = 3;
-  uint8_t b[vds::kMeshHeaderBytes];
+  uint8_t b[vds::kMeshHeaderViewBytes] = {};
+  ASSERT_EQ(vds::mesh_header_size(h), vds::kMeshHeaderBytes);  // +y up: no view block
   vds::mesh_header_to_bytes(h, b);
   vds::MeshHeader out;
-  EXPECT_EQ(vds::mesh_header_from_bytes(b, sizeof b, &out), Status::ok);
+  EXPECT_EQ(vds::mesh_header_from_bytes(b, vds::kMeshHeaderBytes, &out), Status::ok);
   EXPECT_EQ(out.vertices, 10u);
-  EXPECT_EQ(vds::mesh_header_from_bytes(b, sizeof b - 1, &out), Status::malformed);
+  EXPECT_EQ(out.up, vds::MeshUp::y_plus);
+  EXPECT_EQ(vds::mesh_header_from_bytes(b, vds::kMeshHeaderBytes - 1, &out), Status::malformed);
   auto bad = [&](int at, uint8_t v) {
     uint8_t c[vds::kMeshHeaderBytes];
     std::memcpy(c, b, sizeof c);
@@ -482,6 +484,27 @@ TEST(MeshCodec, HeaderChecks) {
   EXPECT_EQ(bad(3, 17), Status::malformed);
   EXPECT_EQ(bad(7, 0x7F), Status::unsupported_feature);  // max degree far above the build's
   EXPECT_EQ(bad(4, 0), Status::malformed);               // no levels but more vertices than the base
+
+  // The view block: every up axis round-trips in 44 bytes.
+  for (uint8_t u = 0; u < 6; ++u) {
+    h.up = static_cast<vds::MeshUp>(u);
+    uint8_t v[vds::kMeshHeaderViewBytes + 1] = {};
+    vds::mesh_header_to_bytes(h, v);
+    const uint32_t n = vds::mesh_header_size(h);
+    EXPECT_EQ(n, u == 0 ? vds::kMeshHeaderBytes : vds::kMeshHeaderViewBytes);
+    ASSERT_EQ(vds::mesh_header_from_bytes(v, n, &out), Status::ok);
+    EXPECT_EQ(out.up, h.up);
+  }
+  uint8_t v[vds::kMeshHeaderViewBytes + 1] = {};
+  vds::mesh_header_to_bytes(h, v);  // -x
+  EXPECT_EQ(vds::mesh_header_from_bytes(v, vds::kMeshHeaderViewBytes + 1, &out), Status::ok);  // a later extension
+  for (uint32_t n = vds::kMeshHeaderBytes + 1; n < vds::kMeshHeaderViewBytes; ++n)
+    EXPECT_EQ(vds::mesh_header_from_bytes(v, n, &out), Status::malformed) << n;  // a cut view block
+  v[42] = 1;
+  EXPECT_EQ(vds::mesh_header_from_bytes(v, vds::kMeshHeaderViewBytes, &out), Status::malformed);  // not zero
+  v[42] = 0;
+  v[40] = 6;
+  EXPECT_EQ(vds::mesh_header_from_bytes(v, vds::kMeshHeaderViewBytes, &out), Status::unsupported_feature);
 }
 
 TEST(MeshCodec, Varints) {

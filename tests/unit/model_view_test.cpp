@@ -170,6 +170,85 @@ TEST(ModelView, ASmallClientShowsTheLevelsThatFit) {
   EXPECT_TRUE(none.crcs.empty());
 }
 
+// The golden mesh, and the same mesh turned so that its +y is the grid's
+// +z (grid (x, y, z) -> (x, K - z, y), exact in integers), each in a
+// MeshState of its own.
+struct TurnedMeshes {
+  std::vector<uint8_t> ws = std::vector<uint8_t>(4u << 20);
+  vds::Arena arena{ws.data(), ws.size()};
+  vds::MeshState upright, turned;
+};
+
+void build_turned(TurnedMeshes& t) {
+  SmallClient c(4u << 20);
+  ASSERT_EQ(c.play(golden_mesh_stream()), Status::ok);
+  const vds::MeshState& m = c.mesh.mesh();
+  const int k = (1 << m.bits()) - 1;
+  for (vds::MeshState* s : {&t.upright, &t.turned}) {
+    ASSERT_EQ(s->init(t.arena, m.vertex_count(), m.triangle_count()), Status::ok);
+    s->clear(m.bits());
+    for (uint32_t v = 0; v < m.vertex_count(); ++v) {
+      const uint16_t* p = m.positions() + 3 * v;
+      const int32_t q[3] = {p[0], p[1], p[2]};
+      const int32_t r[3] = {p[0], k - p[2], p[1]};
+      ASSERT_EQ(s->add_vertex(s == &t.upright ? q : r), Status::ok);
+    }
+    for (uint32_t f = 0; f < m.triangle_count(); ++f) {
+      const uint32_t* c3 = m.triangles() + 3 * f;
+      ASSERT_EQ(s->add_triangle(c3[0], c3[1], c3[2]), Status::ok);
+    }
+    ASSERT_EQ(s->finish_base(t.arena, 64), Status::ok);
+  }
+}
+
+std::vector<uint16_t> frame_pixels(vds::ModelView& view, const vds::MeshState& m, uint16_t angle) {
+  std::vector<uint16_t> px;
+  auto band = [](void* ctx, const vds::Band& b) {
+    auto* out = static_cast<std::vector<uint16_t>*>(ctx);
+    for (uint16_t y = 0; y < b.height; ++y) {
+      const auto* row = reinterpret_cast<const uint16_t*>(reinterpret_cast<const uint8_t*>(b.pixels) + y * b.stride);
+      out->insert(out->end(), row, row + b.width);
+    }
+    return true;
+  };
+  EXPECT_EQ(view.draw(m, angle, band, &px), Status::ok);
+  return px;
+}
+
+// Fraction of pixels that differ.
+double differ(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b) {
+  EXPECT_EQ(a.size(), b.size());
+  size_t n = 0;
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i) n += a[i] != b[i];
+  return a.empty() ? 1.0 : double(n) / double(a.size());
+}
+
+TEST(ModelView, TheStreamsUpAxisIsShownUp) {
+  TurnedMeshes t;
+  build_turned(t);
+  vds::ModelViewConfig cfg;
+  cfg.width = 240;
+  cfg.height = 180;
+  std::vector<uint8_t> ws(vds::ModelView::workspace_bytes(cfg, t.upright.vertex_count(), t.upright.triangle_count()));
+  vds::Arena arena(ws.data(), ws.size());
+  vds::ModelView view;
+  ASSERT_EQ(view.init(cfg, arena, t.upright.vertex_count(), t.upright.triangle_count()), Status::ok);
+  for (uint16_t angle : {0, 5000, 40000}) {
+    view.set_up(vds::MeshUp::y_plus);
+    const std::vector<uint16_t> upright = frame_pixels(view, t.upright, angle);
+    EXPECT_GT(differ(frame_pixels(view, t.turned, angle), upright), 0.05) << "the turned mesh shown +y up";
+    // Shown +z up it is the upright picture, up to the rounding of
+    // arithmetic shifts of negated coordinates (a pixel here and there).
+    view.set_up(vds::MeshUp::z_plus);
+    EXPECT_LT(differ(frame_pixels(view, t.turned, angle), upright), 0.002) << "angle " << angle;
+    // Every other axis gives a picture of its own.
+    for (vds::MeshUp u : {vds::MeshUp::x_plus, vds::MeshUp::y_minus, vds::MeshUp::z_minus, vds::MeshUp::x_minus}) {
+      view.set_up(u);
+      EXPECT_GT(differ(frame_pixels(view, t.turned, angle), upright), 0.05) << static_cast<int>(u);
+    }
+  }
+}
+
 TEST(ModelView, RefusesWhatItCannotDraw) {
   vds::ModelViewConfig cfg;
   cfg.width = 64;

@@ -59,6 +59,11 @@ enum class MeshPredictor : uint8_t {
   area = 2,           // the same with the ring's area centroid in place of its vertex centroid
 };
 
+// Which grid axis points up when the model is shown (MSHH's view block;
+// streams without one are +y, as glTF). A viewer hint only: the decoded
+// positions are the same either way.
+enum class MeshUp : uint8_t { y_plus = 0, z_plus = 1, x_plus = 2, y_minus = 3, z_minus = 4, x_minus = 5 };
+
 // MSHH payload (docs/stream-format.md).
 struct MeshHeader {
   uint8_t version = kMeshCodecVersion;
@@ -75,9 +80,15 @@ struct MeshHeader {
   // as IEEE-754 binary32 bit patterns. The client never interprets them.
   uint32_t origin_f32[3] = {0, 0, 0};
   uint32_t step_f32 = 0;
+  MeshUp up = MeshUp::y_plus;  // the view block, present when not +y
 };
-constexpr uint32_t kMeshHeaderBytes = 40;
-void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderBytes]);
+constexpr uint32_t kMeshHeaderBytes = 40;      // without the view block
+constexpr uint32_t kMeshHeaderViewBytes = 44;  // with it: up axis, three zero bytes
+// Bytes mesh_header_to_bytes writes for `h`: 40, or 44 when up is not +y.
+constexpr uint32_t mesh_header_size(const MeshHeader& h) {
+  return h.up == MeshUp::y_plus ? kMeshHeaderBytes : kMeshHeaderViewBytes;
+}
+void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderViewBytes]);
 Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out);
 
 // LEB128 unsigned varints as used in the mesh chunk headers (at most 5

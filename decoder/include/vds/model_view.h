@@ -5,7 +5,8 @@
 //
 // Framing depends only on the quantisation grid, not on the current level,
 // so the model keeps its size and place while it refines: the grid's centre
-// is the origin, 2^bits grid steps span two world units, y is up, and the
+// is the origin, 2^bits grid steps span two world units, the stream's up
+// axis (MeshUp, +y unless MSHH says otherwise) is up, and the
 // camera sits 3.2 units from the centre, 20 degrees above the horizon,
 // looking at it. Shading is per vertex (Gouraud): an ambient term plus a
 // two-sided diffuse term from a light above and to the left of the camera,
@@ -34,6 +35,8 @@ struct ModelViewConfig {
   uint32_t vertex_cache = UINT32_MAX;
   uint32_t triangle_cache = UINT32_MAX;
   uint32_t setup_cache = 16;
+  // The grid axis shown up (the stream's MSHH says; start_model sets it).
+  MeshUp up = MeshUp::y_plus;
   uint32_t surface_rgb = 0xD8C8A8;    // 0x00RRGGBB at full light
   uint32_t background_rgb = 0x182028;
 };
@@ -53,6 +56,8 @@ class ModelView {
   // invalid_argument before init or for a mesh larger than init's counts.
   Status draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx);
 
+  // Changes the axis shown up for later frames (e.g. once MSHH is in).
+  void set_up(MeshUp up) { cfg_.up = up; }
   const RenderStats& stats() const { return renderer_.stats(); }
 
  private:
@@ -87,7 +92,8 @@ Status plan_model_capacity(const MeshHeader& h, const ModelViewConfig& cfg, size
 
 // A client's set-up when a model stream's MSHH arrives (pass it to
 // mesh.consume() next): parses it, plans for what `arena` has left, then
-// initialises `mesh` and `view` for that capacity. The status of the first
+// initialises `mesh` and `view` for that capacity, the view with the
+// stream's up axis in place of cfg.up. The status of the first
 // step that fails; `cap` says what was planned.
 Status start_model(Arena& arena, const uint8_t* mshh, uint32_t size, const ModelViewConfig& cfg, MeshDecoder& mesh,
                    ModelView& view, ModelCapacity* cap);

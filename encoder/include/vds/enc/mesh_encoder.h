@@ -31,6 +31,7 @@ struct MeshEncodeOptions {
   SimplifyOptions simplify;
   uint32_t max_chunk_payload = 4096;  // >= 512
   uint16_t width = 240, height = 180;  // HEAD frame size (the client's display)
+  MeshUp up = MeshUp::y_plus;          // the axis a viewer shows up (MSHH's view block)
 };
 
 // The paper's choices: Huffman coding, the Laplacian predictor of eq. 13
@@ -47,6 +48,11 @@ SimplifyOptions mesh_simplify_options(const MeshEncodeOptions& o);
 
 // "Laplacian", "parallelogram" or "area", for tables and messages.
 const char* mesh_predictor_name(MeshPredictor p);
+
+// "+y", "+z", "+x", "-y", "-z", "-x"; mesh_up_from_name also takes them
+// without the sign for the positive axes, and returns false for anything else.
+const char* mesh_up_name(MeshUp up);
+bool mesh_up_from_name(const std::string& name, MeshUp* up);
 
 // One row of the per-level table; row 0 is the base mesh.
 struct MeshLevelStats {
