@@ -170,7 +170,10 @@ std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::ve
     auto* r = static_cast<Replay*>(ctx);
     r->width = h.width;
     r->height = h.height;
-    if (h.mode == StreamMode::model) return r->model = true;
+    if (h.mode == StreamMode::model) {
+      r->model = true;  // decoder and view are set up when MSHH arrives
+      return true;
+    }
     if (h.mode != StreamMode::images) return false;
     if (r->decoder.init(*r->arena) != Status::ok) return false;
     r->band.assign(static_cast<size_t>(h.width) * 16, 0);
