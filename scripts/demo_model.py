@@ -40,23 +40,22 @@ def cortex_m4_prefix(a, stream, want):
     with open(os.path.join(a.out, "serve_cortex_m4.log"), "w") as f:
         f.write(run.serve.stdout + run.serve.stderr + "\n== Cortex-M4 board\n" + run.board_log)
     got = sim.frame_crcs(run.serve.stdout)
-    held = re.search(r"the workspace holds (\d+) of its (\d+) vertices", run.board_log)
-    full = re.search(r"workspace full after level (\d+) of (\d+) \((\d+) vertices\)", run.board_log)
+    prefix = sim.model_prefix(run.board_log)
     budget = re.search(r"ready, workspace (\d+) bytes", run.board_log)
     failures = []
     if not run.ok:
         failures.append("Cortex-M4 board: " + (run.failure or f"the run failed (serve {run.serve.returncode})"))
-    if not full:
+    if not prefix:
         failures.append("the Cortex-M4 board did not report where its workspace ran out")
-    elif got != want[:int(full.group(1)) + 1]:
-        failures.append(f"the Cortex-M4 board's {len(got)} frames are not the replay's first {int(full.group(1)) + 1}")
-    if full and held and budget:
+    elif got != want[:prefix["level"] + 1]:
+        failures.append(f"the Cortex-M4 board's {len(got)} frames are not the replay's first {prefix['level'] + 1}")
+    if prefix and budget:
         print(f"The same stream at 115,200 baud to the client on the **Cortex-M4 board** (QEMU mps2-an386), "
-              f"whose {int(budget.group(1)) // 1024} KiB workspace holds {held.group(1)} of the "
-              f"{held.group(2)} vertices: it drew the base and levels 1-{full.group(1)} ({full.group(3)} vertices), "
-              f"{len(got)} frames, each identical to the replay's: "
+              f"whose {int(budget.group(1)) // 1024} KiB workspace holds {prefix['held']} of the "
+              f"{prefix['vertices']} vertices: it drew the base and levels 1-{prefix['level']} "
+              f"({prefix['level_vertices']} vertices), {len(got)} frames, each identical to the replay's: "
               f"{'yes' if not failures else 'NO'}; it received and checked the other "
-              f"{int(full.group(2)) - int(full.group(1))} levels and skipped them "
+              f"{prefix['levels'] - prefix['level']} levels and skipped them "
               f"(log: `out/demo/model/serve_cortex_m4.log`).\n")
     return failures
 

@@ -58,6 +58,19 @@ def frame_times_ms(serve_stdout):
     return [int(m.group(1)) for m in re.finditer(r"^\s*frame\s+\d+\s+crc\s+\S+.*\sat\s+(\d+)\s+ms", serve_stdout, re.M)]
 
 
+def model_prefix(board_log):
+    """Where a client too small for a model stopped, from its log: a dict with
+    the vertices its workspace holds and the stream's (`held`, `vertices`),
+    the last level it applied, the stream's levels and the vertices then
+    (`level`, `levels`, `level_vertices`); None if it held every level."""
+    full = re.search(r"workspace full after level (\d+) of (\d+) \((\d+) vertices\)", board_log)
+    held = re.search(r"the workspace holds (\d+) of its (\d+) vertices", board_log)
+    if not full or not held:
+        return None
+    return {"held": int(held.group(1)), "vertices": int(held.group(2)), "level": int(full.group(1)),
+            "levels": int(full.group(2)), "level_vertices": int(full.group(3))}
+
+
 def replay_crcs(vds, stream, png_dir=None):
     """The CRC of every frame a client must display (`vds frames`), or None if it fails."""
     cmd = [vds, "frames", stream] + (["--png", png_dir] if png_dir else [])

@@ -14,7 +14,6 @@ replay's frames up to the level where it reports its workspace full.
 Usage: e2e_boards.py --vds VDS --host-board EXE --qemu QEMU --elf ELF --work DIR
        [--frames N | --inputs IMAGE... | --stream VDS_STREAM] [--report FILE.json]"""
 import argparse
-import re
 import json
 import os
 import subprocess
@@ -119,11 +118,11 @@ def main():
         if a.prefix:
             # The client says where its workspace ran out; it shows the base
             # and every level up to there, as the replay does.
-            m = re.search(r"workspace full after level (\d+) of (\d+)", log)
-            if not m:
+            prefix = sim.model_prefix(log)
+            if not prefix:
                 failures.append(f"{name} board did not report a full workspace")
             else:
-                expect = want[:int(m.group(1)) + 1]
+                expect = want[:prefix["level"] + 1]
                 if len(expect) >= len(want):
                     failures.append(f"{name} board held every level: the stream does not test a prefix")
         if crcs != expect:
