@@ -187,6 +187,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     Pump pump(host, *b);
     const uint32_t t0 = monotonic_ms();
     uint32_t acked_at = 0;
+    uint32_t owed_at = 0;  // last time the client's stats showed frame records still to come
     std::optional<uint32_t> receipt_at, records_at;  // when the report, and then every frame record, had arrived
     constexpr uint32_t kLingerMs = 300;      // a few of the client's round trips
     constexpr uint32_t kRecordWaitMs = 5000;  // frame records missing after this are reported missing
@@ -216,8 +217,14 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
         if (all_records && !records_at) records_at = now;
         if ((records_at && now - *records_at > kLingerMs) || now - *receipt_at > kRecordWaitMs) break;
       }
-      // All acknowledged: wait briefly for the report (a client may not send one).
-      if (!srv.receipt && acked_at != 0 && now - acked_at > 2000) break;
+      // All acknowledged: wait briefly for the report (a client may not send
+      // one), counted from when the client stopped owing frame records: one
+      // whose stats show more frames than have arrived is still sending, and
+      // its report follows its records.
+      const bool records_owed = srv.have_stats && srv.stats.frames_shown > srv.frames.size();
+      if (records_owed) owed_at = now;
+      const uint32_t quiet_from = owed_at > acked_at ? owed_at : acked_at;
+      if (!srv.receipt && acked_at != 0 && !records_owed && now - quiet_from > 2000) break;
       if (o.timeout_s != 0 && now - t0 > o.timeout_s * 1000u)
         throw std::runtime_error(std::string(host.established() ? "the transfer did not finish" : "no client answered") +
                                  " within " + std::to_string(o.timeout_s) + " s on " + b->describe());
