@@ -37,7 +37,8 @@ constexpr uint32_t kBandRows = 16;          // one MCU row of a 4:2:0 image
 constexpr uint32_t kStatsPeriodMs = 1000;   // statistics datagram
 constexpr uint32_t kPendingRecords = 8;     // frame records waiting for the checksums channel
 constexpr size_t kStreamReadBytes = 256;    // stream bytes handed to the parser at a time
-constexpr uint32_t kDrainTimeoutMs = 20000;  // after the end, wait this long for the host's acks
+constexpr uint32_t kDrainTimeoutMs = 20000;  // after the report, wait at most this long for the host's Goodbye
+constexpr uint32_t kGoodbyeWaitMs = 3000;    // once the host has acknowledged everything, this long
 
 alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
 
@@ -84,6 +85,10 @@ struct Client {
   uint32_t pending_head = 0, pending_count = 0;
   bool done_sent = false;
   uint32_t last_stats_ms = 0;
+  // The host's Goodbye (control channel): it holds the report and records.
+  uint8_t control[link::kGoodbyeBytes];
+  size_t control_len = 0;
+  bool goodbye = false;
 };
 
 Client g;
@@ -302,6 +307,8 @@ Status start_stream() {
   g.late_frames = 0;
   g.pending_count = 0;
   g.done_sent = false;
+  g.control_len = 0;
+  g.goodbye = false;
   vds::ChunkSink sink;
   sink.on_header = on_header;
   sink.on_chunk = on_chunk;
@@ -377,6 +384,29 @@ void send_messages(uint32_t now) {
   }
 }
 
+// Reads the control channel for the host's Goodbye.
+void read_control() {
+  size_t n = 0;
+  while (!g.goodbye &&
+         g.link.read(link::channel::kControl, g.control + g.control_len, link::kGoodbyeBytes - g.control_len, &n) ==
+             Status::ok &&
+         n != 0) {
+    g.control_len += n;
+    if (g.control_len < link::kGoodbyeBytes) continue;
+    g.control_len = 0;
+    link::Goodbye bye{};
+    if (link::decode(g.control, link::kGoodbyeBytes, &bye) != Status::ok) {
+      board::log("client: a control message that is not a Goodbye was ignored\n");
+      continue;
+    }
+    g.goodbye = true;
+    Line l;
+    l.str("client: the host said goodbye: report ").str(bye.verified ? "verified" : "NOT verified").str(", ");
+    l.dec(bye.frame_records).str(" frame records received\n");
+    board::log(l.c_str());
+  }
+}
+
 }  // namespace
 
 // The firmware's entry point, called by each board's start-up code.
@@ -401,8 +431,8 @@ extern "C" int vds_app_main() {
 
   uint8_t rx[256];
   uint8_t tx[256];
-  bool done_timing = false;
-  uint32_t done_at = 0;
+  bool done_timing = false, drained_timing = false;
+  uint32_t done_at = 0, drained_at = 0;
   for (;;) {
     const uint32_t now = board::millis();
     bool busy = false;
@@ -420,22 +450,36 @@ extern "C" int vds_app_main() {
     }
     feed_stream();
     send_messages(now);
+    read_control();
     const size_t m = g.link.transmit(tx, sizeof tx, now);
     if (m) {
       board::uart_write(tx, m);
       busy = true;
     }
+    // The host has everything once it says goodbye: stop as soon as the
+    // acknowledgement of the Goodbye is on the line.
+    if (g.goodbye && m == 0) break;
     if (board::uart_closed()) {
       if (!g.done_sent) board::log("client: the host closed the link before the end of the stream\n");
       break;
     }
     if (g.done_sent) {
+      // No Goodbye yet: a host that says none (or whose Goodbye the line
+      // lost) is given a while after it has acknowledged every message,
+      // and every host the drain timeout.
       if (!done_timing) {
         done_timing = true;
         done_at = now;
       }
       const bool drained = g.link.unacked(link::channel::kChecksums) == 0 && g.link.unacked(link::channel::kControl) == 0;
-      if (drained || now - done_at > kDrainTimeoutMs) break;
+      if (drained && !drained_timing) {
+        drained_timing = true;
+        drained_at = now;
+      }
+      if ((drained_timing && now - drained_at > kGoodbyeWaitMs) || now - done_at > kDrainTimeoutMs) {
+        board::log("client: no goodbye from the host\n");
+        break;
+      }
     }
     if (!busy) board::wait_for_event(1);
   }

@@ -107,6 +107,8 @@ def main():
             failures.append(f"{name} board: {run.failure}")
         if not run.ok:
             failures.append(f"{name} board run failed (serve {run.serve.returncode}, board {run.board_rc})")
+        if "client: the host said goodbye: report verified" not in run.board_log:
+            failures.append(f"{name} board did not receive the host's Goodbye for a verified report")
     host_crcs = sim.frame_crcs(host.serve.stdout)
     qemu_crcs = sim.frame_crcs(qemu.serve.stdout)
     print(f"encoder  : {' '.join(want)}")

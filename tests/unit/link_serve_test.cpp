@@ -1,10 +1,12 @@
 // `vds serve` end to end (serve_stream): over the loopback with faults the
 // in-process client verifies every chunk and its end-of-stream report
 // matches; over a real pty a client thread running the link core does the
-// same.
+// same. Either way the host answers the report with a Goodbye that says
+// whether the report matched, and closes once the client acknowledged it.
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <thread>
 
 #include "vds/crc32c.h"
@@ -46,6 +48,9 @@ TEST(LinkServe, LoopbackClientVerifiesTheStream) {
   EXPECT_EQ(r.sessions, 1u);
   EXPECT_GT(r.host.retransmissions, 0u);
   EXPECT_GT(r.goodput, 0.5);
+  EXPECT_TRUE(r.client_goodbye);
+  EXPECT_TRUE(r.client_goodbye_verified);
+  EXPECT_TRUE(r.goodbye_acked);
 }
 
 TEST(LinkServe, RefusesWhatIsNotAStream) {
@@ -53,12 +58,18 @@ TEST(LinkServe, RefusesWhatIsNotAStream) {
   EXPECT_THROW(serve_stream(junk, ServeOptions{}), std::runtime_error);
 }
 
-TEST(LinkServe, OverAPtyToAClientThread) {
-  const std::vector<uint8_t> s = make_stream(8, 16000);
+// A client thread on a pty's master end: the link core, a DoneReport once
+// the whole stream is in (with the CRC spoiled when `lie` is set), then it
+// waits for the host's Goodbye and stops as the firmware does.
+struct PtyClientResult {
+  uint64_t got = 0;
+  bool goodbye = false;
+  Goodbye bye{};
+};
+
+ServeReport serve_to_pty_client(const std::vector<uint8_t>& s, bool lie, PtyClientResult* out) {
   PtyPair pty = open_pty_pair();
   std::atomic<bool> stop{false};
-  std::atomic<uint64_t> client_got{0};
-  // The client: the link core on the pty's master end, receipt when done.
   std::thread client([&] {
     const LinkConfig dc = device_config(77);
     std::vector<uint64_t> ws((link_workspace_size(dc) + 7) / 8);
@@ -66,26 +77,29 @@ TEST(LinkServe, OverAPtyToAClientThread) {
     Link dev;
     if (dev.init(dc, a) != Status::ok) return;
     Pump pump(dev, *pty.master);
-    uint64_t got = 0;
     uint32_t crc = 0;
     bool sent = false;
     uint8_t buf[1024];
+    uint8_t ctl[kGoodbyeBytes];
+    size_t ctl_len = 0;
     try {
-      while (!stop) {
+      while (!stop && !out->goodbye) {
         pump.step(monotonic_ms(), 1);
         size_t n = 0;
         while (dev.read(channel::kStream, buf, sizeof buf, &n) == Status::ok && n != 0) {
           crc = vds::crc32c_update(crc, buf, n);
-          got += n;
+          out->got += n;
         }
-        client_got = got;
-        if (!sent && got == s.size()) {
+        if (!sent && out->got == s.size()) {
           uint8_t r[kDoneReportBytes];
-          encode(DoneReport{0, 0, static_cast<uint32_t>(got), crc}, r);
+          encode(DoneReport{0, 0, static_cast<uint32_t>(out->got), lie ? crc ^ 1u : crc}, r);
           size_t acc = 0;
           sent = dev.write(channel::kControl, r, sizeof r, &acc) == Status::ok && acc == sizeof r;
         }
+        while (dev.read(channel::kControl, ctl + ctl_len, kGoodbyeBytes - ctl_len, &n) == Status::ok && n != 0)
+          if ((ctl_len += n) == kGoodbyeBytes) out->goodbye = decode(ctl, ctl_len, &out->bye) == Status::ok;
       }
+      pump.step(monotonic_ms(), 1);  // the Goodbye's acknowledgement
     } catch (const BackendError&) {
       // the host closed the pty
     }
@@ -95,12 +109,45 @@ TEST(LinkServe, OverAPtyToAClientThread) {
   o.baud = 921600;
   o.timeout_s = 30;
   ServeReport r;
-  EXPECT_NO_THROW(r = serve_stream(s, o));
+  try {
+    r = serve_stream(s, o);
+  } catch (...) {
+    stop = true;
+    client.join();
+    throw;
+  }
+  // The client stops on the Goodbye by itself; `stop` only ends a client
+  // that never got one (the assertions below then fail).
+  const uint32_t t0 = monotonic_ms();
+  while (!out->goodbye && monotonic_ms() - t0 < 3000) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   stop = true;
   client.join();
-  EXPECT_EQ(client_got.load(), s.size());
+  return r;
+}
+
+TEST(LinkServe, OverAPtyToAClientThread) {
+  const std::vector<uint8_t> s = make_stream(8, 16000);
+  PtyClientResult c;
+  ServeReport r;
+  EXPECT_NO_THROW(r = serve_to_pty_client(s, false, &c));
+  EXPECT_EQ(c.got, s.size());
   EXPECT_TRUE(r.receipt);
   EXPECT_FALSE(r.simulated);
+  ASSERT_TRUE(c.goodbye) << "the host answers the report with a Goodbye";
+  EXPECT_EQ(c.bye.verified, 1);
+  EXPECT_EQ(c.bye.frame_records, 0u);
+  EXPECT_TRUE(r.goodbye_acked) << "and closes once the client acknowledged it";
+}
+
+TEST(LinkServe, TheGoodbyeSaysWhenTheReportDoesNotMatch) {
+  const std::vector<uint8_t> s = make_stream(4, 8000);
+  PtyClientResult c;
+  ServeReport r;
+  EXPECT_NO_THROW(r = serve_to_pty_client(s, true, &c));
+  EXPECT_TRUE(r.report_seen);
+  EXPECT_FALSE(r.receipt) << "a report whose CRC differs from the stream's proves nothing";
+  ASSERT_TRUE(c.goodbye);
+  EXPECT_EQ(c.bye.verified, 0);
 }
 
 }  // namespace

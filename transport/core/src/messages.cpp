@@ -60,6 +60,14 @@ size_t encode(const DoneReport& m, uint8_t out[kDoneReportBytes]) {
   return kDoneReportBytes;
 }
 
+size_t encode(const Goodbye& m, uint8_t out[kGoodbyeBytes]) {
+  uint8_t* p = out;
+  *p++ = static_cast<uint8_t>(MessageType::goodbye);
+  *p++ = m.verified;
+  put32(p, m.frame_records);
+  return kGoodbyeBytes;
+}
+
 Status decode(const uint8_t* p, size_t n, FrameRecord* m) {
   if (m == nullptr || !opens(p, n, kFrameRecordBytes, MessageType::frame)) return Status::malformed;
   ++p;
@@ -98,6 +106,14 @@ Status decode(const uint8_t* p, size_t n, DoneReport* m) {
   m->frames_shown = get32(p);
   m->stream_bytes = get32(p);
   m->stream_crc = get32(p);
+  return Status::ok;
+}
+
+Status decode(const uint8_t* p, size_t n, Goodbye* m) {
+  if (m == nullptr || !opens(p, n, kGoodbyeBytes, MessageType::goodbye) || p[1] > 1) return Status::malformed;
+  ++p;
+  m->verified = *p++;
+  m->frame_records = get32(p);
   return Status::ok;
 }
 

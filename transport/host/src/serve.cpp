@@ -18,8 +18,8 @@ namespace vds::link {
 
 namespace {
 
-// Host side: writes the stream, restarting it with each new session, and
-// collects the client's end-of-stream report.
+// Host side: writes the stream, restarting it with each new session,
+// collects the client's end-of-stream report and answers it with a Goodbye.
 struct Server {
   explicit Server(const std::vector<uint8_t>& s) : stream(s) {}
   const std::vector<uint8_t>& stream;
@@ -32,6 +32,7 @@ struct Server {
   size_t sums_len = 0;
   bool receipt = false;
   DoneReport report{};
+  bool goodbye_sent = false;
   uint32_t frame_records = 0;
   std::vector<FrameRecord> frames;
   bool have_stats = false;
@@ -46,6 +47,7 @@ struct Server {
       written = 0;
       ctl_len = sums_len = 0;
       receipt = false;
+      goodbye_sent = false;
       frame_records = 0;
       frames.clear();
       started_ms = now;
@@ -82,6 +84,20 @@ struct Server {
     }
   }
   bool acked(Link& h) const { return h.established() && written == stream.size() && h.unacked(channel::kStream) == 0; }
+  // The report's status is ok and its byte count and CRC are the stream's.
+  bool verified(uint32_t crc) const {
+    return receipt && report.status == static_cast<int32_t>(Status::ok) &&
+           report.stream_bytes == static_cast<uint32_t>(stream.size()) && report.stream_crc == crc;
+  }
+  void say_goodbye(Link& h, uint32_t crc) {
+    if (goodbye_sent || !h.established() || h.writable(channel::kControl) < kGoodbyeBytes) return;
+    uint8_t msg[kGoodbyeBytes];
+    encode(Goodbye{static_cast<uint8_t>(verified(crc) ? 1 : 0), frame_records}, msg);
+    size_t acc = 0;
+    goodbye_sent = h.write(channel::kControl, msg, sizeof msg, &acc) == Status::ok && acc == sizeof msg;
+  }
+  // The client holds the Goodbye: the host may close.
+  bool goodbye_acked(Link& h) const { return goodbye_sent && h.established() && h.unacked(channel::kControl) == 0; }
 };
 
 // The loopback client: link core + container parser, as firmware would
@@ -94,6 +110,10 @@ struct Client {
   uint64_t got = 0;
   uint32_t crc = 0;
   bool sent_receipt = false;
+  bool goodbye = false;  // the host's Goodbye arrived
+  Goodbye bye{};
+  uint8_t ctl[kGoodbyeBytes] = {};
+  size_t ctl_len = 0;
   Status status = Status::more_input;
   uint32_t chunks = 0;
   size_t budget;
@@ -106,6 +126,8 @@ struct Client {
     got = 0;
     crc = 0;
     sent_receipt = false;
+    goodbye = false;
+    ctl_len = 0;
   }
   void pump(Link& d) {
     if (d.session_epoch() != epoch) {
@@ -125,6 +147,13 @@ struct Client {
       encode(rep, msg);
       size_t acc = 0;
       sent_receipt = d.write(channel::kControl, msg, sizeof msg, &acc) == Status::ok && acc == sizeof msg;
+    }
+    while (!goodbye && d.read(channel::kControl, ctl + ctl_len, kGoodbyeBytes - ctl_len, &n) == Status::ok && n != 0) {
+      ctl_len += n;
+      if (ctl_len == kGoodbyeBytes) {
+        goodbye = decode(ctl, ctl_len, &bye) == Status::ok;
+        ctl_len = 0;
+      }
     }
     chunks = parser.chunks();
   }
@@ -167,7 +196,8 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
       if (is_error(cli.status))
         throw std::runtime_error(std::string("the client refused the stream: ") + status_name(cli.status) + " (" +
                                  cli.parser.error_detail() + ")");
-      if (srv.receipt && srv.acked(sim.host())) break;
+      if (srv.receipt && srv.acked(sim.host())) srv.say_goodbye(sim.host(), rep.stream_crc);
+      if (srv.goodbye_acked(sim.host()) && cli.goodbye) break;
     }
     if (!srv.receipt) throw std::runtime_error("the transfer did not finish within " + std::to_string(limit_ms / 1000) + " simulated seconds");
     rep.seconds = static_cast<double>(sim.now_ms() - srv.started_ms) / 1000.0;
@@ -176,6 +206,9 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     rep.host = sim.host().stats();
     rep.sessions = sim.host().session_epoch();
     rep.final_frame_payload = sim.host().frame_payload();
+    rep.goodbye_acked = srv.goodbye_acked(sim.host());
+    rep.client_goodbye = cli.goodbye;
+    rep.client_goodbye_verified = cli.goodbye && cli.bye.verified == 1;
   } else {
     std::unique_ptr<Backend> b = open_backend(o.link, o.baud);
     if (log) log("link " + b->describe() + " open; waiting for the client");
@@ -188,9 +221,9 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     const uint32_t t0 = monotonic_ms();
     uint32_t acked_at = 0;
     uint32_t owed_at = 0;  // last time the client's stats showed frame records still to come
-    std::optional<uint32_t> receipt_at, records_at;  // when the report, and then every frame record, had arrived
-    constexpr uint32_t kLingerMs = 300;      // a few of the client's round trips
-    constexpr uint32_t kRecordWaitMs = 5000;  // frame records missing after this are reported missing
+    std::optional<uint32_t> receipt_at, goodbye_at;  // when the report had arrived, when the Goodbye went
+    constexpr uint32_t kRecordWaitMs = 5000;   // frame records missing after this are reported missing
+    constexpr uint32_t kGoodbyeWaitMs = 2000;  // a client that does not acknowledge the Goodbye by then has gone
     bool announced = false;
     for (;;) {
       const uint32_t now = monotonic_ms();
@@ -210,12 +243,18 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
       if (srv.acked(host) && acked_at == 0) acked_at = now;
       if (srv.receipt && !receipt_at) receipt_at = now;
       // The report is in: collect the frame records still on their way (a
-      // separate channel), then keep acknowledging a little longer so the
-      // client sees its last messages acknowledged before the line closes.
+      // separate channel), then say goodbye, and close once the client has
+      // acknowledged it: it stops on the Goodbye, without waiting for
+      // acknowledgements of its own last messages.
       if (receipt_at) {
         const bool all_records = srv.frames.size() >= srv.report.frames_shown;
-        if (all_records && !records_at) records_at = now;
-        if ((records_at && now - *records_at > kLingerMs) || now - *receipt_at > kRecordWaitMs) break;
+        if (all_records || now - *receipt_at > kRecordWaitMs) srv.say_goodbye(host, rep.stream_crc);
+        if (srv.goodbye_sent && !goodbye_at) goodbye_at = now;
+        if (srv.goodbye_acked(host)) {
+          rep.goodbye_acked = true;
+          break;
+        }
+        if (goodbye_at && now - *goodbye_at > kGoodbyeWaitMs) break;
       }
       // All acknowledged: wait briefly for the report (a client may not send
       // one), counted from when the client stopped owing frame records: one
@@ -238,8 +277,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
   rep.report_status = srv.report.status;
   rep.receipt_bytes = srv.report.stream_bytes;
   rep.receipt_crc = srv.report.stream_crc;
-  rep.receipt = srv.receipt && srv.report.status == static_cast<int32_t>(Status::ok) &&
-                srv.report.stream_bytes == static_cast<uint32_t>(stream.size()) && srv.report.stream_crc == rep.stream_crc;
+  rep.receipt = srv.verified(rep.stream_crc);
   rep.frame_records = srv.frame_records;
   rep.frames = srv.frames;
   rep.have_stats = srv.have_stats;

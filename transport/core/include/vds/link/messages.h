@@ -2,7 +2,9 @@
 // (docs/protocol.md, "Application messages"): a checksum record per
 // displayed frame on the checksums channel, a statistics snapshot on the
 // stats datagram channel, and the end-of-stream report on the control
-// channel. Fixed little-endian layouts, each opened by a type byte.
+// channel; and the one message the host sends down besides the stream, its
+// goodbye on the control channel. Fixed little-endian layouts, each opened
+// by a type byte.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -15,6 +17,7 @@ enum class MessageType : uint8_t {
   frame = 1,  // FrameRecord, checksums channel
   stats = 2,  // ClientStats, stats channel
   done = 3,   // DoneReport, control channel
+  goodbye = 4,  // Goodbye, control channel, host to client
 };
 
 // One displayed frame: its CRC-32C (RGB565 pixels, little-endian, rows top
@@ -55,13 +58,24 @@ struct DoneReport {
 };
 constexpr size_t kDoneReportBytes = 1 + 4 * 4;
 
+// Sent by the host once it holds the client's DoneReport and every frame
+// record the report announced (or has stopped waiting for them): the client
+// need not wait for acknowledgements of what it sent, and may stop.
+struct Goodbye {
+  uint8_t verified;        // 1: the report's status is ok and its byte count and CRC match what the host sent
+  uint32_t frame_records;  // FrameRecords the host received
+};
+constexpr size_t kGoodbyeBytes = 1 + 1 + 4;
+
 size_t encode(const FrameRecord& m, uint8_t out[kFrameRecordBytes]);
 size_t encode(const ClientStats& m, uint8_t out[kClientStatsBytes]);
 size_t encode(const DoneReport& m, uint8_t out[kDoneReportBytes]);
+size_t encode(const Goodbye& m, uint8_t out[kGoodbyeBytes]);
 
 // Each returns malformed for a wrong type byte or a short message.
 Status decode(const uint8_t* p, size_t n, FrameRecord* m);
 Status decode(const uint8_t* p, size_t n, ClientStats* m);
 Status decode(const uint8_t* p, size_t n, DoneReport* m);
+Status decode(const uint8_t* p, size_t n, Goodbye* m);
 
 }  // namespace vds::link

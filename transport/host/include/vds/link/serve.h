@@ -3,7 +3,8 @@
 // session begins (the client lost its state); over the loopback an
 // in-process client (the freestanding core's receiving end plus the stream
 // container parser) receives and verifies it. The client's DoneReport on
-// the control channel (vds/link/messages.h) confirms byte count and CRC.
+// the control channel (vds/link/messages.h) confirms byte count and CRC,
+// and the host's Goodbye on the same channel tells the client it may stop.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -42,6 +43,12 @@ struct ServeReport {
   std::vector<FrameRecord> frames;  // those records, in order (the last session's)
   bool have_stats = false;          // a ClientStats datagram arrived
   ClientStats stats{};              // the newest one
+  // The host's Goodbye (after the report and its frame records): the client
+  // acknowledged it; loopback: the in-process client read it, and it said
+  // the report was verified.
+  bool goodbye_acked = false;
+  bool client_goodbye = false;
+  bool client_goodbye_verified = false;
   uint32_t client_chunks = 0;  // loopback: chunks the client's parser verified
   LinkStats host;
   LinkStats client;  // loopback only

@@ -1,0 +1,71 @@
+// The application messages of the link (vds/link/messages.h): exact bytes,
+// round trips, and refusal of a wrong type byte, a short message or an
+// out-of-range field.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "vds/link/messages.h"
+
+namespace {
+
+using namespace vds::link;
+using vds::Status;
+
+TEST(LinkMessages, GoodbyeBytesAreFixed) {
+  uint8_t b[kGoodbyeBytes];
+  ASSERT_EQ(encode(Goodbye{1, 0x01020304u}, b), kGoodbyeBytes);
+  const std::vector<uint8_t> want = {4, 1, 0x04, 0x03, 0x02, 0x01};
+  EXPECT_EQ(std::vector<uint8_t>(b, b + kGoodbyeBytes), want);
+  Goodbye g{};
+  ASSERT_EQ(decode(b, sizeof b, &g), Status::ok);
+  EXPECT_EQ(g.verified, 1);
+  EXPECT_EQ(g.frame_records, 0x01020304u);
+}
+
+TEST(LinkMessages, EveryMessageRoundTrips) {
+  uint8_t b[64];
+  const FrameRecord fr{7, 0xDEADBEEFu, 1, 2, 3, 4, 5, 6, 1};
+  ASSERT_EQ(encode(fr, b), kFrameRecordBytes);
+  FrameRecord fr2{};
+  ASSERT_EQ(decode(b, kFrameRecordBytes, &fr2), Status::ok);
+  EXPECT_EQ(fr2.index, 7u);
+  EXPECT_EQ(fr2.crc, 0xDEADBEEFu);
+  EXPECT_EQ(fr2.display_instructions, 5u);
+  EXPECT_EQ(fr2.received_ms, 6u);
+  EXPECT_EQ(fr2.late, 1);
+
+  const ClientStats st{1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  ASSERT_EQ(encode(st, b), kClientStatsBytes);
+  ClientStats st2{};
+  ASSERT_EQ(decode(b, kClientStatsBytes, &st2), Status::ok);
+  EXPECT_EQ(st2.uptime_ms, 1u);
+  EXPECT_EQ(st2.instruction_resolution, 10u);
+
+  const DoneReport d{-3, 12, 3456, 0x12345678u};
+  ASSERT_EQ(encode(d, b), kDoneReportBytes);
+  DoneReport d2{};
+  ASSERT_EQ(decode(b, kDoneReportBytes, &d2), Status::ok);
+  EXPECT_EQ(d2.status, -3);
+  EXPECT_EQ(d2.frames_shown, 12u);
+  EXPECT_EQ(d2.stream_bytes, 3456u);
+  EXPECT_EQ(d2.stream_crc, 0x12345678u);
+}
+
+TEST(LinkMessages, WrongTypeShortOrOutOfRangeIsMalformed) {
+  uint8_t b[kGoodbyeBytes];
+  encode(Goodbye{0, 5}, b);
+  Goodbye g{};
+  for (size_t n = 0; n < kGoodbyeBytes; ++n) EXPECT_EQ(decode(b, n, &g), Status::malformed) << n << " bytes";
+  EXPECT_EQ(decode(nullptr, kGoodbyeBytes, &g), Status::malformed);
+  b[1] = 2;  // verified is 0 or 1
+  EXPECT_EQ(decode(b, sizeof b, &g), Status::malformed);
+  b[1] = 0;
+  DoneReport d{};
+  EXPECT_EQ(decode(b, sizeof b, &d), Status::malformed) << "a Goodbye is not a DoneReport";
+  uint8_t r[kDoneReportBytes];
+  encode(DoneReport{0, 0, 0, 0}, r);
+  EXPECT_EQ(decode(r, sizeof r, &g), Status::malformed) << "nor a DoneReport a Goodbye";
+}
+
+}  // namespace
