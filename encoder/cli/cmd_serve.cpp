@@ -85,8 +85,10 @@ void run_serve(const ServeArgs& a) {
   if (r.receipt) {
     std::printf("  client report      %llu bytes, CRC-32C %08x: matches\n",
                 static_cast<unsigned long long>(r.receipt_bytes), r.receipt_crc);
-    std::printf("  goodbye            %s\n", r.goodbye_acked ? "acknowledged by the client"
-                                                          : "not acknowledged (the line closed, or 2 s passed)");
+    std::printf("  goodbye            %s\n", r.goodbye_acked  ? "acknowledged by the client"
+                                          : !r.goodbye_sent ? "not sent"
+                                          : r.client_closed ? "sent; then the client closed the line"
+                                                            : "sent; not acknowledged within 2 s");
   } else if (r.report_seen) {
     throw Failure(kExitBadInput, "the client reports status " + std::to_string(r.report_status) + " (" +
                                      status_name(static_cast<Status>(r.report_status)) + ") after " +

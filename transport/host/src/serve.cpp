@@ -234,6 +234,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
         // A client that has reported may power off (QEMU exits) while this
         // side still lingers: that is the end, not a failure.
         if (!(srv.receipt && e.kind() == BackendError::Kind::disconnected)) throw;
+        rep.client_closed = true;
         break;
       }
       if (host.established() && !announced) {
@@ -273,6 +274,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     rep.sessions = host.session_epoch();
     rep.final_frame_payload = host.frame_payload();
   }
+  rep.goodbye_sent = srv.goodbye_sent;
   rep.report_seen = srv.receipt;
   rep.report_status = srv.report.status;
   rep.receipt_bytes = srv.report.stream_bytes;

@@ -46,7 +46,9 @@ struct ServeReport {
   // The host's Goodbye (after the report and its frame records): the client
   // acknowledged it; loopback: the in-process client read it, and it said
   // the report was verified.
+  bool goodbye_sent = false;
   bool goodbye_acked = false;
+  bool client_closed = false;  // real links: the client closed the line after its report
   bool client_goodbye = false;
   bool client_goodbye_verified = false;
   uint32_t client_chunks = 0;  // loopback: chunks the client's parser verified
