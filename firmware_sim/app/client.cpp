@@ -86,8 +86,7 @@ struct Client {
   bool done_sent = false;
   uint32_t last_stats_ms = 0;
   // The host's Goodbye (control channel): it holds the report and records.
-  uint8_t control[link::kGoodbyeBytes];
-  size_t control_len = 0;
+  link::MessageReader<link::kGoodbyeBytes> control;
   bool goodbye = false;
 };
 
@@ -307,7 +306,7 @@ Status start_stream() {
   g.late_frames = 0;
   g.pending_count = 0;
   g.done_sent = false;
-  g.control_len = 0;
+  g.control.reset();
   g.goodbye = false;
   vds::ChunkSink sink;
   sink.on_header = on_header;
@@ -386,16 +385,9 @@ void send_messages(uint32_t now) {
 
 // Reads the control channel for the host's Goodbye.
 void read_control() {
-  size_t n = 0;
-  while (!g.goodbye &&
-         g.link.read(link::channel::kControl, g.control + g.control_len, link::kGoodbyeBytes - g.control_len, &n) ==
-             Status::ok &&
-         n != 0) {
-    g.control_len += n;
-    if (g.control_len < link::kGoodbyeBytes) continue;
-    g.control_len = 0;
+  while (!g.goodbye && g.control.next(g.link, link::channel::kControl)) {
     link::Goodbye bye{};
-    if (link::decode(g.control, link::kGoodbyeBytes, &bye) != Status::ok) {
+    if (link::decode(g.control.bytes, link::kGoodbyeBytes, &bye) != Status::ok) {
       board::log("client: a control message that is not a Goodbye was ignored\n");
       continue;
     }

@@ -1,11 +1,13 @@
 // The application messages of the link (vds/link/messages.h): exact bytes,
-// round trips, and refusal of a wrong type byte, a short message or an
-// out-of-range field.
+// round trips, refusal of a wrong type byte, a short message or an
+// out-of-range field, and MessageReader putting messages together from the
+// pieces a reliable channel hands over.
 #include <gtest/gtest.h>
 
 #include <vector>
 
 #include "vds/link/messages.h"
+#include "vds/link/sim.h"
 
 namespace {
 
@@ -66,6 +68,45 @@ TEST(LinkMessages, WrongTypeShortOrOutOfRangeIsMalformed) {
   uint8_t r[kDoneReportBytes];
   encode(DoneReport{0, 0, 0, 0}, r);
   EXPECT_EQ(decode(r, sizeof r, &g), Status::malformed) << "nor a DoneReport a Goodbye";
+}
+
+TEST(LinkMessages, ReaderAssemblesMessagesFromPieces) {
+  LinkSim sim(1000000, FaultConfig{}, FaultConfig{}, host_config(5), device_config(6));
+  auto settle = [&] {
+    for (int i = 0; i < 2000; ++i) sim.step();
+  };
+  settle();  // handshake
+  ASSERT_TRUE(sim.host().established());
+  uint8_t a[kDoneReportBytes], b[kDoneReportBytes];
+  encode(DoneReport{0, 1, 2, 3}, a);
+  encode(DoneReport{-1, 4, 5, 6}, b);
+  auto send = [&](const uint8_t* p, size_t n) {
+    size_t took = 0;
+    ASSERT_EQ(sim.device().write(channel::kControl, p, n, &took), Status::ok);
+    ASSERT_EQ(took, n);
+  };
+  MessageReader<kDoneReportBytes> r;
+  send(a, 5);
+  settle();
+  EXPECT_FALSE(r.next(sim.host(), channel::kControl)) << "5 of 17 bytes";
+  EXPECT_EQ(r.len, 5u);
+  send(a + 5, kDoneReportBytes - 5);
+  send(b, 9);
+  settle();
+  ASSERT_TRUE(r.next(sim.host(), channel::kControl));
+  DoneReport d{};
+  ASSERT_EQ(decode(r.bytes, kDoneReportBytes, &d), Status::ok);
+  EXPECT_EQ(d.stream_crc, 3u);
+  EXPECT_FALSE(r.next(sim.host(), channel::kControl)) << "9 bytes of the second";
+  send(b + 9, kDoneReportBytes - 9);
+  settle();
+  ASSERT_TRUE(r.next(sim.host(), channel::kControl));
+  ASSERT_EQ(decode(r.bytes, kDoneReportBytes, &d), Status::ok);
+  EXPECT_EQ(d.status, -1);
+  EXPECT_EQ(d.stream_crc, 6u);
+  EXPECT_FALSE(r.next(sim.host(), channel::kControl)) << "nothing more";
+  r.reset();
+  EXPECT_EQ(r.len, 0u);
 }
 
 }  // namespace

@@ -80,8 +80,7 @@ ServeReport serve_to_pty_client(const std::vector<uint8_t>& s, bool lie, PtyClie
     uint32_t crc = 0;
     bool sent = false;
     uint8_t buf[1024];
-    uint8_t ctl[kGoodbyeBytes];
-    size_t ctl_len = 0;
+    MessageReader<kGoodbyeBytes> ctl;
     try {
       while (!stop && !out->goodbye) {
         pump.step(monotonic_ms(), 1);
@@ -96,8 +95,8 @@ ServeReport serve_to_pty_client(const std::vector<uint8_t>& s, bool lie, PtyClie
           size_t acc = 0;
           sent = dev.write(channel::kControl, r, sizeof r, &acc) == Status::ok && acc == sizeof r;
         }
-        while (dev.read(channel::kControl, ctl + ctl_len, kGoodbyeBytes - ctl_len, &n) == Status::ok && n != 0)
-          if ((ctl_len += n) == kGoodbyeBytes) out->goodbye = decode(ctl, ctl_len, &out->bye) == Status::ok;
+        while (!out->goodbye && ctl.next(dev, channel::kControl))
+          out->goodbye = decode(ctl.bytes, kGoodbyeBytes, &out->bye) == Status::ok;
       }
       pump.step(monotonic_ms(), 1);  // the Goodbye's acknowledgement
     } catch (const BackendError&) {

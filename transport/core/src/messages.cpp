@@ -1,4 +1,4 @@
-// Encoding of the client's upward application messages (vds/link/messages.h).
+// Encoding of the link's application messages (vds/link/messages.h).
 #include "vds/link/messages.h"
 
 namespace vds::link {

@@ -26,10 +26,8 @@ struct Server {
   uint64_t written = 0;
   uint32_t epoch = 0;
   uint64_t started_ms = 0;
-  uint8_t ctl[kDoneReportBytes] = {};
-  size_t ctl_len = 0;
-  uint8_t sums[kFrameRecordBytes] = {};
-  size_t sums_len = 0;
+  MessageReader<kDoneReportBytes> ctl;
+  MessageReader<kFrameRecordBytes> sums;
   bool receipt = false;
   DoneReport report{};
   bool goodbye_sent = false;
@@ -45,7 +43,8 @@ struct Server {
       if (epoch != 0 && log) log("session " + std::to_string(h.session_epoch()) + ": the client lost the session, sending the stream again");
       epoch = h.session_epoch();
       written = 0;
-      ctl_len = sums_len = 0;
+      ctl.reset();
+      sums.reset();
       receipt = false;
       goodbye_sent = false;
       frame_records = 0;
@@ -60,28 +59,18 @@ struct Server {
     }
     // Frame records (checksums channel) are counted; the DoneReport
     // (control channel) ends the transfer.
-    size_t n = 0;
-    while (h.read(channel::kChecksums, sums + sums_len, kFrameRecordBytes - sums_len, &n) == Status::ok && n != 0) {
-      sums_len += n;
-      if (sums_len == kFrameRecordBytes) {
-        FrameRecord fr{};
-        if (decode(sums, sums_len, &fr) == Status::ok) {
-          ++frame_records;
-          frames.push_back(fr);
-        }
-        sums_len = 0;
+    while (sums.next(h, channel::kChecksums)) {
+      FrameRecord fr{};
+      if (decode(sums.bytes, kFrameRecordBytes, &fr) == Status::ok) {
+        ++frame_records;
+        frames.push_back(fr);
       }
     }
     uint8_t st[kClientStatsBytes];
+    size_t n = 0;
     while (h.read_datagram(channel::kStats, st, sizeof st, &n) == Status::ok)
       if (decode(st, n, &stats) == Status::ok) have_stats = true;
-    while (!receipt && h.read(channel::kControl, ctl + ctl_len, kDoneReportBytes - ctl_len, &n) == Status::ok && n != 0) {
-      ctl_len += n;
-      if (ctl_len == kDoneReportBytes) {
-        receipt = decode(ctl, ctl_len, &report) == Status::ok;
-        ctl_len = 0;
-      }
-    }
+    while (!receipt && ctl.next(h, channel::kControl)) receipt = decode(ctl.bytes, kDoneReportBytes, &report) == Status::ok;
   }
   bool acked(Link& h) const { return h.established() && written == stream.size() && h.unacked(channel::kStream) == 0; }
   // The report's status is ok and its byte count and CRC are the stream's.
@@ -112,8 +101,7 @@ struct Client {
   bool sent_receipt = false;
   bool goodbye = false;  // the host's Goodbye arrived
   Goodbye bye{};
-  uint8_t ctl[kGoodbyeBytes] = {};
-  size_t ctl_len = 0;
+  MessageReader<kGoodbyeBytes> ctl;
   Status status = Status::more_input;
   uint32_t chunks = 0;
   size_t budget;
@@ -127,7 +115,7 @@ struct Client {
     crc = 0;
     sent_receipt = false;
     goodbye = false;
-    ctl_len = 0;
+    ctl.reset();
   }
   void pump(Link& d) {
     if (d.session_epoch() != epoch) {
@@ -148,13 +136,7 @@ struct Client {
       size_t acc = 0;
       sent_receipt = d.write(channel::kControl, msg, sizeof msg, &acc) == Status::ok && acc == sizeof msg;
     }
-    while (!goodbye && d.read(channel::kControl, ctl + ctl_len, kGoodbyeBytes - ctl_len, &n) == Status::ok && n != 0) {
-      ctl_len += n;
-      if (ctl_len == kGoodbyeBytes) {
-        goodbye = decode(ctl, ctl_len, &bye) == Status::ok;
-        ctl_len = 0;
-      }
-    }
+    while (!goodbye && ctl.next(d, channel::kControl)) goodbye = decode(ctl.bytes, kGoodbyeBytes, &bye) == Status::ok;
     chunks = parser.chunks();
   }
 };

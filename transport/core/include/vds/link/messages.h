@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "vds/link/link.h"
 #include "vds/status.h"
 
 namespace vds::link {
@@ -77,5 +78,22 @@ Status decode(const uint8_t* p, size_t n, FrameRecord* m);
 Status decode(const uint8_t* p, size_t n, ClientStats* m);
 Status decode(const uint8_t* p, size_t n, DoneReport* m);
 Status decode(const uint8_t* p, size_t n, Goodbye* m);
+
+// Collects fixed-size messages of N bytes from a reliable channel, which
+// may hand them over in pieces: next() is true each time `bytes` holds a
+// whole one (the following call starts on the next).
+template <size_t N>
+struct MessageReader {
+  uint8_t bytes[N] = {};
+  size_t len = 0;
+
+  bool next(Link& link, uint8_t ch) {
+    if (len == N) len = 0;
+    size_t n = 0;
+    while (len < N && link.read(ch, bytes + len, N - len, &n) == Status::ok && n != 0) len += n;
+    return len == N;
+  }
+  void reset() { len = 0; }
+};
 
 }  // namespace vds::link
