@@ -41,6 +41,7 @@ def cortex_m4_prefix(a, stream, want):
         f.write(run.serve.stdout + run.serve.stderr + "\n== Cortex-M4 board\n" + run.board_log)
     got = sim.frame_crcs(run.serve.stdout)
     prefix = sim.model_prefix(run.board_log)
+    full = sim.full_report(run.serve.stdout)
     budget = re.search(r"ready, workspace (\d+) bytes", run.board_log)
     failures = []
     if not run.ok:
@@ -49,14 +50,19 @@ def cortex_m4_prefix(a, stream, want):
         failures.append("the Cortex-M4 board did not report where its workspace ran out")
     elif got != want[:prefix["level"] + 1]:
         failures.append(f"the Cortex-M4 board's {len(got)} frames are not the replay's first {prefix['level'] + 1}")
+    if prefix and not full:
+        failures.append("the Cortex-M4 board's report of a full workspace was not verified")
     if prefix and budget:
         print(f"The same stream at 115,200 baud to the client on the **Cortex-M4 board** (QEMU mps2-an386), "
               f"whose {int(budget.group(1)) // 1024} KiB workspace holds {prefix['held']} of the "
               f"{prefix['vertices']} vertices: it drew the base and levels 1-{prefix['level']} "
               f"({prefix['level_vertices']} vertices), {len(got)} frames, each identical to the replay's: "
-              f"{'yes' if not failures else 'NO'}; it received and checked the other "
-              f"{prefix['levels'] - prefix['level']} levels and skipped them "
-              f"(log: `out/demo/model/serve_cortex_m4.log`).\n")
+              f"{'yes' if not failures else 'NO'}. "
+              + (f"It then reported its workspace full after the first {full['bytes']:,} bytes and the host "
+                 f"stopped the stream: {full['acked']:,} of its {full['stream']:,} bytes had been delivered when it "
+                 f"closed, instead of all {prefix['levels'] - prefix['level']} skipped levels "
+                 if full else "It did not report its workspace full ")
+              + "(log: `out/demo/model/serve_cortex_m4.log`).\n")
     return failures
 
 

@@ -53,6 +53,18 @@ def frame_instructions(serve_stdout):
     return rows
 
 
+def full_report(serve_stdout):
+    """A client's workspace-full report as `vds serve` printed it: a dict with
+    the bytes it covers, the stream's size and the stream bytes the client
+    had acknowledged when the host closed (`bytes`, `stream`, `acked`); None
+    if the client reported no such thing."""
+    m = re.search(r"client report\s+workspace full after the first (\d+) of (\d+) bytes, CRC-32C [0-9a-f]{8}: "
+                  r"matches; the host stopped the stream: (\d+) bytes of it acknowledged", serve_stdout)
+    if not m:
+        return None
+    return {"bytes": int(m.group(1)), "stream": int(m.group(2)), "acked": int(m.group(3))}
+
+
 def frame_times_ms(serve_stdout):
     """The client's clock (ms) when it finished each frame."""
     return [int(m.group(1)) for m in re.finditer(r"^\s*frame\s+\d+\s+crc\s+\S+.*\sat\s+(\d+)\s+ms", serve_stdout, re.M)]

@@ -82,13 +82,27 @@ void run_serve(const ServeArgs& a) {
     }
     enc::write_file(a.crc_out, std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size()));
   }
-  if (r.receipt) {
+  if (r.receipt && r.receipt_prefix) {
+    std::printf("  client report      workspace full after the first %llu of %llu bytes, CRC-32C %08x: matches; "
+                "the host stopped the stream: %llu bytes of it acknowledged in all\n",
+                static_cast<unsigned long long>(r.receipt_bytes), static_cast<unsigned long long>(r.bytes),
+                r.receipt_crc, static_cast<unsigned long long>(r.bytes_acked));
+  } else if (r.receipt) {
     std::printf("  client report      %llu bytes, CRC-32C %08x: matches\n",
                 static_cast<unsigned long long>(r.receipt_bytes), r.receipt_crc);
+  }
+  if (r.receipt) {
     std::printf("  goodbye            %s\n", r.goodbye_acked  ? "acknowledged by the client"
                                           : !r.goodbye_sent ? "not sent"
                                           : r.client_closed ? "sent; then the client closed the line"
                                                             : "sent; not acknowledged within 2 s");
+  } else if (r.report_seen && r.report_status == static_cast<int32_t>(Status::ok)) {
+    char crc[16];
+    std::snprintf(crc, sizeof crc, "%08x", r.receipt_crc);
+    throw Failure(kExitBadInput, std::string("the client's report (") +
+                                     (r.receipt_prefix ? "workspace full after " : "") +
+                                     std::to_string(r.receipt_bytes) + " bytes, CRC-32C " + crc + ") does not match " +
+                                     (r.receipt_prefix ? "that prefix of the stream" : "the stream"));
   } else if (r.report_seen) {
     throw Failure(kExitBadInput, "the client reports status " + std::to_string(r.report_status) + " (" +
                                      status_name(static_cast<Status>(r.report_status)) + ") after " +

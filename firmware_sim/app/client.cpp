@@ -53,6 +53,11 @@ struct Client {
   bool model = false;
   bool model_started = false;  // MSHH seen: decoder and view set up
   bool model_full_logged = false;
+  // The workspace holds no more of the model: the client reports early and
+  // the host writes no more; stream bytes still in flight are read and
+  // dropped (counted, outside the report's bytes and CRC).
+  bool full = false;
+  uint32_t dropped_bytes = 0;
   vds::ModelFrames model_frames;
   size_t stream_mark = 0;  // arena mark below the per-stream state
   uint32_t epoch = 0;
@@ -238,6 +243,7 @@ vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t 
     result = vds::ChunkResult::abort;
   } else if (g.mesh.capacity_reached() && !g.model_full_logged) {
     g.model_full_logged = true;
+    g.full = true;
     Line l;
     l.str("client: model: workspace full after level ").dec(g.mesh.levels_done()).str(" of ");
     l.dec(g.mesh.header().levels).str(" (").dec(g.mesh.mesh().vertex_count()).str(" vertices)\n");
@@ -301,6 +307,8 @@ Status start_stream() {
   g.stream_status = Status::more_input;
   g.stream_bytes = 0;
   g.stream_crc = 0;
+  g.full = false;
+  g.dropped_bytes = 0;
   g.in_frame = false;
   g.frames_shown = 0;
   g.late_frames = 0;
@@ -317,6 +325,13 @@ Status start_stream() {
 
 void feed_stream() {
   uint8_t buf[kStreamReadBytes];
+  if (g.full && g.stream_status == Status::ok) {
+    // Reported full: what the host had already sent is read and dropped.
+    size_t got = 0;
+    while (g.link.read(link::channel::kStream, buf, sizeof buf, &got) == Status::ok && got != 0)
+      g.dropped_bytes += static_cast<uint32_t>(got);
+    return;
+  }
   // Stop taking stream bytes while frame records wait: back-pressure.
   while (g.stream_status == Status::more_input && g.pending_count < kPendingRecords) {
     // An image frame spans many chunks, but a model draws after every level
@@ -336,6 +351,12 @@ void feed_stream() {
     g.feed_mark = board::instructions();
     Status s = g.parser.feed(buf, got);
     g.parse_total += board::instructions() - g.feed_mark;
+    if (s == Status::more_input && g.full) {
+      // Every later level would be skipped: the report goes now, and covers
+      // the bytes received so far.
+      board::log("client: model: asking the host for no more of the stream\n");
+      s = Status::ok;
+    }
     if (s == Status::more_input) continue;
     g.stream_status = s;
     if (vds::is_error(s)) {
@@ -374,7 +395,8 @@ void send_messages(uint32_t now) {
   }
   if (g.stream_status != Status::more_input && !g.done_sent && g.pending_count == 0 &&
       g.link.writable(link::channel::kControl) >= link::kDoneReportBytes) {
-    link::DoneReport d{static_cast<int32_t>(g.stream_status), g.frames_shown, g.stream_bytes, g.stream_crc};
+    link::DoneReport d{static_cast<int32_t>(g.stream_status), g.frames_shown, g.stream_bytes, g.stream_crc,
+                       g.full ? link::DoneReason::workspace_full : link::DoneReason::end_of_stream};
     uint8_t msg[link::kDoneReportBytes];
     link::encode(d, msg);
     size_t took = 0;
@@ -477,7 +499,9 @@ extern "C" int vds_app_main() {
   }
   Line l;
   l.str("client: ").str(vds::status_name(g.stream_status)).str(", ").dec(g.frames_shown).str(" frames, ");
-  l.dec(g.stream_bytes).str(" stream bytes, workspace high-water ").dec(g.arena.high_water()).str(" bytes\n");
+  l.dec(g.stream_bytes).str(" stream bytes");
+  if (g.full) l.str(" (workspace full; ").dec(g.dropped_bytes).str(" bytes in flight dropped)");
+  l.str(", workspace high-water ").dec(g.arena.high_water()).str(" bytes\n");
   board::log(l.c_str());
   return g.stream_status == Status::ok ? 0 : 1;
 }

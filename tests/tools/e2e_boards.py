@@ -9,13 +9,15 @@ client is bit-exact across architectures.
 With --stream, an existing stream (e.g. a progressive model) is served
 instead, and the encoder side is `vds frames STREAM`. With --prefix and a
 --workspace too small for the whole model, each board must show the
-replay's frames up to the level where it reports its workspace full.
+replay's frames up to the level where it reports its workspace full, and
+the host must stop the stream on that report.
 
 Usage: e2e_boards.py --vds VDS --host-board EXE --qemu QEMU --elf ELF --work DIR
        [--frames N | --inputs IMAGE... | --stream VDS_STREAM] [--report FILE.json]"""
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -127,6 +129,18 @@ def main():
                 expect = want[:prefix["level"] + 1]
                 if len(expect) >= len(want):
                     failures.append(f"{name} board held every level: the stream does not test a prefix")
+            # It then says so, and the host stops the stream.
+            served = host.serve.stdout if name == "host-native" else qemu.serve.stdout
+            full = sim.full_report(served)
+            if not full:
+                failures.append(f"{name} board: vds serve shows no verified workspace-full report")
+            else:
+                took = re.search(r"client: ok, \d+ frames, (\d+) stream bytes \(workspace full; (\d+) bytes in "
+                                 r"flight dropped\)", log)
+                if not took or int(took.group(1)) != full["bytes"]:
+                    failures.append(f"{name} board's log does not show the {full['bytes']} bytes it reported")
+                elif int(took.group(1)) + int(took.group(2)) >= full["stream"] or full["acked"] >= full["stream"]:
+                    failures.append(f"{name} board received all {full['stream']} bytes: the host did not stop")
         if crcs != expect:
             failures.append(f"{name} board frame CRCs differ from the encoder's reconstruction")
     instr = sim.frame_instructions(qemu.serve.stdout)

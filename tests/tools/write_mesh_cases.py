@@ -3,7 +3,8 @@
 the golden stream of mesh format v1 (vertex-centroid predictor), and
 mesh_case1.vds, a torus encoded now by `vds encode-mesh` with the default
 options (area predictor), so the boards compare both predictors; and
-model_prefix.vds, a finer torus for a client too small to hold all of it.
+model_prefix.vds, a finer torus (4,608 vertices, about 14 KB) for a client too
+small to hold all of it, long enough that stopping the stream shows.
 
 Usage: write_mesh_cases.py --vds VDS --golden GOLDEN.vds --out DIR"""
 import argparse
@@ -55,7 +56,7 @@ def main():
         print("write_mesh_cases: the torus was not encoded with the area predictor")
         return 1
     fine = os.path.join(a.out, "torus_fine.obj")
-    torus_obj(fine, rings=48, sides=24)
+    torus_obj(fine, rings=96, sides=48)
     enc = subprocess.run([a.vds, "encode-mesh", fine, "-o", os.path.join(a.out, "model_prefix.vds"), "--max-chunk", "1024"],
                          capture_output=True, text=True)
     print(enc.stdout + enc.stderr)

@@ -25,6 +25,14 @@ TEST(LinkMessages, GoodbyeBytesAreFixed) {
   EXPECT_EQ(g.frame_records, 0x01020304u);
 }
 
+TEST(LinkMessages, DoneReportBytesAreFixed) {
+  uint8_t b[kDoneReportBytes];
+  ASSERT_EQ(encode(DoneReport{-2, 3, 0x0A0B0C0Du, 0x11223344u, DoneReason::workspace_full}, b), kDoneReportBytes);
+  const std::vector<uint8_t> want = {3,    0xFE, 0xFF, 0xFF, 0xFF, 3,    0,    0,    0, 0x0D,
+                                     0x0C, 0x0B, 0x0A, 0x44, 0x33, 0x22, 0x11, 1};
+  EXPECT_EQ(std::vector<uint8_t>(b, b + kDoneReportBytes), want);
+}
+
 TEST(LinkMessages, EveryMessageRoundTrips) {
   uint8_t b[64];
   const FrameRecord fr{7, 0xDEADBEEFu, 1, 2, 3, 4, 5, 6, 1};
@@ -52,6 +60,12 @@ TEST(LinkMessages, EveryMessageRoundTrips) {
   EXPECT_EQ(d2.frames_shown, 12u);
   EXPECT_EQ(d2.stream_bytes, 3456u);
   EXPECT_EQ(d2.stream_crc, 0x12345678u);
+  EXPECT_EQ(d2.reason, DoneReason::end_of_stream) << "the default: the client read the whole stream";
+  const DoneReport full{0, 4, 999, 1, DoneReason::workspace_full};
+  encode(full, b);
+  ASSERT_EQ(decode(b, kDoneReportBytes, &d2), Status::ok);
+  EXPECT_EQ(d2.reason, DoneReason::workspace_full);
+  EXPECT_EQ(d2.stream_bytes, 999u);
 }
 
 TEST(LinkMessages, WrongTypeShortOrOutOfRangeIsMalformed) {
@@ -68,6 +82,9 @@ TEST(LinkMessages, WrongTypeShortOrOutOfRangeIsMalformed) {
   uint8_t r[kDoneReportBytes];
   encode(DoneReport{0, 0, 0, 0}, r);
   EXPECT_EQ(decode(r, sizeof r, &g), Status::malformed) << "nor a DoneReport a Goodbye";
+  EXPECT_EQ(decode(r, sizeof r - 1, &d), Status::malformed) << "a report without its reason byte";
+  r[kDoneReportBytes - 1] = 2;  // the reason is 0 or 1
+  EXPECT_EQ(decode(r, sizeof r, &d), Status::malformed);
 }
 
 TEST(LinkMessages, ReaderAssemblesMessagesFromPieces) {

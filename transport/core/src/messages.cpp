@@ -57,6 +57,7 @@ size_t encode(const DoneReport& m, uint8_t out[kDoneReportBytes]) {
   put32(p, m.frames_shown);
   put32(p, m.stream_bytes);
   put32(p, m.stream_crc);
+  *p++ = static_cast<uint8_t>(m.reason);
   return kDoneReportBytes;
 }
 
@@ -100,12 +101,15 @@ Status decode(const uint8_t* p, size_t n, ClientStats* m) {
 }
 
 Status decode(const uint8_t* p, size_t n, DoneReport* m) {
-  if (m == nullptr || !opens(p, n, kDoneReportBytes, MessageType::done)) return Status::malformed;
+  if (m == nullptr || !opens(p, n, kDoneReportBytes, MessageType::done) ||
+      p[kDoneReportBytes - 1] > static_cast<uint8_t>(DoneReason::workspace_full))
+    return Status::malformed;
   ++p;
   m->status = static_cast<int32_t>(get32(p));
   m->frames_shown = get32(p);
   m->stream_bytes = get32(p);
   m->stream_crc = get32(p);
+  m->reason = static_cast<DoneReason>(*p);
   return Status::ok;
 }
 

@@ -20,6 +20,7 @@ namespace {
 
 // Host side: writes the stream, restarting it with each new session,
 // collects the client's end-of-stream report and answers it with a Goodbye.
+// A client whose workspace is full reports early: the host writes no more.
 struct Server {
   explicit Server(const std::vector<uint8_t>& s) : stream(s) {}
   const std::vector<uint8_t>& stream;
@@ -51,7 +52,7 @@ struct Server {
       frames.clear();
       started_ms = now;
     }
-    while (written < stream.size()) {
+    while (written < stream.size() && !wants_no_more()) {
       size_t acc = 0;
       if (h.write(channel::kStream, stream.data() + written, stream.size() - written, &acc) != Status::ok || acc == 0)
         break;
@@ -73,10 +74,15 @@ struct Server {
     while (!receipt && ctl.next(h, channel::kControl)) receipt = decode(ctl.bytes, kDoneReportBytes, &report) == Status::ok;
   }
   bool acked(Link& h) const { return h.established() && written == stream.size() && h.unacked(channel::kStream) == 0; }
-  // The report's status is ok and its byte count and CRC are the stream's.
+  // The client has reported that its workspace is full.
+  bool wants_no_more() const { return receipt && report.reason == DoneReason::workspace_full; }
+  // The report's status is ok and its byte count and CRC are the stream's,
+  // or, from a client whose workspace is full, those of a prefix of it.
   bool verified(uint32_t crc) const {
-    return receipt && report.status == static_cast<int32_t>(Status::ok) &&
-           report.stream_bytes == static_cast<uint32_t>(stream.size()) && report.stream_crc == crc;
+    if (!receipt || report.status != static_cast<int32_t>(Status::ok)) return false;
+    if (report.reason == DoneReason::end_of_stream)
+      return report.stream_bytes == static_cast<uint32_t>(stream.size()) && report.stream_crc == crc;
+    return report.stream_bytes <= stream.size() && report.stream_crc == crc32c(stream.data(), report.stream_bytes);
   }
   void say_goodbye(Link& h, uint32_t crc) {
     if (goodbye_sent || !h.established() || h.writable(channel::kControl) < kGoodbyeBytes) return;
@@ -178,7 +184,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
       if (is_error(cli.status))
         throw std::runtime_error(std::string("the client refused the stream: ") + status_name(cli.status) + " (" +
                                  cli.parser.error_detail() + ")");
-      if (srv.receipt && srv.acked(sim.host())) srv.say_goodbye(sim.host(), rep.stream_crc);
+      if (srv.receipt && (srv.acked(sim.host()) || srv.wants_no_more())) srv.say_goodbye(sim.host(), rep.stream_crc);
       if (srv.goodbye_acked(sim.host()) && cli.goodbye) break;
     }
     if (!srv.receipt) throw std::runtime_error("the transfer did not finish within " + std::to_string(limit_ms / 1000) + " simulated seconds");
@@ -191,6 +197,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     rep.goodbye_acked = srv.goodbye_acked(sim.host());
     rep.client_goodbye = cli.goodbye;
     rep.client_goodbye_verified = cli.goodbye && cli.bye.verified == 1;
+    rep.bytes_acked = srv.written - sim.host().unacked(channel::kStream);
   } else {
     std::unique_ptr<Backend> b = open_backend(o.link, o.baud);
     if (log) log("link " + b->describe() + " open; waiting for the client");
@@ -255,6 +262,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     rep.host = host.stats();
     rep.sessions = host.session_epoch();
     rep.final_frame_payload = host.frame_payload();
+    rep.bytes_acked = srv.written - host.unacked(channel::kStream);
   }
   rep.goodbye_sent = srv.goodbye_sent;
   rep.report_seen = srv.receipt;
@@ -262,11 +270,14 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
   rep.receipt_bytes = srv.report.stream_bytes;
   rep.receipt_crc = srv.report.stream_crc;
   rep.receipt = srv.verified(rep.stream_crc);
+  rep.receipt_prefix = srv.wants_no_more();
+  rep.bytes_written = srv.written;
   rep.frame_records = srv.frame_records;
   rep.frames = srv.frames;
   rep.have_stats = srv.have_stats;
   rep.stats = srv.stats;
-  if (rep.seconds > 0) rep.goodput = static_cast<double>(stream.size()) / rep.seconds / (o.baud / 10.0);
+  const double delivered = rep.receipt_prefix ? static_cast<double>(rep.receipt_bytes) : static_cast<double>(stream.size());
+  if (rep.seconds > 0) rep.goodput = delivered / rep.seconds / (o.baud / 10.0);
   return rep;
 }
 

@@ -50,20 +50,30 @@ struct ClientStats {
 };
 constexpr size_t kClientStatsBytes = 1 + 10 * 4;
 
-// Sent once, after the END chunk or the first error.
-struct DoneReport {
-  int32_t status;  // vds::Status of the stream
-  uint32_t frames_shown;
-  uint32_t stream_bytes;
-  uint32_t stream_crc;  // CRC-32C of every stream byte received
+// Why the client reports: it read the whole stream (the END chunk, or the
+// first error), or it holds as much of a model as its workspace can and
+// wants no more of the stream: its bytes and CRC then cover a prefix.
+enum class DoneReason : uint8_t {
+  end_of_stream = 0,
+  workspace_full = 1,
 };
-constexpr size_t kDoneReportBytes = 1 + 4 * 4;
+
+// Sent once, after the END chunk or the first error, or as soon as a model
+// client's workspace is full.
+struct DoneReport {
+  int32_t status;  // vds::Status of the stream (ok for a full workspace)
+  uint32_t frames_shown;
+  uint32_t stream_bytes;  // stream bytes received (for workspace_full, those the report covers)
+  uint32_t stream_crc;    // CRC-32C of those bytes
+  DoneReason reason = DoneReason::end_of_stream;
+};
+constexpr size_t kDoneReportBytes = 1 + 4 * 4 + 1;
 
 // Sent by the host once it holds the client's DoneReport and every frame
 // record the report announced (or has stopped waiting for them): the client
 // need not wait for acknowledgements of what it sent, and may stop.
 struct Goodbye {
-  uint8_t verified;        // 1: the report's status is ok and its byte count and CRC match what the host sent
+  uint8_t verified;        // 1: the report's status is ok and its byte count and CRC match what the host sent (or, workspace full, its prefix)
   uint32_t frame_records;  // FrameRecords the host received
 };
 constexpr size_t kGoodbyeBytes = 1 + 1 + 4;
@@ -73,7 +83,8 @@ size_t encode(const ClientStats& m, uint8_t out[kClientStatsBytes]);
 size_t encode(const DoneReport& m, uint8_t out[kDoneReportBytes]);
 size_t encode(const Goodbye& m, uint8_t out[kGoodbyeBytes]);
 
-// Each returns malformed for a wrong type byte or a short message.
+// Each returns malformed for a wrong type byte, a short message or a field
+// out of its range (a DoneReport's reason, a Goodbye's verified flag).
 Status decode(const uint8_t* p, size_t n, FrameRecord* m);
 Status decode(const uint8_t* p, size_t n, ClientStats* m);
 Status decode(const uint8_t* p, size_t n, DoneReport* m);

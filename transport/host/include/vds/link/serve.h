@@ -3,8 +3,10 @@
 // session begins (the client lost its state); over the loopback an
 // in-process client (the freestanding core's receiving end plus the stream
 // container parser) receives and verifies it. The client's DoneReport on
-// the control channel (vds/link/messages.h) confirms byte count and CRC,
-// and the host's Goodbye on the same channel tells the client it may stop.
+// the control channel (vds/link/messages.h) confirms byte count and CRC —
+// of the whole stream, or of the prefix a client whose workspace is full
+// took, after which the host writes no more — and the host's Goodbye on the
+// same channel tells the client it may stop.
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -33,8 +35,12 @@ struct ServeReport {
   double goodput = 0;         // bytes / seconds / (baud / 10)
   uint32_t sessions = 0;      // sessions the host established
   // The client's end-of-stream report (DoneReport on the control channel,
-  // vds/link/messages.h): arrived, stream ok, and byte count and CRC match.
+  // vds/link/messages.h): arrived, stream ok, and byte count and CRC match
+  // the stream's, or a prefix's when the client's workspace was full.
   bool receipt = false;
+  bool receipt_prefix = false;  // the client reported its workspace full: it wanted no more
+  uint64_t bytes_written = 0;   // stream bytes the host wrote to the link (less than `bytes` after a full report)
+  uint64_t bytes_acked = 0;     // of those, acknowledged by the client when the host closed
   bool report_seen = false;
   int32_t report_status = 0;
   uint64_t receipt_bytes = 0;
