@@ -60,7 +60,8 @@ def cortex_m4_prefix(a, stream, want):
               f"{'yes' if not failures else 'NO'}. "
               + (f"It then reported its workspace full after the first {full['bytes']:,} bytes and the host "
                  f"stopped the stream: {full['acked']:,} of its {full['stream']:,} bytes had been delivered when it "
-                 f"closed, instead of all {prefix['levels'] - prefix['level']} skipped levels "
+                 f"closed, so the {prefix['levels'] - prefix['level']} levels the client could not hold cost the "
+                 f"line only the {full['acked'] - full['bytes']:,} bytes already in flight "
                  if full else "It did not report its workspace full ")
               + "(log: `out/demo/model/serve_cortex_m4.log`).\n")
     return failures
