@@ -80,6 +80,7 @@ struct Client {
   // difference from the snapshot taken when its header chunk arrived.
   // Parsing is the time inside StreamParser::feed outside the callbacks.
   uint64_t parse_total = 0, decode_total = 0, display_total = 0;
+  uint64_t link_total = 0;  // the link serviced between bands: in no stage
   uint64_t parse_at_start = 0, decode_at_start = 0, display_at_start = 0;
   vds::StageClock stages;  // the image decoder's split of decode_total (boards with a counter)
   uint64_t entropy_at_start = 0, transform_at_start = 0;
@@ -101,14 +102,31 @@ void log_status(const char* what, Status s) {
   board::log(Line().str("client: ").str(what).str(": ").str(vds::status_name(s)).str("\n").c_str());
 }
 
+// Keeps the link moving while a frame is decoded and drawn, between its
+// bands: what the UART holds goes to the link (the receive buffer must not
+// overrun) and the acknowledgements it owes go out (the host must not time
+// out while a long frame is drawn). Stream bytes wait in the link's window
+// until the main loop feeds them to the parser.
+void service_link() {
+  const uint64_t t0 = board::instructions();
+  const uint32_t now = board::millis();
+  uint8_t buf[128];
+  size_t n = 0;
+  while ((n = board::uart_read(buf, sizeof buf)) != 0) g.link.receive(buf, n, now);
+  while ((n = g.link.transmit(buf, sizeof buf, now)) != 0) board::uart_write(buf, n);
+  g.link_total += board::instructions() - t0;
+}
+
 // Display callback of the image decoder: one band of full-width RGB565 rows.
 bool on_band(void*, const vds::PixelRect& r) {
   const uint64_t t0 = board::instructions();
+  const uint64_t link_before = g.link_total;
   const size_t stride_pixels = static_cast<size_t>(r.stride) / 2;
   for (uint16_t row = 0; row < r.h; ++row)
     g.frame_crc = vds::crc32c_update(g.frame_crc, r.pixels + row * r.stride, static_cast<size_t>(r.w) * 2);
   board::display_band(r.y, r.h, reinterpret_cast<const uint16_t*>(r.pixels), stride_pixels);
-  g.display_total += board::instructions() - t0;
+  service_link();
+  g.display_total += board::instructions() - t0 - (g.link_total - link_before);
   return true;
 }
 
@@ -253,10 +271,11 @@ vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t 
     g.in_frame = true;
     g.frame_crc = 0;
     const uint64_t band_before = g.display_total;
+    const uint64_t link_before = g.link_total;
     const Status d = g.view.draw(g.mesh.mesh(), g.model_frames.angle(), on_render_band, nullptr);
     g.model_frames.mark_drawn(g.mesh);
     // Drawing counts as display: on_band has added its part, add the renderer's.
-    g.display_total += (board::instructions() - t1) - (g.display_total - band_before);
+    g.display_total += (board::instructions() - t1) - (g.display_total - band_before) - (g.link_total - link_before);
     if (d != Status::ok) {
       log_status("model view", d);
       result = vds::ChunkResult::abort;
@@ -276,6 +295,7 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
   const uint64_t parse_before = g.parse_total;
   g.parse_total += t0 - g.feed_mark;
   const uint64_t display_before = g.display_total;
+  const uint64_t link_before = g.link_total;
   if (type == vds::chunk::kImageHeader) {
     board::display_begin_frame(g.header.width, g.header.height);
     g.in_frame = true;
@@ -286,7 +306,7 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
   const vds::ImageTarget target = vds::ImageTarget::bands(vds::PixelFormat::rgb565, reinterpret_cast<uint8_t*>(g.band),
                                                           static_cast<ptrdiff_t>(g.header.width) * 2, on_band, nullptr);
   const Status s = g.decoder.on_chunk(type, payload, size, target);
-  g.decode_total += (board::instructions() - t0) - (g.display_total - display_before);
+  g.decode_total += (board::instructions() - t0) - (g.display_total - display_before) - (g.link_total - link_before);
   vds::ChunkResult result = vds::ChunkResult::consumed;
   if (vds::is_error(s)) {
     log_status("image", s);
