@@ -528,6 +528,10 @@ Status MeshDecoder::level_items(const uint8_t* conn, uint32_t conn_size, const u
     if (needs_geom) bg.init(geom, geom_size);
   }
   for (uint32_t item = first; item < first + count; ++item) {
+    if (progress_ != nullptr && ++progress_count_ >= progress_every_) {
+      progress_count_ = 0;
+      progress_(progress_user_);
+    }
     if (item < pass_a_) {
       // Pass A: which vertices split.
       if (arith) {

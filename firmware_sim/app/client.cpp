@@ -37,6 +37,7 @@ constexpr uint32_t kBandRows = 16;          // one MCU row of a 4:2:0 image
 constexpr uint32_t kStatsPeriodMs = 1000;   // statistics datagram
 constexpr uint32_t kPendingRecords = 8;     // frame records waiting for the checksums channel
 constexpr size_t kStreamReadBytes = 256;    // stream bytes handed to the parser at a time
+constexpr uint32_t kMeshServiceItems = 64;  // mesh items decoded between two services of the link
 constexpr uint32_t kDrainTimeoutMs = 20000;  // after the report, wait at most this long for the host's Goodbye
 constexpr uint32_t kGoodbyeWaitMs = 3000;    // once the host has acknowledged everything, this long
 
@@ -203,6 +204,8 @@ bool start_model(const uint8_t* mshh, uint32_t size) {
     l.dec(g.header.max_vertices).str(" vertices; later levels are skipped\n");
     board::log(l.c_str());
   }
+  // A level's chunk can take long to decode: keep the link moving meanwhile.
+  g.mesh.set_progress([](void*) { service_link(); }, nullptr, kMeshServiceItems);
   g.model_started = true;
   return true;
 }
@@ -252,9 +255,10 @@ vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t 
   }
   const uint64_t t0 = board::instructions();
   g.parse_total += t0 - g.feed_mark;
+  const uint64_t link_before_decode = g.link_total;
   const Status s = g.mesh.consume(type, payload, size);
   const uint64_t t1 = board::instructions();
-  g.decode_total += t1 - t0;
+  g.decode_total += t1 - t0 - (g.link_total - link_before_decode);
   vds::ChunkResult result = vds::ChunkResult::consumed;
   if (vds::is_error(s)) {
     log_status("mesh", s);

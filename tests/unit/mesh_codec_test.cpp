@@ -193,6 +193,35 @@ TEST(MeshCodec, SmallChunksSplitLevels) {
   EXPECT_LE(mx.max, 512u);
 }
 
+// The progress callback runs every N level items, inside consume(), and
+// leaves the decoding as it was.
+TEST(MeshCodec, ProgressIsCalledWhileLevelsDecode) {
+  const Mesh m = vds::test::torus_mesh(64, 32);
+  const MeshEncodeResult r = vds::enc::encode_mesh(m, MeshEncodeOptions{});
+  struct Count {
+    uint32_t calls = 0;
+  };
+  auto decode = [&](uint32_t every, Count* count, std::vector<uint64_t>* sums) {
+    Client c;
+    if (every != 0)
+      c.decoder.set_progress([](void* user) { ++static_cast<Count*>(user)->calls; }, count, every);
+    ASSERT_EQ(c.feed(r.stream, r.stream.size()), Status::ok);
+    *sums = c.checksums;
+  };
+  Count each, sixteen, none;
+  std::vector<uint64_t> s1, s16, s0;
+  decode(1, &each, &s1);
+  decode(16, &sixteen, &s16);
+  decode(0, &none, &s0);
+  // One item per split flag and per split, level after level: more items
+  // than the torus has vertices.
+  EXPECT_GT(each.calls, 2048u);
+  EXPECT_EQ(sixteen.calls, each.calls / 16);
+  EXPECT_EQ(none.calls, 0u);
+  EXPECT_EQ(s1, s0);
+  EXPECT_EQ(s16, s0);
+}
+
 // Applies the simplifier's collapses to the input faces: the face set of
 // each level, in input vertex ids.
 std::vector<std::set<std::array<uint32_t, 3>>> hierarchy(const Mesh& mesh, const vds::enc::SimplifyResult& s) {

@@ -344,6 +344,18 @@ class MeshDecoder {
   // Numbers of the level completed last (level 0 = the base).
   const MeshLevelInfo& last_level() const { return last_; }
 
+  // Calls fn(user) after every `every_items` level items (split flags and
+  // vertex splits) while consume() decodes a chunk: a full chunk can take a
+  // third of a second on a 100 MHz microcontroller, and a client may have
+  // other work meanwhile (its link). fn must not call this decoder. nullptr
+  // or 0 turns it off (the default).
+  void set_progress(void (*fn)(void* user), void* user, uint32_t every_items) {
+    progress_ = every_items != 0 ? fn : nullptr;
+    progress_user_ = user;
+    progress_every_ = every_items;
+    progress_count_ = 0;
+  }
+
  private:
   Status fail(Status s) {
     if (status_ == Status::ok) status_ = s;
@@ -389,6 +401,10 @@ class MeshDecoder {
   int weight_q4_ = 0;
   MeshLevelInfo last_{};
   MeshLevelInfo cur_{};
+  void (*progress_)(void*) = nullptr;
+  void* progress_user_ = nullptr;
+  uint32_t progress_every_ = 0;
+  uint32_t progress_count_ = 0;
 };
 
 }  // namespace vds
