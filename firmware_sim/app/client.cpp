@@ -53,7 +53,6 @@ struct Client {
   vds::ModelView view;
   bool model = false;
   bool model_started = false;  // MSHH seen: decoder and view set up
-  bool model_full_logged = false;
   // The workspace holds no more of the model: the client reports early and
   // the host writes no more; stream bytes still in flight are read and
   // dropped (counted, outside the report's bytes and CRC).
@@ -81,7 +80,7 @@ struct Client {
   // difference from the snapshot taken when its header chunk arrived.
   // Parsing is the time inside StreamParser::feed outside the callbacks.
   uint64_t parse_total = 0, decode_total = 0, display_total = 0;
-  uint64_t link_total = 0;  // the link serviced between bands: in no stage
+  uint64_t link_total = 0;  // instructions spent servicing the link inside a frame: in no stage (work_clock)
   uint64_t parse_at_start = 0, decode_at_start = 0, display_at_start = 0;
   vds::StageClock stages;  // the image decoder's split of decode_total (boards with a counter)
   uint64_t entropy_at_start = 0, transform_at_start = 0;
@@ -118,23 +117,26 @@ void service_link() {
   g.link_total += board::instructions() - t0;
 }
 
+// The clock every stage count reads: the board's instruction counter less
+// the time spent in service_link, which belongs to no stage.
+uint64_t work_clock() { return board::instructions() - g.link_total; }
+
 // Display callback of the image decoder: one band of full-width RGB565 rows.
 bool on_band(void*, const vds::PixelRect& r) {
-  const uint64_t t0 = board::instructions();
-  const uint64_t link_before = g.link_total;
+  const uint64_t t0 = work_clock();
   const size_t stride_pixels = static_cast<size_t>(r.stride) / 2;
   for (uint16_t row = 0; row < r.h; ++row)
     g.frame_crc = vds::crc32c_update(g.frame_crc, r.pixels + row * r.stride, static_cast<size_t>(r.w) * 2);
   board::display_band(r.y, r.h, reinterpret_cast<const uint16_t*>(r.pixels), stride_pixels);
   service_link();
-  g.display_total += board::instructions() - t0 - (g.link_total - link_before);
+  g.display_total += work_clock() - t0;
   return true;
 }
 
 void finish_frame() {
-  const uint64_t t0 = board::instructions();
+  const uint64_t t0 = work_clock();
   board::display_end_frame(g.frame_crc);
-  g.display_total += board::instructions() - t0;
+  g.display_total += work_clock() - t0;
   const uint32_t now = board::millis();
   if (g.frames_shown == 0) g.first_frame_ms = now;
   // Frame i is due one period after frame i-1, counted from the first one.
@@ -220,7 +222,6 @@ bool on_header(void*, const vds::StreamHeader& h) {
   if (h.mode == vds::StreamMode::model) {
     g.model = true;
     g.model_started = false;
-    g.model_full_logged = false;
     g.model_frames = vds::ModelFrames{};
     start_frame_counts(g.parse_total);
     return true;
@@ -233,7 +234,7 @@ bool on_header(void*, const vds::StreamHeader& h) {
   }
   if (board::instruction_resolution() != 0) {
     g.stages = vds::StageClock{};
-    g.stages.now = [](void*) { return board::instructions(); };
+    g.stages.now = [](void*) { return work_clock(); };
     g.decoder.set_stage_clock(&g.stages);
   }
   g.band = g.arena.alloc_array<uint16_t>(static_cast<size_t>(h.width) * kBandRows);
@@ -253,18 +254,16 @@ vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t 
     if (type != vds::chunk::kMeshHeader) log_status("mesh: first mesh chunk is not MSHH", Status::malformed);
     return vds::ChunkResult::abort;
   }
-  const uint64_t t0 = board::instructions();
+  const uint64_t t0 = work_clock();
   g.parse_total += t0 - g.feed_mark;
-  const uint64_t link_before_decode = g.link_total;
   const Status s = g.mesh.consume(type, payload, size);
-  const uint64_t t1 = board::instructions();
-  g.decode_total += t1 - t0 - (g.link_total - link_before_decode);
+  const uint64_t t1 = work_clock();
+  g.decode_total += t1 - t0;
   vds::ChunkResult result = vds::ChunkResult::consumed;
   if (vds::is_error(s)) {
     log_status("mesh", s);
     result = vds::ChunkResult::abort;
-  } else if (g.mesh.capacity_reached() && !g.model_full_logged) {
-    g.model_full_logged = true;
+  } else if (g.mesh.capacity_reached() && !g.full) {
     g.full = true;
     Line l;
     l.str("client: model: workspace full after level ").dec(g.mesh.levels_done()).str(" of ");
@@ -275,11 +274,10 @@ vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t 
     g.in_frame = true;
     g.frame_crc = 0;
     const uint64_t band_before = g.display_total;
-    const uint64_t link_before = g.link_total;
     const Status d = g.view.draw(g.mesh.mesh(), g.model_frames.angle(), on_render_band, nullptr);
     g.model_frames.mark_drawn(g.mesh);
     // Drawing counts as display: on_band has added its part, add the renderer's.
-    g.display_total += (board::instructions() - t1) - (g.display_total - band_before) - (g.link_total - link_before);
+    g.display_total += (work_clock() - t1) - (g.display_total - band_before);
     if (d != Status::ok) {
       log_status("model view", d);
       result = vds::ChunkResult::abort;
@@ -288,18 +286,17 @@ vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t 
       start_frame_counts(g.parse_total);
     }
   }
-  g.feed_mark = board::instructions();
+  g.feed_mark = work_clock();
   return result;
 }
 
 vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t size) {
   if (g.model) return on_model_chunk(type, payload, size);
   if (type != vds::chunk::kImageHeader && type != vds::chunk::kImageData) return vds::ChunkResult::unknown;
-  const uint64_t t0 = board::instructions();
+  const uint64_t t0 = work_clock();
   const uint64_t parse_before = g.parse_total;
   g.parse_total += t0 - g.feed_mark;
   const uint64_t display_before = g.display_total;
-  const uint64_t link_before = g.link_total;
   if (type == vds::chunk::kImageHeader) {
     board::display_begin_frame(g.header.width, g.header.height);
     g.in_frame = true;
@@ -310,7 +307,7 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
   const vds::ImageTarget target = vds::ImageTarget::bands(vds::PixelFormat::rgb565, reinterpret_cast<uint8_t*>(g.band),
                                                           static_cast<ptrdiff_t>(g.header.width) * 2, on_band, nullptr);
   const Status s = g.decoder.on_chunk(type, payload, size, target);
-  g.decode_total += (board::instructions() - t0) - (g.display_total - display_before) - (g.link_total - link_before);
+  g.decode_total += (work_clock() - t0) - (g.display_total - display_before);
   vds::ChunkResult result = vds::ChunkResult::consumed;
   if (vds::is_error(s)) {
     log_status("image", s);
@@ -318,7 +315,7 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
   } else if (type == vds::chunk::kImageData && s == Status::ok) {
     finish_frame();
   }
-  g.feed_mark = board::instructions();
+  g.feed_mark = work_clock();
   return result;
 }
 
@@ -372,9 +369,9 @@ void feed_stream() {
     if (g.link.read(link::channel::kStream, buf, want, &got) != Status::ok || got == 0) return;
     g.stream_bytes += static_cast<uint32_t>(got);
     g.stream_crc = vds::crc32c_update(g.stream_crc, buf, got);
-    g.feed_mark = board::instructions();
+    g.feed_mark = work_clock();
     Status s = g.parser.feed(buf, got);
-    g.parse_total += board::instructions() - g.feed_mark;
+    g.parse_total += work_clock() - g.feed_mark;
     if (s == Status::more_input && g.full) {
       // Every later level would be skipped: the report goes now, and covers
       // the bytes received so far.

@@ -116,8 +116,9 @@ def main():
     print(f"encoder  : {' '.join(want)}")
     print(f"host     : {' '.join(host_crcs)}")
     print(f"cortex-m4: {' '.join(qemu_crcs)}")
-    shown = {"host-native": (host_crcs, host.board_log), "Cortex-M4": (qemu_crcs, qemu.board_log)}
-    for name, (crcs, log) in shown.items():
+    shown = {"host-native": (host_crcs, host), "Cortex-M4": (qemu_crcs, qemu)}
+    for name, (crcs, run) in shown.items():
+        log = run.board_log
         expect = want
         if a.prefix:
             # The client says where its workspace ran out; it shows the base
@@ -130,8 +131,7 @@ def main():
                 if len(expect) >= len(want):
                     failures.append(f"{name} board held every level: the stream does not test a prefix")
             # It then says so, and the host stops the stream.
-            served = host.serve.stdout if name == "host-native" else qemu.serve.stdout
-            full = sim.full_report(served)
+            full = sim.full_report(run.serve.stdout)
             if not full:
                 failures.append(f"{name} board: vds serve shows no verified workspace-full report")
             else:
