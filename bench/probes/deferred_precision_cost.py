@@ -75,7 +75,7 @@ def main():
                 _, scale, role, r, s = map(int, fields[1:])
                 total["N"] += signed(("N", role, scale, s), r)
             elif fields[0] == "R":
-                _, scale, role, _, a, s, offset, predicted = map(int, fields[1:])
+                _, scale, role, a, s, offset, predicted = map(int, fields[1:])
                 low, width = 0, 1 << a  # the interval, grid units from the cell's low corner
                 for b in range(a - s - 1, -1, -1):
                     mid = low + width // 2
