@@ -101,7 +101,7 @@ struct Client {
         }
         out.triangles.resize(m.triangle_count());
         for (uint32_t t = 0; t < m.triangle_count(); ++t)
-          out.triangles[t] = {m.triangles()[3 * t], m.triangles()[3 * t + 1], m.triangles()[3 * t + 2]};
+          out.triangles[t] = {m.corner_vertex(3 * t), m.corner_vertex(3 * t + 1), m.corner_vertex(3 * t + 2)};
         c->levels.emplace_back(c->parser.bytes_consumed(), std::move(out));
       }
       return ChunkResult::consumed;

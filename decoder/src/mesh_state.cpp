@@ -28,26 +28,28 @@ size_t aligned(size_t bytes) { return bytes + alignof(uint32_t); }
 size_t MeshState::workspace_bytes(uint32_t max_vertices, uint32_t max_triangles) {
   // Keep every product inside 32 bits so the size is right on the client too.
   if (max_vertices > 0x0FFFFFFFu || max_triangles > 0x07FFFFFFu) return SIZE_MAX;
+  const uint64_t corners = uint64_t{max_triangles} * 3;
   const uint64_t total = aligned(uint64_t{max_vertices} * 3 * sizeof(uint16_t)) +
-                         aligned(uint64_t{max_vertices} * sizeof(uint32_t)) +
-                         aligned(uint64_t{max_triangles} * 3 * sizeof(uint32_t)) +
-                         aligned(uint64_t{max_triangles} * 3 * sizeof(int32_t)) +
+                         IndexTable::workspace_bytes(max_vertices, corners) +
+                         IndexTable::workspace_bytes(corners, max_vertices) +
+                         IndexTable::workspace_bytes(corners, corners) +
                          4 * aligned((kMeshMaxDegree + 1) * sizeof(uint32_t));
   return total > SIZE_MAX ? SIZE_MAX : static_cast<size_t>(total);
 }
 
 Status MeshState::init(Arena& arena, uint32_t max_vertices, uint32_t max_triangles) {
   if (workspace_bytes(max_vertices, max_triangles) == SIZE_MAX) return Status::workspace_too_small;
+  const uint32_t corners = max_triangles * 3;
   pos_ = arena.alloc_array<uint16_t>(size_t{max_vertices} * 3);
-  vertex_corner_ = arena.alloc_array<uint32_t>(max_vertices);
-  corner_vertex_ = arena.alloc_array<uint32_t>(size_t{max_triangles} * 3);
-  opposite_ = arena.alloc_array<int32_t>(size_t{max_triangles} * 3);
+  bool ok = vertex_corner_.init(arena, max_vertices, corners);
+  ok = corner_vertex_.init(arena, corners, max_vertices) && ok;
+  ok = opposite_.init(arena, corners, corners) && ok;
   for (int i = 0; i < 2; ++i) {
     ring_vertex_[i] = arena.alloc_array<uint32_t>(kMeshMaxDegree + 1);
     ring_corner_[i] = arena.alloc_array<uint32_t>(kMeshMaxDegree + 1);
   }
-  if ((max_vertices && (!pos_ || !vertex_corner_)) || (max_triangles && (!corner_vertex_ || !opposite_)) ||
-      !ring_vertex_[0] || !ring_vertex_[1] || !ring_corner_[0] || !ring_corner_[1])
+  if (!ok || (max_vertices && !pos_) || !ring_vertex_[0] || !ring_vertex_[1] || !ring_corner_[0] ||
+      !ring_corner_[1])
     return Status::workspace_too_small;
   cap_v_ = max_vertices;
   cap_t_ = max_triangles;
@@ -69,7 +71,7 @@ Status MeshState::add_vertex(const int32_t p[3]) {
   for (int k = 0; k < 3; ++k)
     if (p[k] < 0 || p[k] > top) return Status::malformed;
   for (int k = 0; k < 3; ++k) pos_[3 * nv_ + k] = static_cast<uint16_t>(p[k]);
-  vertex_corner_[nv_] = kMeshNone;
+  vertex_corner_.set(nv_, kMeshNone);
   ++nv_;
   return Status::ok;
 }
@@ -86,10 +88,10 @@ Status MeshState::set_position(uint32_t v, const int32_t p[3]) {
 Status MeshState::add_triangle(uint32_t a, uint32_t b, uint32_t c) {
   if (nt_ >= cap_t_) return Status::malformed;
   if (a >= nv_ || b >= nv_ || c >= nv_ || a == b || b == c || a == c) return Status::malformed;
-  corner_vertex_[3 * nt_] = a;
-  corner_vertex_[3 * nt_ + 1] = b;
-  corner_vertex_[3 * nt_ + 2] = c;
-  opposite_[3 * nt_] = opposite_[3 * nt_ + 1] = opposite_[3 * nt_ + 2] = -1;
+  corner_vertex_.set(3 * nt_, a);
+  corner_vertex_.set(3 * nt_ + 1, b);
+  corner_vertex_.set(3 * nt_ + 2, c);
+  for (uint32_t k = 0; k < 3; ++k) set_opp(3 * nt_ + k, -1);
   ++nt_;
   return Status::ok;
 }
@@ -102,52 +104,53 @@ Status MeshState::finish_base(Arena& arena, uint32_t max_degree) {
   // Per-vertex lists of corners: head in vertex_corner_, links here.
   uint32_t* link_next = arena.alloc_array<uint32_t>(nc ? nc : 1);
   if (link_next == nullptr) return Status::workspace_too_small;
-  for (uint32_t v = 0; v < nv_; ++v) vertex_corner_[v] = kMeshNone;
+  for (uint32_t v = 0; v < nv_; ++v) vertex_corner_.set(v, kMeshNone);
   for (uint32_t c = 0; c < nc; ++c) {
-    const uint32_t v = corner_vertex_[c];
-    link_next[c] = vertex_corner_[v];
-    vertex_corner_[v] = c;
+    const uint32_t v = corner_vertex(c);
+    link_next[c] = vertex_corner_.get(v);
+    vertex_corner_.set(v, c);
   }
   Status st = Status::ok;
   // No vertex may have more faces than the degree limit: this also bounds
   // the list walks below, so a hostile base costs O(corners * max_degree).
   for (uint32_t v = 0; v < nv_ && st == Status::ok; ++v) {
     uint32_t n = 0;
-    for (uint32_t x = vertex_corner_[v]; x != kMeshNone && st == Status::ok; x = link_next[x])
+    for (uint32_t x = vertex_corner_.get(v); x != kMeshNone && st == Status::ok; x = link_next[x])
       if (++n > max_degree_) st = Status::malformed;
   }
   // Opposite of corner c: the face holding the reverse of c's opposite edge
   // (V[next c] -> V[prev c]), i.e. an edge V[prev c] -> V[next c].
   for (uint32_t c = 0; c < nc && st == Status::ok; ++c) {
-    const uint32_t a = corner_vertex_[prev(c)], b = corner_vertex_[next(c)];
+    const uint32_t a = corner_vertex(prev(c)), b = corner_vertex(next(c));
     int32_t found = -1;
     uint32_t same_direction = 0;
-    for (uint32_t x = vertex_corner_[a]; x != kMeshNone; x = link_next[x]) {
-      if (corner_vertex_[next(x)] == b) {
+    for (uint32_t x = vertex_corner_.get(a); x != kMeshNone; x = link_next[x]) {
+      if (corner_vertex(next(x)) == b) {
         if (found >= 0) st = Status::malformed;  // two faces with edge a -> b
         found = static_cast<int32_t>(prev(x));
       }
     }
-    for (uint32_t x = vertex_corner_[b]; x != kMeshNone; x = link_next[x])
-      if (corner_vertex_[next(x)] == a) ++same_direction;
+    for (uint32_t x = vertex_corner_.get(b); x != kMeshNone; x = link_next[x])
+      if (corner_vertex(next(x)) == a) ++same_direction;
     if (same_direction != 1) st = Status::malformed;  // edge b -> a in another face too
-    opposite_[c] = found;
+    set_opp(c, found);
   }
   for (uint32_t c = 0; c < nc && st == Status::ok; ++c)
-    if (opposite_[c] >= 0 && opposite_[opposite_[c]] != static_cast<int32_t>(c)) st = Status::malformed;
+    if (opposite(c) >= 0 && opposite(static_cast<uint32_t>(opposite(c))) != static_cast<int32_t>(c))
+      st = Status::malformed;
   // One fan per vertex, no vertex unused, degrees within the limit.
   for (uint32_t v = 0; v < nv_ && st == Status::ok; ++v) {
     uint32_t total = 0;
-    for (uint32_t x = vertex_corner_[v]; x != kMeshNone; x = link_next[x]) ++total;
+    for (uint32_t x = vertex_corner_.get(v); x != kMeshNone; x = link_next[x]) ++total;
     if (total == 0) {
       st = Status::malformed;
       break;
     }
     // Clockwise to the boundary start (or all the way round).
-    const uint32_t c0 = vertex_corner_[v];
+    const uint32_t c0 = vertex_corner_.get(v);
     uint32_t c = c0;
     for (uint32_t step = 0; step <= total; ++step) {
-      const int32_t o = opposite_[prev(c)];
+      const int32_t o = opposite(prev(c));
       if (o < 0) break;
       c = prev(static_cast<uint32_t>(o));
       if (c == c0) break;
@@ -159,7 +162,7 @@ Status MeshState::finish_base(Arena& arena, uint32_t max_degree) {
     do {
       ++faces;
       if (faces > total) break;
-      const int32_t o = opposite_[next(c)];
+      const int32_t o = opposite(next(c));
       if (o < 0) {
         boundary = true;
         break;
@@ -169,38 +172,66 @@ Status MeshState::finish_base(Arena& arena, uint32_t max_degree) {
     const uint32_t degree = faces + (boundary ? 1u : 0u);
     if (faces != total || degree > max_degree_) st = Status::malformed;
     if (degree > max_degree_seen_) max_degree_seen_ = degree;
-    vertex_corner_[v] = start;  // v's list is no longer needed
+    vertex_corner_.set(v, start);  // v's list is no longer needed
   }
   arena.rewind(mark);
   return st;
 }
 
+namespace {
+
+// The walk of MeshState::ring over tables of either width (Index: uint16_t
+// or uint32_t entries, all ones = none): the loop every split and
+// prediction runs, so the widths are chosen once per walk, not per entry.
+// Returns the degree, with *boundary set, or 0 if the walk is malformed.
+template <typename VertexIndex, typename CornerIndex>
+uint32_t walk_ring(const VertexIndex* cv, const CornerIndex* opp, uint32_t x, uint32_t c0, uint32_t max_degree,
+                   uint32_t* rv, uint32_t* rc, bool* boundary) {
+  constexpr CornerIndex kNone = static_cast<CornerIndex>(~CornerIndex{0});
+  auto next = [](uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; };
+  auto prev = [](uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; };
+  uint32_t c = c0, d = 0;
+  *boundary = false;
+  while (true) {
+    if (d >= max_degree || cv[c] != x) return 0;
+    const uint32_t n = next(c);
+    rv[d] = cv[n];
+    rc[d] = c;
+    ++d;
+    const CornerIndex o = opp[n];
+    if (o == kNone) {
+      if (d >= max_degree) return 0;
+      rv[d] = cv[prev(c)];
+      rc[d] = kMeshNone;
+      *boundary = true;
+      return d + 1;
+    }
+    c = next(o);
+    if (c == c0) return d;
+  }
+}
+
+}  // namespace
+
 Status MeshState::ring(uint32_t x, Ring* out, int scratch) {
   if (x >= nv_) return Status::malformed;
-  const uint32_t c0 = vertex_corner_[x];
+  const uint32_t c0 = vertex_corner_.get(x);
   if (c0 == kMeshNone || c0 >= 3 * nt_) return Status::malformed;
   uint32_t* rv = ring_vertex_[scratch];
   uint32_t* rc = ring_corner_[scratch];
-  uint32_t c = c0, d = 0;
   bool boundary = false;
-  while (true) {
-    if (d >= max_degree_ || corner_vertex_[c] != x) return Status::malformed;
-    rv[d] = corner_vertex_[next(c)];
-    rc[d] = c;
-    ++d;
-    const int32_t o = opposite_[next(c)];
-    if (o < 0) {
-      if (d >= max_degree_) return Status::malformed;
-      rv[d] = corner_vertex_[prev(c)];
-      rc[d] = kMeshNone;
-      ++d;
-      boundary = true;
-      break;
-    }
-    c = next(static_cast<uint32_t>(o));
-    if (c == c0) break;
-  }
-  if (!boundary && d < 3) return Status::malformed;
+  const uint16_t* cv16 = corner_vertex_.narrow();
+  const uint16_t* op16 = opposite_.narrow();
+  uint32_t d;
+  if (cv16 != nullptr && op16 != nullptr)
+    d = walk_ring(cv16, op16, x, c0, max_degree_, rv, rc, &boundary);
+  else if (cv16 != nullptr)
+    d = walk_ring(cv16, opposite_.wide(), x, c0, max_degree_, rv, rc, &boundary);
+  else if (op16 != nullptr)
+    d = walk_ring(corner_vertex_.wide(), op16, x, c0, max_degree_, rv, rc, &boundary);
+  else
+    d = walk_ring(corner_vertex_.wide(), opposite_.wide(), x, c0, max_degree_, rv, rc, &boundary);
+  if (d == 0 || (!boundary && d < 3)) return Status::malformed;
   if (d > max_degree_seen_) max_degree_seen_ = d;
   out->degree = d;
   out->boundary = boundary;
@@ -221,11 +252,11 @@ bool MeshState::choice_valid(const Ring& r, const SplitChoice& c) {
 }
 
 void MeshState::fix_vertex_corner(uint32_t x, uint32_t hint) {
-  uint32_t c = vertex_corner_[x];
-  if (c >= 3 * nt_ || corner_vertex_[c] != x) c = hint;
+  uint32_t c = vertex_corner_.get(x);
+  if (c >= 3 * nt_ || corner_vertex(c) != x) c = hint;
   const uint32_t c0 = c;
   for (uint32_t step = 0; step <= max_degree_; ++step) {
-    const int32_t o = opposite_[prev(c)];
+    const int32_t o = opposite(prev(c));
     if (o < 0) break;
     const uint32_t n = prev(static_cast<uint32_t>(o));
     if (n == c0) {
@@ -234,7 +265,7 @@ void MeshState::fix_vertex_corner(uint32_t x, uint32_t hint) {
     }
     c = n;
   }
-  vertex_corner_[x] = c;
+  vertex_corner_.set(x, c);
 }
 
 Status MeshState::split(uint32_t u, const SplitChoice& ch, uint32_t* new_vertex) {
@@ -265,29 +296,29 @@ Status MeshState::split(uint32_t u, const SplitChoice& ch, uint32_t* new_vertex)
   }
   const uint32_t v = nv_++;
   pos_[3 * v] = pos_[3 * v + 1] = pos_[3 * v + 2] = 0;
-  vertex_corner_[v] = kMeshNone;
-  for (uint32_t i = 0; i < count; ++i) corner_vertex_[r.corner[face(first + i)]] = v;
+  vertex_corner_.set(v, kMeshNone);
+  for (uint32_t i = 0; i < count; ++i) corner_vertex_.set(r.corner[face(first + i)], v);
   auto corner = [](uint32_t c) { return c == kMeshNone ? -1 : static_cast<int32_t>(c); };
   int32_t a0 = -1, a1 = -1, a2 = -1, b0 = -1, b1 = -1, b2 = -1;
   if (has_l) {
     const uint32_t t = nt_++;
-    corner_vertex_[3 * t] = v;
-    corner_vertex_[3 * t + 1] = l_vertex;
-    corner_vertex_[3 * t + 2] = u;
+    corner_vertex_.set(3 * t, v);
+    corner_vertex_.set(3 * t + 1, l_vertex);
+    corner_vertex_.set(3 * t + 2, u);
     a0 = static_cast<int32_t>(3 * t);
     a1 = a0 + 1;
     a2 = a0 + 2;
-    opposite_[a0] = opposite_[a1] = opposite_[a2] = -1;
+    for (uint32_t k = 0; k < 3; ++k) set_opp(3 * t + k, -1);
   }
   if (has_f) {
     const uint32_t t = nt_++;
-    corner_vertex_[3 * t] = v;
-    corner_vertex_[3 * t + 1] = u;
-    corner_vertex_[3 * t + 2] = f_vertex;
+    corner_vertex_.set(3 * t, v);
+    corner_vertex_.set(3 * t + 1, u);
+    corner_vertex_.set(3 * t + 2, f_vertex);
     b0 = static_cast<int32_t>(3 * t);
     b1 = b0 + 1;
     b2 = b0 + 2;
-    opposite_[b0] = opposite_[b1] = opposite_[b2] = -1;
+    for (uint32_t k = 0; k < 3; ++k) set_opp(3 * t + k, -1);
   }
   if (has_l) {
     // Edge (v, L) with the last moved face, edge (L, u) with the face after.
@@ -303,7 +334,7 @@ Status MeshState::split(uint32_t u, const SplitChoice& ch, uint32_t* new_vertex)
   // Corners the walks start from: boundary vertices start at their first face.
   const uint32_t v_hint = static_cast<uint32_t>(has_l ? a0 : b0);
   const uint32_t u_hint = static_cast<uint32_t>(has_l ? a2 : b1);
-  vertex_corner_[v] = v_hint;
+  vertex_corner_.set(v, v_hint);
   fix_vertex_corner(v, v_hint);
   fix_vertex_corner(u, u_hint);
   if (has_f) fix_vertex_corner(f_vertex, static_cast<uint32_t>(b2));
@@ -396,9 +427,9 @@ Status MeshState::predict(uint32_t v, MeshPredictor predictor, int weight_q4, in
     for (uint32_t j = 0; j < d; ++j)
       for (int a = 0; a < 3; ++a) s[a] += pos_[3 * r.vertex[j] + a];
     for (uint32_t j = 0; j < r.faces(); ++j) {
-      const int32_t o = opposite_[r.corner[j]];
+      const int32_t o = opposite(r.corner[j]);
       if (o < 0) continue;
-      const uint32_t ov = corner_vertex_[o];
+      const uint32_t ov = corner_vertex(static_cast<uint32_t>(o));
       const uint32_t a_v = r.vertex[j], b_v = r.vertex[(j + 1) % d];
       for (int a = 0; a < 3; ++a)
         p[a] += int64_t{pos_[3 * a_v + a]} + pos_[3 * b_v + a] - pos_[3 * ov + a];

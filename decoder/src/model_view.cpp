@@ -8,7 +8,9 @@
 namespace vds {
 namespace {
 
-constexpr uint32_t kMaxPositions = 65536;  // the renderer's uint16 indices
+// The renderer's uint16 indices, which draw() takes from the mesh's own
+// 16-bit corner table (MeshState::triangles16).
+constexpr uint32_t kMaxPositions = 65535;
 constexpr int64_t kCameraDistanceQ16 = 3 * 65536 + 13107;  // 3.2 world units
 constexpr uint32_t kElevation = 238609294u;                // 20 degrees in 2^-32 turn
 // Direction to the light in camera space (x right, y down, z forward), Q15:
@@ -42,9 +44,9 @@ size_t ModelView::workspace_bytes(const ModelViewConfig& cfg, uint32_t max_verti
   if (max_vertices == 0 || max_vertices > kMaxPositions || max_triangles == 0) return 0;
   const size_t render = render_workspace_size(render_config(cfg, max_vertices, max_triangles));
   if (render == 0) return 0;
-  // Positions (12), colours (4) per vertex, three uint16 indices per
-  // triangle, and alignment padding for each array.
-  return render + size_t{16} * max_vertices + size_t{6} * max_triangles + 3 * 8;
+  // Positions (12) and colours (4) per vertex, and alignment padding for
+  // each array; the triangles are the mesh's own.
+  return render + size_t{16} * max_vertices + 2 * 8;
 }
 
 Status ModelView::init(const ModelViewConfig& cfg, Arena& arena, uint32_t max_vertices, uint32_t max_triangles) {
@@ -53,8 +55,7 @@ Status ModelView::init(const ModelViewConfig& cfg, Arena& arena, uint32_t max_ve
   cfg_ = cfg;
   positions_ = arena.alloc_array<Vec3<Q16_16>>(max_vertices);
   colors_ = arena.alloc_array<uint32_t>(max_vertices);
-  indices_ = arena.alloc_array<uint16_t>(size_t{3} * max_triangles);
-  if (!positions_ || !colors_ || !indices_) return Status::workspace_too_small;
+  if (!positions_ || !colors_) return Status::workspace_too_small;
   const Status s = renderer_.init(render_config(cfg, max_vertices, max_triangles), arena);
   if (s != Status::ok) return s;
   cap_v_ = max_vertices;
@@ -69,7 +70,8 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
   const int bits = mesh.bits();
   if (bits < 2 || bits > 16) return Status::invalid_argument;
   const uint16_t* pos = mesh.positions();
-  const uint32_t* tri = mesh.triangles();
+  const uint16_t* tri = mesh.triangles16();
+  if (tri == nullptr) return Status::invalid_argument;
 
   // Camera basis (rows: right, down, forward) in Q2.30.
   const uint32_t theta = static_cast<uint32_t>(angle) << 16;
@@ -119,7 +121,7 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
   int32_t* acc = reinterpret_cast<int32_t*>(positions_);
   for (uint32_t i = 0; i < 3 * nv; ++i) acc[i] = 0;
   for (uint32_t t = 0; t < nt; ++t) {
-    const uint32_t* c = tri + 3 * t;
+    const uint16_t* c = tri + 3 * t;
     if (c[0] >= nv || c[1] >= nv || c[2] >= nv) return Status::invalid_argument;
     const uint16_t* p0 = pos + 3 * c[0];
     const uint16_t* p1 = pos + 3 * c[1];
@@ -178,10 +180,9 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
     for (int a = 0; a < 3; ++a) w[a] = (2 * static_cast<int32_t>(pos[3 * v + a]) - static_cast<int32_t>(lo[a] + hi[a])) * (1 << up);
     positions_[v] = {Q16_16::from_raw(w[0]), Q16_16::from_raw(w[1]), Q16_16::from_raw(w[2])};
   }
-  for (uint32_t i = 0; i < 3 * nt; ++i) indices_[i] = static_cast<uint16_t>(tri[i]);
 
   Mesh m;
-  m.indices = indices_;
+  m.indices = tri;
   m.num_triangles = nt;
   m.shading = Shading::gouraud;
   m.cull = Cull::none;

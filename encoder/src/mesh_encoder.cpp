@@ -687,8 +687,8 @@ MeshEncodeResult Encoder::run() {
     };
     std::vector<std::array<uint32_t, 3>> a, b;
     for (const auto& t : mesh_.triangles) a.push_back(canon(t));
-    const uint32_t* tv = st_.triangles();
-    for (uint32_t t = 0; t < nt; ++t) b.push_back(canon({orig_of_[tv[3 * t]], orig_of_[tv[3 * t + 1]], orig_of_[tv[3 * t + 2]]}));
+    auto orig = [this](uint32_t c) { return orig_of_[st_.corner_vertex(c)]; };
+    for (uint32_t t = 0; t < nt; ++t) b.push_back(canon({orig(3 * t), orig(3 * t + 1), orig(3 * t + 2)}));
     std::sort(a.begin(), a.end());
     std::sort(b.begin(), b.end());
     if (a != b) throw std::logic_error("encode_mesh: reconstructed faces differ from the input");
@@ -782,7 +782,7 @@ uint64_t mesh_checksum(const MeshState& m) {
   mix(m.vertex_count());
   mix(m.triangle_count());
   for (uint32_t i = 0; i < 3 * m.vertex_count(); ++i) mix(m.positions()[i]);
-  for (uint32_t i = 0; i < 3 * m.triangle_count(); ++i) mix(m.triangles()[i]);
+  for (uint32_t i = 0; i < 3 * m.triangle_count(); ++i) mix(m.corner_vertex(i));
   return h;
 }
 

@@ -194,8 +194,8 @@ void build_turned(TurnedMeshes& t) {
       ASSERT_EQ(s->add_vertex(s == &t.upright ? q : r), Status::ok);
     }
     for (uint32_t f = 0; f < m.triangle_count(); ++f) {
-      const uint32_t* c3 = m.triangles() + 3 * f;
-      ASSERT_EQ(s->add_triangle(c3[0], c3[1], c3[2]), Status::ok);
+      ASSERT_EQ(s->add_triangle(m.corner_vertex(3 * f), m.corner_vertex(3 * f + 1), m.corner_vertex(3 * f + 2)),
+                Status::ok);
     }
     ASSERT_EQ(s->finish_base(t.arena, 64), Status::ok);
   }
@@ -254,7 +254,8 @@ TEST(ModelView, RefusesWhatItCannotDraw) {
   cfg.width = 64;
   cfg.height = 48;
   EXPECT_EQ(vds::ModelView::workspace_bytes(cfg, 0, 10), 0u);
-  EXPECT_EQ(vds::ModelView::workspace_bytes(cfg, 65537, 10), 0u);
+  EXPECT_EQ(vds::ModelView::workspace_bytes(cfg, 65536, 10), 0u);
+  EXPECT_GT(vds::ModelView::workspace_bytes(cfg, 65535, 10), 0u);
   vds::ModelViewConfig bad = cfg;
   bad.width = 0;
   EXPECT_EQ(vds::ModelView::workspace_bytes(bad, 100, 100), 0u);
@@ -285,6 +286,26 @@ TEST(ModelView, RefusesWhatItCannotDraw) {
   vds::ModelView tiny;
   ASSERT_EQ(tiny.init(cfg, one, 2, 1), Status::ok);
   EXPECT_EQ(tiny.draw(mesh, 0, sink, nullptr), Status::invalid_argument) << "3 vertices in a view for 2";
+
+  // A mesh whose corner table is 32-bit (sized for more than 65,535
+  // vertices) has no 16-bit triangles to draw from.
+  {
+    std::vector<uint8_t> wide_ws(vds::MeshState::workspace_bytes(70000, 10));
+    vds::Arena wide_arena(wide_ws.data(), wide_ws.size());
+    vds::MeshState wide;
+    ASSERT_EQ(wide.init(wide_arena, 70000, 10), Status::ok);
+    wide.clear(10);
+    for (const auto& q : p) ASSERT_EQ(wide.add_vertex(q), Status::ok);
+    ASSERT_EQ(wide.add_triangle(0, 1, 2), Status::ok);
+    std::vector<uint8_t> scratch(64);
+    vds::Arena scratch_arena(scratch.data(), scratch.size());
+    ASSERT_EQ(wide.finish_base(scratch_arena, 12), Status::ok);
+    EXPECT_EQ(wide.triangles16(), nullptr);
+    vds::Arena fits(ws.data(), ws.size());
+    ASSERT_EQ(view.init(cfg, fits, 162, 320), Status::ok);
+    EXPECT_EQ(view.draw(wide, 0, sink, nullptr), Status::invalid_argument);
+    ASSERT_NE(mesh.triangles16(), nullptr);
+  }
 
   // The single triangle draws, and a sink that stops the frame is obeyed.
   vds::Arena fits(ws.data(), ws.size());

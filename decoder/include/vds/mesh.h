@@ -112,6 +112,44 @@ struct SplitChoice {
   uint32_t count = 0;
 };
 
+// An index table in the caller's arena, in 16-bit entries when every index
+// it will hold is below `limit` <= 0xFFFF (half the bytes: what lets a small
+// client hold more of a model), in 32-bit entries otherwise. kMeshNone (and
+// so an int32 -1) is stored as 0xFFFF in 16 bits.
+class IndexTable {
+ public:
+  static bool narrow_for(uint64_t limit) { return limit <= 0xFFFFu; }
+  // Bytes init() carves for n entries below `limit`, alignment included.
+  static uint64_t workspace_bytes(uint64_t n, uint64_t limit) {
+    return n * (narrow_for(limit) ? sizeof(uint16_t) : sizeof(uint32_t)) + alignof(uint32_t);
+  }
+  // false if the arena cannot hold it.
+  bool init(Arena& arena, uint32_t n, uint64_t limit) {
+    n16_ = nullptr;
+    n32_ = nullptr;
+    if (narrow_for(limit)) n16_ = arena.alloc_array<uint16_t>(n);
+    else n32_ = arena.alloc_array<uint32_t>(n);
+    return n == 0 || n16_ != nullptr || n32_ != nullptr;
+  }
+  uint32_t get(uint32_t i) const {
+    if (n16_ == nullptr) return n32_[i];
+    const uint32_t x = n16_[i];
+    return x == 0xFFFFu ? kMeshNone : x;
+  }
+  void set(uint32_t i, uint32_t value) {
+    if (n16_ != nullptr) n16_[i] = static_cast<uint16_t>(value);
+    else n32_[i] = value;
+  }
+  // The 16-bit entries, or nullptr when the table is 32-bit; the 32-bit
+  // entries, or nullptr when it is 16-bit.
+  const uint16_t* narrow() const { return n16_; }
+  const uint32_t* wide() const { return n32_; }
+
+ private:
+  uint16_t* n16_ = nullptr;
+  uint32_t* n32_ = nullptr;
+};
+
 // The ring of a vertex as MeshState::ring() returns it.
 struct Ring {
   uint32_t degree = 0;     // ring vertices
@@ -144,9 +182,14 @@ class MeshState {
   uint32_t triangle_count() const { return nt_; }
   int bits() const { return bits_; }
   const uint16_t* positions() const { return pos_; }  // x, y, z per vertex
-  const uint32_t* triangles() const { return corner_vertex_; }
-  const int32_t* opposites() const { return opposite_; }
-  uint32_t vertex_corner(uint32_t v) const { return vertex_corner_[v]; }
+  // The corner table: corner c is corner c % 3 of triangle c / 3; its
+  // vertex, and its opposite corner (-1 across a boundary edge).
+  uint32_t corner_vertex(uint32_t c) const { return corner_vertex_.get(c); }
+  int32_t opposite(uint32_t c) const { return static_cast<int32_t>(opposite_.get(c)); }
+  // Three vertex indices per triangle in 16 bits, what the renderer takes;
+  // nullptr if init() was given more than 65,535 vertices (32-bit table).
+  const uint16_t* triangles16() const { return corner_vertex_.narrow(); }
+  uint32_t vertex_corner(uint32_t v) const { return vertex_corner_.get(v); }
   void position(uint32_t v, int32_t out[3]) const {
     out[0] = pos_[3 * v];
     out[1] = pos_[3 * v + 1];
@@ -187,15 +230,19 @@ class MeshState {
   uint32_t next(uint32_t c) const { return c % 3 == 2 ? c - 2 : c + 1; }
   uint32_t prev(uint32_t c) const { return c % 3 == 0 ? c + 2 : c - 1; }
   void fix_vertex_corner(uint32_t x, uint32_t any_corner);
+  void set_opp(uint32_t c, int32_t o) { opposite_.set(c, static_cast<uint32_t>(o)); }
   void link(int32_t a, int32_t b) {
-    if (a >= 0) opposite_[a] = b;
-    if (b >= 0) opposite_[b] = a;
+    if (a >= 0) set_opp(static_cast<uint32_t>(a), b);
+    if (b >= 0) set_opp(static_cast<uint32_t>(b), a);
   }
 
+  // The tables are 16-bit when the capacity allows (IndexTable): vertex
+  // indices below 65,535 for corner_vertex_, corner indices below 65,535
+  // (21,845 triangles) for vertex_corner_ and opposite_.
   uint16_t* pos_ = nullptr;
-  uint32_t* vertex_corner_ = nullptr;
-  uint32_t* corner_vertex_ = nullptr;
-  int32_t* opposite_ = nullptr;
+  IndexTable vertex_corner_;
+  IndexTable corner_vertex_;
+  IndexTable opposite_;
   uint32_t cap_v_ = 0, cap_t_ = 0;
   uint32_t nv_ = 0, nt_ = 0;
   int bits_ = 0;

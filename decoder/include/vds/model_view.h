@@ -43,17 +43,19 @@ struct ModelViewConfig {
 
 class ModelView {
  public:
-  // Bytes init() carves for meshes of up to max_vertices (<= 65536) and
+  // Bytes init() carves for meshes of up to max_vertices (<= 65,535) and
   // max_triangles; 0 if the configuration is invalid.
   static size_t workspace_bytes(const ModelViewConfig& cfg, uint32_t max_vertices, uint32_t max_triangles);
 
-  // invalid_argument for a bad configuration or more than 65536 vertices;
+  // invalid_argument for a bad configuration or more than 65,535 vertices;
   // workspace_too_small if the arena cannot hold the buffers.
   Status init(const ModelViewConfig& cfg, Arena& arena, uint32_t max_vertices, uint32_t max_triangles);
 
   // Draws `mesh` with the camera at orbit angle `angle` (2^-16 turn, about
   // the vertical axis) and hands each finished band (RGB565) to `sink`.
-  // invalid_argument before init or for a mesh larger than init's counts.
+  // invalid_argument before init, for a mesh larger than init's counts or
+  // one whose MeshState was initialised for more than 65,535 vertices (its
+  // triangles are then 32-bit: MeshState::triangles16).
   Status draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx);
 
   // Changes the axis shown up for later frames (e.g. once MSHH is in).
@@ -65,7 +67,6 @@ class ModelView {
   Renderer renderer_;
   Vec3<Q16_16>* positions_ = nullptr;  // also the normal accumulators while shading
   uint32_t* colors_ = nullptr;
-  uint16_t* indices_ = nullptr;
   uint32_t cap_v_ = 0, cap_t_ = 0;
   bool ready_ = false;
 };
@@ -84,7 +85,7 @@ struct ModelCapacity {
 // header is `h`: MeshDecoder::init, its Huffman tables and base scratch, and
 // ModelView::init, all for `vertices` and `triangles` = base triangles plus
 // two per vertex above the base (no split adds more), at most the stream's
-// counts and 65,536 vertices (the view's limit). workspace_too_small when not
+// counts and 65,535 vertices (the view's limit). workspace_too_small when not
 // even the base fits (then `out->bytes` is what the base needs),
 // unsupported_feature for a base above the view's limit, invalid_argument for
 // a bad configuration.
