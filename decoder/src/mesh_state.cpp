@@ -178,18 +178,14 @@ Status MeshState::finish_base(Arena& arena, uint32_t max_degree) {
   return st;
 }
 
-namespace {
-
-// The walk of MeshState::ring over tables of either width (Index: uint16_t
-// or uint32_t entries, all ones = none): the loop every split and
-// prediction runs, so the widths are chosen once per walk, not per entry.
-// Returns the degree, with *boundary set, or 0 if the walk is malformed.
+// The walk of ring() over tables of either width (uint16_t or uint32_t
+// entries, all ones = none): the loop every split and prediction runs, so
+// the widths are chosen once per walk, not per entry. Returns the degree,
+// with *boundary set, or 0 if the walk is malformed.
 template <typename VertexIndex, typename CornerIndex>
-uint32_t walk_ring(const VertexIndex* cv, const CornerIndex* opp, uint32_t x, uint32_t c0, uint32_t max_degree,
-                   uint32_t* rv, uint32_t* rc, bool* boundary) {
+uint32_t MeshState::walk_ring(const VertexIndex* cv, const CornerIndex* opp, uint32_t x, uint32_t c0,
+                              uint32_t max_degree, uint32_t* rv, uint32_t* rc, bool* boundary) {
   constexpr CornerIndex kNone = static_cast<CornerIndex>(~CornerIndex{0});
-  auto next = [](uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; };
-  auto prev = [](uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; };
   uint32_t c = c0, d = 0;
   *boundary = false;
   while (true) {
@@ -210,8 +206,6 @@ uint32_t walk_ring(const VertexIndex* cv, const CornerIndex* opp, uint32_t x, ui
     if (c == c0) return d;
   }
 }
-
-}  // namespace
 
 Status MeshState::ring(uint32_t x, Ring* out, int scratch) {
   if (x >= nv_) return Status::malformed;

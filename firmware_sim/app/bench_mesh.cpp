@@ -57,15 +57,14 @@ struct Run {
 
 Run g_run;
 
-// CRC-32C of the positions and corner vertices (each as 4 little-endian
-// bytes, whatever width the mesh stores them in): the mesh after a level.
+// CRC-32C of the positions and corner vertices (each as a uint32_t,
+// whatever width the mesh stores them in; both boards are little-endian):
+// the mesh after a level.
 uint32_t mesh_hash(const vds::MeshState& m) {
   uint32_t h = vds::crc32c(m.positions(), static_cast<size_t>(m.vertex_count()) * 3 * sizeof(uint16_t));
   for (uint32_t c = 0; c < 3 * m.triangle_count(); ++c) {
     const uint32_t v = m.corner_vertex(c);
-    const uint8_t le[4] = {static_cast<uint8_t>(v), static_cast<uint8_t>(v >> 8), static_cast<uint8_t>(v >> 16),
-                           static_cast<uint8_t>(v >> 24)};
-    h = vds::crc32c_update(h, le, sizeof le);
+    h = vds::crc32c_update(h, &v, sizeof v);
   }
   return h;
 }

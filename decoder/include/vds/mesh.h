@@ -227,8 +227,12 @@ class MeshState {
   uint32_t max_degree_seen() const { return max_degree_seen_; }
 
  private:
-  uint32_t next(uint32_t c) const { return c % 3 == 2 ? c - 2 : c + 1; }
-  uint32_t prev(uint32_t c) const { return c % 3 == 0 ? c + 2 : c - 1; }
+  static uint32_t next(uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; }
+  static uint32_t prev(uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; }
+  // ring()'s walk for tables of the given entry types (mesh_state.cpp).
+  template <typename VertexIndex, typename CornerIndex>
+  static uint32_t walk_ring(const VertexIndex* cv, const CornerIndex* opp, uint32_t x, uint32_t c0,
+                            uint32_t max_degree, uint32_t* rv, uint32_t* rc, bool* boundary);
   void fix_vertex_corner(uint32_t x, uint32_t any_corner);
   void set_opp(uint32_t c, int32_t o) { opposite_.set(c, static_cast<uint32_t>(o)); }
   void link(int32_t a, int32_t b) {
