@@ -11,6 +11,9 @@ namespace {
 // The renderer's uint16 indices, which draw() takes from the mesh's own
 // 16-bit corner table (MeshState::triangles16).
 constexpr uint32_t kMaxPositions = 65535;
+// Faces summed into a vertex normal (a bound on the walk, far above any
+// real fan; 2^10 - 1 keeps the sum of 2^21-bounded terms within int32).
+constexpr uint32_t kMaxFanFaces = 1023;
 constexpr int64_t kCameraDistanceQ16 = 3 * 65536 + 13107;  // 3.2 world units
 constexpr uint32_t kElevation = 238609294u;                // 20 degrees in 2^-32 turn
 // Direction to the light in camera space (x right, y down, z forward), Q15:
@@ -24,6 +27,39 @@ int32_t mul_q30(int32_t a, int32_t b) {
 }
 
 int32_t abs32(int32_t v) { return v < 0 ? -v : v; }
+
+// The normal of vertex v: the sum of its fan's face normals, each the
+// cross product of the face's edges from v, (a - v) x (b - v) with a and b
+// the next and previous corners' vertices, i.e. the face's own
+// (p1 - p0) x (p2 - p0) exactly, shifted right by `shift`. Walking the fan
+// counter-clockwise, a face's b is the next face's a, so each face reads
+// one new position. Product is int32_t when the grid has at most 15 bits
+// (the products then fit), int64_t otherwise.
+template <typename Product>
+void fan_normal(const MeshState& mesh, const uint16_t* tri, const uint16_t* pos, uint32_t v, int shift, int32_t n[3]) {
+  n[0] = n[1] = n[2] = 0;
+  const uint32_t nc = 3 * mesh.triangle_count();
+  const uint32_t c0 = mesh.vertex_corner(v);
+  if (c0 >= nc) return;  // no faces
+  const uint16_t* pv = pos + 3 * v;
+  const uint16_t* pa = pos + 3 * tri[MeshState::next(c0)];
+  int32_t a[3] = {pa[0] - pv[0], pa[1] - pv[1], pa[2] - pv[2]};
+  uint32_t c = c0;
+  for (uint32_t faces = 0; faces < kMaxFanFaces; ++faces) {
+    const uint16_t* pb = pos + 3 * tri[MeshState::prev(c)];
+    const int32_t b[3] = {pb[0] - pv[0], pb[1] - pv[1], pb[2] - pv[2]};
+    n[0] += static_cast<int32_t>((Product{a[1]} * b[2] - Product{a[2]} * b[1]) >> shift);
+    n[1] += static_cast<int32_t>((Product{a[2]} * b[0] - Product{a[0]} * b[2]) >> shift);
+    n[2] += static_cast<int32_t>((Product{a[0]} * b[1] - Product{a[1]} * b[0]) >> shift);
+    const int32_t o = mesh.opposite(MeshState::next(c));
+    if (o < 0 || static_cast<uint32_t>(o) >= nc) break;
+    c = MeshState::next(static_cast<uint32_t>(o));
+    if (c == c0) break;
+    a[0] = b[0];
+    a[1] = b[1];
+    a[2] = b[2];
+  }
+}
 
 RenderConfig render_config(const ModelViewConfig& cfg, uint32_t max_vertices, uint32_t max_triangles) {
   RenderConfig rc;
@@ -44,18 +80,17 @@ size_t ModelView::workspace_bytes(const ModelViewConfig& cfg, uint32_t max_verti
   if (max_vertices == 0 || max_vertices > kMaxPositions || max_triangles == 0) return 0;
   const size_t render = render_workspace_size(render_config(cfg, max_vertices, max_triangles));
   if (render == 0) return 0;
-  // Positions (12) and colours (4) per vertex, and alignment padding for
-  // each array; the triangles are the mesh's own.
-  return render + size_t{16} * max_vertices + 2 * 8;
+  // Colours (4 bytes per vertex) and alignment padding; the positions and
+  // triangles are the mesh's own.
+  return render + size_t{4} * max_vertices + 8;
 }
 
 Status ModelView::init(const ModelViewConfig& cfg, Arena& arena, uint32_t max_vertices, uint32_t max_triangles) {
   ready_ = false;
   if (workspace_bytes(cfg, max_vertices, max_triangles) == 0) return Status::invalid_argument;
   cfg_ = cfg;
-  positions_ = arena.alloc_array<Vec3<Q16_16>>(max_vertices);
   colors_ = arena.alloc_array<uint32_t>(max_vertices);
-  if (!positions_ || !colors_) return Status::workspace_too_small;
+  if (!colors_) return Status::workspace_too_small;
   const Status s = renderer_.init(render_config(cfg, max_vertices, max_triangles), arena);
   if (s != Status::ok) return s;
   cap_v_ = max_vertices;
@@ -112,36 +147,31 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
         (int64_t{kLightCam[0]} * rows[0][a] + int64_t{kLightCam[1]} * rows[1][a] + int64_t{kLightCam[2]} * rows[2][a]) >>
         30);
 
-  // Vertex normals: the sum of the adjacent faces' cross products, each
-  // brought to at most 2^21 per component (an arithmetic shift by
-  // 2 (bits - 10)); the decoder refuses rings of more than 64 faces
-  // (kMeshMaxDegree), so a sum stays below 2^27. They are accumulated in
-  // the positions array, which is filled with positions afterwards.
-  const int shift = bits > 10 ? 2 * (bits - 10) : 0;
-  int32_t* acc = reinterpret_cast<int32_t*>(positions_);
-  for (uint32_t i = 0; i < 3 * nv; ++i) acc[i] = 0;
-  for (uint32_t t = 0; t < nt; ++t) {
-    const uint16_t* c = tri + 3 * t;
-    if (c[0] >= nv || c[1] >= nv || c[2] >= nv) return Status::invalid_argument;
-    const uint16_t* p0 = pos + 3 * c[0];
-    const uint16_t* p1 = pos + 3 * c[1];
-    const uint16_t* p2 = pos + 3 * c[2];
-    const int32_t e1[3] = {p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]};
-    const int32_t e2[3] = {p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]};
-    const int32_t n[3] = {
-        static_cast<int32_t>((int64_t{e1[1]} * e2[2] - int64_t{e1[2]} * e2[1]) >> shift),
-        static_cast<int32_t>((int64_t{e1[2]} * e2[0] - int64_t{e1[0]} * e2[2]) >> shift),
-        static_cast<int32_t>((int64_t{e1[0]} * e2[1] - int64_t{e1[1]} * e2[0]) >> shift)};
-    for (int k = 0; k < 3; ++k) {
-      int32_t* a = acc + 3 * c[k];
-      a[0] += n[0];
-      a[1] += n[1];
-      a[2] += n[2];
+  // The current bounding box: its centre is put at the origin.
+  uint32_t lo[3] = {65535, 65535, 65535}, hi[3] = {0, 0, 0};
+  for (uint32_t v = 0; v < nv; ++v)
+    for (int a = 0; a < 3; ++a) {
+      const uint32_t p = pos[3 * v + a];
+      if (p < lo[a]) lo[a] = p;
+      if (p > hi[a]) hi[a] = p;
     }
-  }
+  for (uint32_t i = 0; i < 3 * nt; ++i)
+    if (tri[i] >= nv) return Status::invalid_argument;
+
+  // Vertex colours from vertex normals: each the sum of the cross products
+  // of the faces in the vertex's fan, each brought to at most 2^21 per
+  // component (an arithmetic shift by 2 (bits - 10)), over at most
+  // kMaxFanFaces faces, so a sum stays below 2^31. The fan is walked in the
+  // corner table (one fan per vertex, from its first face on a boundary),
+  // so no per-vertex sums are stored.
+  const int shift = bits > 10 ? 2 * (bits - 10) : 0;
   const uint32_t base_rgb[3] = {(cfg_.surface_rgb >> 16) & 255, (cfg_.surface_rgb >> 8) & 255, cfg_.surface_rgb & 255};
   for (uint32_t v = 0; v < nv; ++v) {
-    int32_t n[3] = {acc[3 * v], acc[3 * v + 1], acc[3 * v + 2]};
+    int32_t n[3];
+    if (bits <= 15)
+      fan_normal<int32_t>(mesh, tri, pos, v, shift, n);
+    else
+      fan_normal<int64_t>(mesh, tri, pos, v, shift, n);
     // Down to 15 bits a component (arithmetic shift), so the squared length
     // fits 32 bits and |n . l| <= |n| 2^15 (Cauchy-Schwarz) fits after >> 15.
     const uint32_t m = static_cast<uint32_t>(abs32(n[0]) | abs32(n[1]) | abs32(n[2]));
@@ -165,30 +195,21 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
     colors_[v] = rgb;
   }
 
-  // Positions: the centre of the current bounding box at the origin, 2^bits
-  // grid steps = 2 units.
-  uint32_t lo[3] = {65535, 65535, 65535}, hi[3] = {0, 0, 0};
-  for (uint32_t v = 0; v < nv; ++v)
-    for (int a = 0; a < 3; ++a) {
-      const uint32_t p = pos[3 * v + a];
-      if (p < lo[a]) lo[a] = p;
-      if (p > hi[a]) hi[a] = p;
-    }
-  const int up = 16 - bits;
-  for (uint32_t v = 0; v < nv; ++v) {
-    int32_t w[3];
-    for (int a = 0; a < 3; ++a) w[a] = (2 * static_cast<int32_t>(pos[3 * v + a]) - static_cast<int32_t>(lo[a] + hi[a])) * (1 << up);
-    positions_[v] = {Q16_16::from_raw(w[0]), Q16_16::from_raw(w[1]), Q16_16::from_raw(w[2])};
-  }
-
   Mesh m;
   m.indices = tri;
   m.num_triangles = nt;
   m.shading = Shading::gouraud;
   m.cull = Cull::none;
   m.colors = colors_;
+  // World positions, read by the renderer from the decoder's grid: 2^bits
+  // grid steps = 2 units, i.e. (2 g - (lo + hi)) 2^(16 - bits) in Q16.16.
+  const int up = 16 - bits;
   DrawList list;
-  list.positions = positions_;
+  list.grid = pos;
+  list.grid_shift = static_cast<uint8_t>(up + 1);
+  list.grid_origin = {Q16_16::from_raw(-static_cast<int32_t>((lo[0] + hi[0]) << up)),
+                      Q16_16::from_raw(-static_cast<int32_t>((lo[1] + hi[1]) << up)),
+                      Q16_16::from_raw(-static_cast<int32_t>((lo[2] + hi[2]) << up))};
   list.num_positions = nv;
   list.meshes = &m;
   list.num_meshes = 1;

@@ -76,7 +76,8 @@ Status check_texture(const Texture* t) {
 
 Status check_list(const DrawList& list) {
   if (list.num_positions > 65536) return Status::malformed;
-  if (list.num_positions && !list.positions) return Status::invalid_argument;
+  if (list.num_positions && (list.positions == nullptr) == (list.grid == nullptr)) return Status::invalid_argument;
+  if (list.grid_shift > 15) return Status::invalid_argument;
   if (list.num_meshes && !list.meshes) return Status::invalid_argument;
   for (uint32_t i = 0; i < list.num_meshes; ++i) {
     const Mesh& m = list.meshes[i];
@@ -209,9 +210,20 @@ struct RenderFrame {
   uint32_t live = 0, fresh = 0, cursor = 0, free_slots = 0, unused = 0;
   int32_t live_end = 0;  // the first row past the live polygon that ends first
 
+  // World position of vertex i.
+  Vec3<Q16_16> world(uint32_t i) const {
+    if (list.positions != nullptr) return list.positions[i];
+    const uint16_t* g = list.grid + 3 * i;
+    const Vec3<Q16_16>& o = list.grid_origin;
+    const int s = list.grid_shift;
+    return {Q16_16::from_raw(sat_s32((int64_t{g[0]} << s) + o.x.raw())),
+            Q16_16::from_raw(sat_s32((int64_t{g[1]} << s) + o.y.raw())),
+            Q16_16::from_raw(sat_s32((int64_t{g[2]} << s) + o.z.raw()))};
+  }
+
   // Camera-space vertex i (no attributes).
   ClipVertex camera_vertex(uint32_t i) const {
-    const Vec3<Q16_16> p = camera_transform(*fc.cam, list.positions[i]);
+    const Vec3<Q16_16> p = camera_transform(*fc.cam, world(i));
     ClipVertex v{};
     v.x = p.x.raw();
     v.y = p.y.raw();

@@ -1,8 +1,10 @@
 // libFuzzer harness for the client renderer (vds/render.h): a scene of raw,
 // hostile values (positions, camera, texture coordinates, homographies,
 // indices, formats) is rendered into a caller frame with guard bytes around
-// it, once in 1-row bands and once in one band. Traps if a guard byte
-// changes, if the two frames differ, or on any sanitizer report.
+// it, once in 1-row bands and once in one band, and optionally with its
+// positions given on a grid (DrawList::grid) against the same positions in
+// Q16.16. Traps if a guard byte changes, if two frames that must agree
+// differ, or on any sanitizer report.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -166,5 +168,43 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::vector<uint8_t> b = render(cfg, cfg.height, cam, list, &s2);
   if (s1 != s2) __builtin_trap();
   if (s1 == vds::Status::ok && a != b) __builtin_trap();
+
+  // Grid positions ((g << shift) + origin) against the Q16.16 positions
+  // they stand for, saturated as the renderer saturates them: the same
+  // status and frame; a shift above 15 is refused.
+  const uint8_t gsel = in.u8();
+  if (gsel & 1) {
+    const uint8_t shift = static_cast<uint8_t>(gsel >> 3);
+    const int32_t origin[3] = {in.i32() >> (gsel & 6), in.i32() >> (gsel & 6), in.i32() >> (gsel & 6)};
+    std::vector<uint16_t> grid(3 * np);
+    std::vector<vds::Vec3<vds::Q16_16>> world(np);
+    for (uint32_t v = 0; v < np; ++v) {
+      int32_t w[3];
+      for (int k = 0; k < 3; ++k) {
+        grid[3 * v + k] = static_cast<uint16_t>(in.u8() | in.u8() << 8);
+        int64_t x = (int64_t{grid[3 * v + k]} << (shift & 15)) + origin[k];
+        if (x > INT32_MAX) x = INT32_MAX;
+        if (x < INT32_MIN) x = INT32_MIN;
+        w[k] = static_cast<int32_t>(x);
+      }
+      world[v] = {vds::Q16_16::from_raw(w[0]), vds::Q16_16::from_raw(w[1]), vds::Q16_16::from_raw(w[2])};
+    }
+    vds::DrawList by_world = list, by_grid = list;
+    by_world.positions = world.data();
+    by_grid.positions = nullptr;
+    by_grid.grid = grid.data();
+    by_grid.grid_shift = shift;
+    by_grid.grid_origin = {vds::Q16_16::from_raw(origin[0]), vds::Q16_16::from_raw(origin[1]),
+                           vds::Q16_16::from_raw(origin[2])};
+    vds::Status sw, sg;
+    const std::vector<uint8_t> fw = render(cfg, cfg.height, cam, by_world, &sw);
+    const std::vector<uint8_t> fg = render(cfg, cfg.height, cam, by_grid, &sg);
+    if (shift > 15) {
+      if (sg != vds::Status::invalid_argument) __builtin_trap();
+    } else {
+      if (sg != sw) __builtin_trap();
+      if (sg == vds::Status::ok && fg != fw) __builtin_trap();
+    }
+  }
   return 0;
 }

@@ -321,4 +321,71 @@ TEST(ModelView, RefusesWhatItCannotDraw) {
   EXPECT_EQ(view.draw(mesh, 0, stop, nullptr), Status::aborted);
 }
 
+// The golden stream's full mesh copied into a MeshState of its own, on a
+// grid `extra` bits finer (positions times 2^extra); with `hole`, without
+// vertex 0 and its faces, which opens a hole whose rim vertices' fans end
+// at the boundary.
+void build_copy(vds::MeshState& s, vds::Arena& arena, int extra, bool hole) {
+  SmallClient c(4u << 20);
+  ASSERT_EQ(c.play(golden_mesh_stream()), Status::ok);
+  const vds::MeshState& m = c.mesh.mesh();
+  ASSERT_LE(m.bits() + extra, 16);
+  ASSERT_EQ(s.init(arena, m.vertex_count(), m.triangle_count()), Status::ok);
+  s.clear(m.bits() + extra);
+  const uint32_t skip = hole ? 1 : 0;
+  for (uint32_t v = skip; v < m.vertex_count(); ++v) {
+    const uint16_t* p = m.positions() + 3 * v;
+    const int32_t q[3] = {p[0] << extra, p[1] << extra, p[2] << extra};
+    ASSERT_EQ(s.add_vertex(q), Status::ok);
+  }
+  uint32_t dropped = 0;
+  for (uint32_t f = 0; f < m.triangle_count(); ++f) {
+    const uint32_t a = m.corner_vertex(3 * f), b = m.corner_vertex(3 * f + 1), d = m.corner_vertex(3 * f + 2);
+    if (hole && (a == 0 || b == 0 || d == 0)) {
+      ++dropped;
+      continue;
+    }
+    ASSERT_EQ(s.add_triangle(a - skip, b - skip, d - skip), Status::ok);
+  }
+  if (hole) ASSERT_GE(dropped, 3u);
+  ASSERT_EQ(s.finish_base(arena, 64), Status::ok);
+}
+
+// Vertex normals are summed over each vertex's fan in the corner table.
+// The picture is the same at every grid size: positions scaled by 2^s
+// give the same world positions and, after the shift by 2 (bits - 10), the
+// same normals, whether the cross products are taken in 32 bits (up to 15
+// bits) or 64 (16 bits). With a hole (fans that end at a boundary) the
+// frame is the one pinned below, drawn when
+// each face's normal was added to its three vertices' sums.
+TEST(ModelView, ShadingFromFansAtEveryGridSize) {
+  vds::ModelViewConfig cfg;
+  cfg.width = 240;
+  cfg.height = 180;
+  for (bool hole : {false, true}) {
+    std::vector<uint16_t> first;
+    for (int extra : {0, 2, 5, 6}) {
+      std::vector<uint8_t> mesh_ws(4u << 20);
+      vds::Arena mesh_arena(mesh_ws.data(), mesh_ws.size());
+      vds::MeshState m;
+      build_copy(m, mesh_arena, extra, hole);
+      if (HasFatalFailure()) return;
+      std::vector<uint8_t> ws(vds::ModelView::workspace_bytes(cfg, m.vertex_count(), m.triangle_count()));
+      vds::Arena arena(ws.data(), ws.size());
+      vds::ModelView view;
+      ASSERT_EQ(view.init(cfg, arena, m.vertex_count(), m.triangle_count()), Status::ok);
+      const std::vector<uint16_t> px = frame_pixels(view, m, 9000);
+      if (first.empty()) {
+        first = px;
+        if (hole) {
+          const uint32_t crc = vds::crc32c(reinterpret_cast<const uint8_t*>(px.data()), px.size() * 2);
+          EXPECT_EQ(crc, 0x5DAB34E2u) << std::hex << crc;
+        }
+      } else {
+        EXPECT_EQ(px, first) << "grid " << m.bits() << " bits" << (hole ? ", with a hole" : "");
+      }
+    }
+  }
+}
+
 }  // namespace

@@ -445,6 +445,20 @@ TEST(RenderApi, ValidationStatuses) {
   EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::malformed);  // index 3 >= 3
   idx[2] = 2;
   EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::ok);
+  // Positions from one source, and a grid shift that keeps them in 32 bits.
+  const uint16_t grid[9] = {};
+  DrawList both = list;
+  both.grid = grid;
+  EXPECT_EQ(r.render(cam, both, 0, sink, nullptr), Status::invalid_argument);
+  DrawList by_grid = both;
+  by_grid.positions = nullptr;
+  by_grid.grid_shift = 15;
+  EXPECT_EQ(r.render(cam, by_grid, 0, sink, nullptr), Status::ok);
+  by_grid.grid_shift = 16;
+  EXPECT_EQ(r.render(cam, by_grid, 0, sink, nullptr), Status::invalid_argument);
+  by_grid.grid_shift = 0;
+  by_grid.grid = nullptr;
+  EXPECT_EQ(r.render(cam, by_grid, 0, sink, nullptr), Status::invalid_argument);  // neither
   m.shading = Shading::texture;
   EXPECT_EQ(r.render(cam, list, 0, sink, nullptr), Status::malformed);  // no uvs, no texture
   TexCoord uv[3] = {};
@@ -480,6 +494,83 @@ TEST(RenderApi, ApronAndPlainTexturesGiveTheSameFrame) {
         ASSERT_EQ(a.status, Status::ok);
         EXPECT_EQ(a.bytes, b.bytes) << base.name << " " << tex_name(tf);
       }
+    }
+  }
+}
+
+// Grid positions ((g << grid_shift) + grid_origin) draw exactly what the
+// same positions as Q16.16 vectors draw, with and without the vertex cache.
+TEST(RenderApi, GridPositionsDrawWhatTheirWorldPositionsDraw) {
+  constexpr int kSide = 17;
+  std::vector<uint16_t> grid;
+  std::vector<uint32_t> colors;
+  std::mt19937 rng(7);
+  for (int j = 0; j < kSide; ++j)
+    for (int i = 0; i < kSide; ++i) {
+      grid.push_back(static_cast<uint16_t>(i * 240));                 // x
+      grid.push_back(static_cast<uint16_t>(1500 + rng() % 1100));      // y: a rough height field
+      grid.push_back(static_cast<uint16_t>(j * 240));                 // z
+      colors.push_back(rng() & 0xFFFFFF);
+    }
+  std::vector<uint16_t> idx;
+  for (int j = 0; j + 1 < kSide; ++j)
+    for (int i = 0; i + 1 < kSide; ++i) {
+      const uint16_t a = static_cast<uint16_t>(j * kSide + i), b = static_cast<uint16_t>(a + 1),
+                     c = static_cast<uint16_t>(a + kSide), d = static_cast<uint16_t>(c + 1);
+      idx.insert(idx.end(), {a, c, b, b, c, d});
+    }
+  Mesh m;
+  m.indices = idx.data();
+  m.num_triangles = static_cast<uint32_t>(idx.size() / 3);
+  m.shading = Shading::gouraud;
+  m.cull = Cull::none;
+  m.colors = colors.data();
+  const Camera cam = enc::to_client(enc::CameraD::look_at({0, 1.6, -1.8}, {0, 0, 0}, {0, 1, 0}, 96, 72, 60, 0.1, 20));
+  for (const uint8_t shift : {uint8_t{5}, uint8_t{6}}) {
+    const Vec3<Q16_16> origin{Q16_16::from_raw(-(2048 << shift)), Q16_16::from_raw(-(2048 << shift)),
+                              Q16_16::from_raw(-(2048 << shift))};
+    std::vector<Vec3<Q16_16>> world;
+    for (size_t v = 0; v < grid.size() / 3; ++v)
+      world.push_back({Q16_16::from_raw((grid[3 * v] << shift) + origin.x.raw()),
+                       Q16_16::from_raw((grid[3 * v + 1] << shift) + origin.y.raw()),
+                       Q16_16::from_raw((grid[3 * v + 2] << shift) + origin.z.raw())});
+    DrawList by_world{world.data(), static_cast<uint32_t>(world.size()), &m, 1};
+    DrawList by_grid{nullptr, static_cast<uint32_t>(world.size()), &m, 1};
+    by_grid.grid = grid.data();
+    by_grid.grid_shift = shift;
+    by_grid.grid_origin = origin;
+    for (uint32_t cache : {0u, 1000u}) {
+      RenderConfig cfg;
+      cfg.width = 96;
+      cfg.height = 72;
+      cfg.band_height = 8;
+      cfg.vertex_cache = cache;
+      cfg.triangle_cache = cache;
+      std::vector<uint8_t> ws(render_workspace_size(cfg));
+      auto draw = [&](const DrawList& list) {
+        Arena arena(ws.data(), ws.size());
+        Renderer r;
+        EXPECT_EQ(r.init(cfg, arena), Status::ok);
+        std::vector<uint16_t> frame;
+        EXPECT_EQ(r.render(
+                      cam, list, 0,
+                      [](void* ctx, const Band& b) {
+                        auto* f = static_cast<std::vector<uint16_t>*>(ctx);
+                        for (int y = 0; y < b.height; ++y) {
+                          const auto* row = reinterpret_cast<const uint16_t*>(b.pixels + y * b.stride);
+                          f->insert(f->end(), row, row + b.width);
+                        }
+                        return true;
+                      },
+                      &frame),
+                  Status::ok);
+        return frame;
+      };
+      const std::vector<uint16_t> a = draw(by_world), b = draw(by_grid);
+      ASSERT_EQ(a.size(), 96u * 72u);
+      EXPECT_EQ(a, b) << "shift " << int{shift} << " cache " << cache;
+      EXPECT_GT(std::count_if(a.begin(), a.end(), [](uint16_t p) { return p != 0; }), 96 * 72 / 8)
+          << "the surface should cover much of the frame";
     }
   }
 }

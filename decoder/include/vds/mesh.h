@@ -190,6 +190,9 @@ class MeshState {
   // nullptr if init() was given more than 65,535 vertices (32-bit table).
   const uint16_t* triangles16() const { return corner_vertex_.narrow(); }
   uint32_t vertex_corner(uint32_t v) const { return vertex_corner_.get(v); }
+  // The corners after and before c in its triangle (counter-clockwise).
+  static uint32_t next(uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; }
+  static uint32_t prev(uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; }
   void position(uint32_t v, int32_t out[3]) const {
     out[0] = pos_[3 * v];
     out[1] = pos_[3 * v + 1];
@@ -227,8 +230,6 @@ class MeshState {
   uint32_t max_degree_seen() const { return max_degree_seen_; }
 
  private:
-  static uint32_t next(uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; }
-  static uint32_t prev(uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; }
   // ring()'s walk for tables of the given entry types (mesh_state.cpp).
   template <typename VertexIndex, typename CornerIndex>
   static uint32_t walk_ring(const VertexIndex* cv, const CornerIndex* opp, uint32_t x, uint32_t c0,

@@ -65,7 +65,6 @@ class ModelView {
  private:
   ModelViewConfig cfg_{};
   Renderer renderer_;
-  Vec3<Q16_16>* positions_ = nullptr;  // also the normal accumulators while shading
   uint32_t* colors_ = nullptr;
   uint32_t cap_v_ = 0, cap_t_ = 0;
   bool ready_ = false;

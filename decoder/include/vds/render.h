@@ -156,6 +156,13 @@ struct DrawList {
   uint32_t num_positions = 0;               // <= 65536
   const Mesh* meshes = nullptr;
   uint32_t num_meshes = 0;
+  // Instead of `positions` (which is then nullptr): unsigned grid
+  // coordinates, x, y, z per vertex, taken to world as
+  // (g << grid_shift) + grid_origin (Q16.16 raw, saturated), so a mesh
+  // decoder's own positions are drawn without a converted copy.
+  const uint16_t* grid = nullptr;
+  uint8_t grid_shift = 0;  // 0..15
+  Vec3<Q16_16> grid_origin{};
 };
 
 struct RenderConfig {
