@@ -21,13 +21,13 @@ mkdir -p "$TMP" "$OUT"
 BENCH_CMD="$BUILD/bench/bench_mesh --out $OUT --tmp $TMP"
 $BENCH_CMD
 
-# Instructions per vertex split: the mesh decoder only (MeshDecoder::consume
-# and everything it calls), one decode of each stream under callgrind.
+# Instructions per vertex: the mesh decoder only (MeshDecoder::consume and
+# everything it calls), one decode of each stream under callgrind.
 CG="$TMP/callgrind.md"
 {
-  echo "| stream | vertices | splits | instructions | per vertex split |"
+  echo "| stream | vertices | vertices after the base | instructions | per vertex after the base |"
   echo "|---|---:|---:|---:|---:|"
-  for f in "$TMP"/*_1[02].vds "$TMP"/*_1[02]_paper.vds; do
+  for f in "$TMP"/*_1[02].vds "$TMP"/*_1[02]_splits.vds "$TMP"/*_1[02]_paper.vds; do
     [ -f "$f" ] || continue
     valgrind --tool=callgrind --callgrind-out-file="$TMP/cg.out" \
       --toggle-collect='vds::MeshDecoder::consume*' \
@@ -54,11 +54,15 @@ fig, axes = plt.subplots(1, len(models), figsize=(5.2 * len(models), 4.4), squee
 for ax, m in zip(axes[0], models):
     for b in bits:
         v = [r for r in rows if r["model"] == m and int(r["bits"]) == b and r["codec"] == "vds"]
+        s = [r for r in rows if r["model"] == m and int(r["bits"]) == b and r["codec"] == "vds-splits"]
         d = [r for r in rows if r["model"] == m and int(r["bits"]) == b and r["codec"] == "draco"]
         x = [int(r["bytes"]) / 1024 for r in v]
         c = colors.get(b, None)
         ax.plot(x, [100 * float(r["hausdorff"]) for r in v], "-o", ms=3, color=c, label=f"vds {b} bits: Hausdorff")
         ax.plot(x, [100 * float(r["rms"]) for r in v], "--s", ms=3, color=c, label=f"vds {b} bits: RMS")
+        xs_ = [int(r["bytes"]) / 1024 for r in s]
+        ax.plot(xs_, [100 * float(r["rms"]) for r in s], ":", lw=1, color=c, alpha=0.7,
+                label=f"vds splits only {b} bits: RMS")
         for r in d:
             ax.plot([int(r["bytes"]) / 1024], [100 * float(r["hausdorff"])], "*", ms=13, color=c,
                     markeredgecolor="black", label=f"Draco {b} bits: Hausdorff")
@@ -80,17 +84,19 @@ fig.savefig(out + "/mesh_rd.png", dpi=110)
 sizes = collections.OrderedDict()
 for line in open(out + "/mesh_body.md"):
     p = [x.strip() for x in line.split("|")]
-    if len(p) > 12 and p[1] in models and p[2].isdigit() and p[9].startswith("**"):
-        sizes[(p[1], int(p[2]))] = (float(p[6]), float(p[8]), float(p[11]))
-fig, ax = plt.subplots(figsize=(8, 4))
+    if len(p) > 16 and p[1] in models and p[2].isdigit() and p[9].startswith("**"):
+        sizes[(p[1], int(p[2]))] = (float(p[6]), float(p[8]), float(p[15]), float(p[11]))
+fig, ax = plt.subplots(figsize=(9, 4))
 labels = [f"{m}\n{b} bits" for (m, b) in sizes]
 import numpy as np
 xs = np.arange(len(sizes))
-w = 0.27
-ax.bar(xs - w, [v[0] for v in sizes.values()], w, label="Draco -cl 10 (single rate)", color="tab:gray")
-ax.bar(xs, [v[1] for v in sizes.values()], w, label="vds progressive (arithmetic)", color="tab:blue")
-ax.bar(xs + w, [v[2] for v in sizes.values()], w, label="paper's coding (Huffman)", color="tab:orange")
-ax.bar(xs, [1.25 * v[0] for v in sizes.values()], w, fill=False, edgecolor="black", ls="--", label="goal: 1.25 x Draco")
+w = 0.21
+ax.bar(xs - 1.5 * w, [v[0] for v in sizes.values()], w, label="Draco -cl 10 (single rate)", color="tab:gray")
+ax.bar(xs - 0.5 * w, [v[1] for v in sizes.values()], w, label="vds: split levels + single-rate tail", color="tab:blue")
+ax.bar(xs + 0.5 * w, [v[2] for v in sizes.values()], w, label="vds splits only", color="tab:cyan")
+ax.bar(xs + 1.5 * w, [v[3] for v in sizes.values()], w, label="paper's coding (Huffman)", color="tab:orange")
+ax.bar(xs - 0.5 * w, [1.25 * v[0] for v in sizes.values()], w, fill=False, edgecolor="black", ls="--",
+       label="goal: 1.25 x Draco")
 ax.set_xticks(xs)
 ax.set_xticklabels(labels, fontsize=8)
 ax.set_ylabel("bits per triangle (whole stream)")
@@ -113,7 +119,7 @@ EOF
   echo "raw numbers: \`mesh_rd.csv\`. The codec is described in \`docs/mesh-codec.md\`."
   echo
   cat "$OUT/mesh_body.md"
-  echo "## Client instructions per vertex split (host, callgrind)"
+  echo "## Client instructions per vertex (host, callgrind)"
   echo
   echo "One decode of each stream under \`valgrind --tool=callgrind --toggle-collect='vds::MeshDecoder::consume*'\`"
   echo "(the mesh decoder and everything it calls; container parsing and file reading excluded), x86-64"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Progressive mesh decoding on the Cortex-M4 board: glmark2's bunny, horse
-# and cat at 10 and 12 bits, vds default coding and the paper's coding
+# and cat at 10 and 12 bits, vds default coding (split levels, then the
+# single-rate tail), vds splits only (`--tail 0`) and the paper's coding
 # (`vds encode-mesh --paper`), decoded by the firmware vds_fw_bench_mesh in
 # QEMU mps2-an386 (-icount shift=0; the stream parser and the mesh decoder,
 # instructions counted inside the mesh decoder), and by the same firmware on
@@ -29,7 +30,7 @@ trap 'rm -rf "$WORK"' EXIT
 
 ROWS="$WORK/rows.txt"
 : >"$ROWS"
-for coding in default paper; do
+for coding in default splits paper; do
   dir="$WORK/$coding"
   mkdir -p "$dir"
   i=0
@@ -37,6 +38,7 @@ for coding in default paper; do
     for bits in 10 12; do
       extra=()
       [[ $coding == paper ]] && extra=(--paper)
+      [[ $coding == splits ]] && extra=(--tail 0)
       # glmark2's horse and cat stand along -z (as imported), the bunny along +y.
       [[ $model != bunny.obj ]] && extra+=(--up -z)
       "$VDS" encode-mesh "$MODELS/$model" -o "$dir/mesh_case$i.vds" --bits $bits "${extra[@]}" -q
@@ -76,26 +78,32 @@ L = ["# Progressive mesh decoding on the Cortex-M4 board", "",
      f"Produced by `bench/run_mesh_m4.sh build/host-release` on {datetime.date.today()}. {sys.argv[4]}, "
      "`-M mps2-an386 -cpu cortex-m4 -icount shift=0`; firmware `vds_fw_bench_mesh` (arm-none-eabi-g++ -O2, "
      "the Release Cortex-M4 sub-build, 4 MiB RAM linker script). Streams written by `vds encode-mesh IN --bits B` "
-     "(vds: arithmetic coding, area predictor) and `vds encode-mesh IN --bits B --paper` (Huffman, "
+     "(vds: arithmetic coding, area predictor, split levels to 4 % of the vertices, then the single-rate tail), "
+     "`vds encode-mesh IN --bits B --tail 0` (vds splits only) and `vds encode-mesh IN --bits B --paper` (Huffman, "
      "Laplacian predictor) from glmark2-data's models, the horse and cat with `--up -z` so they are drawn "
      "standing. Instructions are counted inside `MeshDecoder::consume` "
      "(chunk parsing and CRC checks excluded). The same firmware on the host board printed the same mesh "
      "checksum after every level.", "",
-     "| model | bits | coding | stream bytes | vertices | splits | levels | instructions | per vertex split | base | workspace bytes | bytes/vertex |",
-     "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+     "| model | bits | coding | stream bytes | vertices | levels | instructions | per vertex split | single-rate tail: instructions | per vertex | base | workspace bytes | bytes/vertex |",
+     "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+names = {"default": "vds", "splits": "vds splits only", "paper": "paper"}
 for name, model, bits, coding, size in rows:
     kv = summ[(coding, name)]
-    splits = int(kv["splits"])
     ins = int(kv["instructions"])
     base = int(kv["base_instructions"])
     v = int(kv["vertices"])
     ws = int(kv["workspace"])
-    per = (ins - base) / splits if splits else 0
-    L.append(f"| {model} | {bits} | {'vds' if coding == 'default' else 'paper'} | {int(size):,} | {v:,} | {splits:,} | "
-             f"{kv['levels']} | {ins:,} | {per:,.0f} | {base:,} | {ws:,} | {ws / v:.1f} |")
-L += ["", "Per vertex split: (instructions - base) / splits. Workspace: the arena's high-water mark (mesh, "
-      "contexts or Huffman tables, split flags, the stream parser's 16 KiB chunk buffer), the model view's "
-      "buffers not included.", "",
+    tail = int(kv.get("tail_instructions", 0))
+    # Vertices the split levels add: up to the tail's level, or all of them.
+    splits = int(kv["tail_split_vertices"]) if "tail_split_vertices" in kv else int(kv["splits"])
+    per = (ins - base - tail) / splits if splits else 0
+    tail_cols = f"{tail:,} | {tail / v:,.0f}" if tail else "- | -"
+    L.append(f"| {model} | {bits} | {names[coding]} | {int(size):,} | {v:,} | "
+             f"{kv['levels']} | {ins:,} | {per:,.0f} | {tail_cols} | {base:,} | {ws:,} | {ws / v:.1f} |")
+L += ["", "Per vertex split: (instructions - base - tail) / the vertices the split levels add. The single-rate "
+      "tail rebuilds the whole mesh: its instructions per vertex of the full mesh. Workspace: the arena's "
+      "high-water mark (mesh, contexts or Huffman tables, split flags, the tail's border, the stream parser's "
+      "16 KiB chunk buffer), the model view's buffers not included.", "",
       "## Drawing the model (vds::ModelView, as the client firmware)", "",
       "After the base and after every level the firmware draws the mesh at 240x180 (shaded, z-buffered, "
       "16-row bands, every vertex projected once and every triangle's band range found once per frame), as the client does while a model streams in; the "

@@ -23,12 +23,13 @@ import sim  # noqa: E402
 
 
 def level_table(info_stdout):
-    """(level, vertices, cumulative bytes) from `vds info`'s per-level table."""
+    """(level, vertices, cumulative bytes) from `vds info`'s per-level table
+    (the single-rate tail's level carries a T)."""
     rows = []
     for line in info_stdout.splitlines():
-        m = re.match(r"^\s*(base|\d+)\s+(\d+)\s+(\d+)\s+\S+\s+\S+\s+\S+\s+(\d+)\s+(\d+)\s+(\d+)\s*$", line)
+        m = re.match(r"^\s*(base|\d+T?)\s+(\d+)\s+(\d+)\s+\S+\s+\S+\s+\S+\s+(\d+)\s+(\d+)\s+(\d+)\s*$", line)
         if m:
-            level = 0 if m.group(1) == "base" else int(m.group(1))
+            level = 0 if m.group(1) == "base" else int(m.group(1).rstrip("T"))
             rows.append((level, int(m.group(6)), int(m.group(5))))
     return rows
 

@@ -121,7 +121,7 @@ struct Row {
   std::string model;
   int bits = 0;
   size_t vertices = 0, triangles = 0;
-  size_t draco = 0, vds = 0, paper = 0;
+  size_t draco = 0, vds = 0, paper = 0, splits = 0;  // vds: with the single-rate tail; splits: without
   size_t levels = 0, base = 0;
   double vds_decode_ms = 0, draco_decode_ms = 0;
   double workspace_per_vertex = 0;
@@ -129,7 +129,7 @@ struct Row {
   SurfaceDistance draco_dist, vds_full_dist;
   size_t bytes_first_second = 0, vertices_first_second = 0;
   double diag = 1;
-  MeshBitBreakdown bits_vds, bits_paper;
+  MeshBitBreakdown bits_vds, bits_paper, bits_splits;
 };
 
 int decode_once(const std::string& path) {
@@ -229,16 +229,24 @@ int main(int argc, char** argv) {
                  draco_mesh.triangles.size(), row.draco, row.draco_dist.hausdorff / diag, row.draco_dist.rms / diag,
                  row.draco_dist.mean / diag);
 
-      // vds, default options and the paper's.
+      // vds as `vds encode-mesh` writes it (split levels, then the
+      // single-rate tail), vds splits only, and the paper's coding.
       MeshEncodeOptions o;
       o.bits = bits;
+      o.tail_fraction = kMeshDefaultTail;
       const MeshEncodeResult r = encode_mesh(mesh, o);
+      MeshEncodeOptions so;
+      so.bits = bits;
+      const MeshEncodeResult sr = encode_mesh(mesh, so);
       MeshEncodeOptions po = paper_mesh_options();
       po.bits = bits;
       const MeshEncodeResult pr = encode_mesh(mesh, po);
       write_file(tmp + "/" + name + "_" + bs + ".vds", r.stream);
+      write_file(tmp + "/" + name + "_" + bs + "_splits.vds", sr.stream);
       write_file(tmp + "/" + name + "_" + bs + "_paper.vds", pr.stream);
       row.vds = r.stream.size();
+      row.splits = sr.stream.size();
+      row.bits_splits = sr.bits;
       row.paper = pr.stream.size();
       row.levels = r.levels.size() - 1;
       row.base = r.mesh_header.base_vertices;
@@ -247,8 +255,11 @@ int main(int argc, char** argv) {
       row.workspace = r.stream_header.workspace_bytes;
       row.chunk = r.stream_header.max_chunk_payload;
       row.workspace_per_vertex = double(row.workspace + row.chunk) / double(row.vertices);
-      md_levels += fmt("### %s, %d bits — vds (arithmetic coder, area predictor)\n\n```\n", name.c_str(), bits) +
+      md_levels += fmt("### %s, %d bits — vds (arithmetic coder, area predictor, single-rate tail)\n\n```\n",
+                       name.c_str(), bits) +
                    format_mesh_table(r.levels, r.stream.size()) + "```\n\n";
+      md_levels += fmt("### %s, %d bits — vds splits only (`--tail 0`)\n\n```\n", name.c_str(), bits) +
+                   format_mesh_table(sr.levels, sr.stream.size()) + "```\n\n";
       md_levels += fmt("### %s, %d bits — the paper's coding (Huffman, Laplacian predictor, eq. 1 priority)\n\n```\n",
                        name.c_str(), bits) +
                    format_mesh_table(pr.levels, pr.stream.size()) + "```\n\n";
@@ -257,6 +268,20 @@ int main(int argc, char** argv) {
       if (c.run(r.stream, &r.quantisation, true) != Status::ok) {
         std::fprintf(stderr, "decode failed\n");
         return 1;
+      }
+      {
+        Client cs;
+        if (cs.run(sr.stream, &sr.quantisation, true) != Status::ok) {
+          std::fprintf(stderr, "decode failed\n");
+          return 1;
+        }
+        for (size_t l = 0; l < cs.levels.size(); ++l) {
+          const auto& [bytes, m] = cs.levels[l];
+          const SurfaceDistance d = surface_distance(mesh, m, samples);
+          csv += fmt("%s,%d,vds-splits,%zu,%zu,%zu,%llu,%.9g,%.9g,%.9g\n", name.c_str(), bits, l, m.positions.size(),
+                     m.triangles.size(), static_cast<unsigned long long>(bytes), d.hausdorff / diag, d.rms / diag,
+                     d.mean / diag);
+        }
       }
       md_rd += fmt("### %s, %d bits\n\n| level | vertices | bytes | seconds at 2 KB/s | Hausdorff (%% diag) | RMS (%% diag) |\n"
                    "|---:|---:|---:|---:|---:|---:|\n",
@@ -298,26 +323,40 @@ int main(int argc, char** argv) {
   std::string md;
   md += "## Sizes against Draco (same welded, positions-only mesh; `draco_encoder -qp Q -cl 10`)\n\n";
   md += "| model | bits | V | T | Draco bytes | Draco b/T | vds bytes | vds b/T | vds / Draco | paper coding bytes | "
-        "paper b/T | levels | base V (%) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+        "paper b/T | levels | base V (%) | vds splits only bytes | splits only b/T | splits only / Draco |\n"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Row& r : rows)
-    md += fmt("| %s | %d | %zu | %zu | %zu | %.2f | %zu | %.2f | **%.2f** | %zu | %.2f | %zu | %zu (%.2f %%) |\n",
+    md += fmt("| %s | %d | %zu | %zu | %zu | %.2f | %zu | %.2f | **%.3f** | %zu | %.2f | %zu | %zu (%.2f %%) | %zu | "
+              "%.2f | %.2f |\n",
               r.model.c_str(), r.bits, r.vertices, r.triangles, r.draco, 8.0 * r.draco / r.triangles, r.vds,
               8.0 * r.vds / r.triangles, double(r.vds) / r.draco, r.paper, 8.0 * r.paper / r.triangles, r.levels,
-              r.base, 100.0 * r.base / r.vertices);
-  md += "\nGoal: vds / Draco <= 1.25, >= 12 levels, base <= 2 % of the vertices.\n\n";
+              r.base, 100.0 * r.base / r.vertices, r.splits, 8.0 * r.splits / r.triangles,
+              double(r.splits) / r.draco);
+  md += "\nGoal: vds / Draco <= 1.25, >= 12 levels, base <= 2 % of the vertices. vds: `vds encode-mesh`'s "
+        "default, split levels up to 4 % of the vertices then the single-rate tail (levels counts it); vds "
+        "splits only: vertex splits all the way (`--tail 0`).\n\n";
   md += "## Where the bits go (bits per vertex of the full mesh)\n\n";
   md += "| model | bits | coder | split flags | arc length | rotation | connectivity | positions | of which normal axis "
         "| base |\n|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const Row& r : rows)
     for (int p = 0; p < 2; ++p) {
-      const MeshBitBreakdown& b = p ? r.bits_paper : r.bits_vds;
+      const MeshBitBreakdown& b = p ? r.bits_paper : r.bits_splits;
       const double n = double(r.vertices);
       md += fmt("| %s | %d | %s | %.2f | %.2f | %.2f | %.2f | %.2f | %s | %.2f |\n", r.model.c_str(), r.bits,
-                p ? "paper (Huffman)" : "vds (arithmetic)", b.split_flags / n, b.split_shape / n,
+                p ? "paper (Huffman)" : "vds splits only", b.split_flags / n, b.split_shape / n,
                 b.split_rotation / n, b.connectivity() / n, b.geometry / n,
                 p ? "-" : fmt("%.2f", b.geometry_normal / n).c_str(), b.base / n);
     }
   md += "\nDraco's own split for comparison: connectivity about 1.3 bits/vertex, positions the rest.\n\n";
+  md += "With the single-rate tail (bits per vertex of the full mesh):\n\n| model | bits | split levels "
+        "(connectivity + positions + base) | tail connectivity | tail positions |\n|---|---:|---:|---:|---:|\n";
+  for (const Row& r : rows) {
+    const MeshBitBreakdown& b = r.bits_vds;
+    const double n = double(r.vertices);
+    md += fmt("| %s | %d | %.2f | %.2f | %.2f |\n", r.model.c_str(), r.bits,
+              (b.connectivity() + b.geometry + b.base) / n, b.tail_connectivity / n, b.tail_geometry / n);
+  }
+  md += "\n";
   md += "## Client cost on the host\n\n| model | bits | vds decode (ms) | libdraco decode (ms) | workspace + chunk "
         "buffer (bytes) | bytes per vertex | first 2 KB (one second at 2 KB/s): bytes, vertices |\n"
         "|---|---:|---:|---:|---:|---:|---:|\n";

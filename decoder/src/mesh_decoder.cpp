@@ -53,7 +53,7 @@ bool marked(const uint8_t* marks, uint32_t v) { return (marks[v >> 3] >> (v & 7)
 
 }  // namespace
 
-void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderViewBytes]) {
+void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderTailBytes]) {
   out[0] = h.version;
   out[1] = static_cast<uint8_t>(h.coder);
   out[2] = static_cast<uint8_t>(h.predictor);
@@ -66,9 +66,14 @@ void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderViewBytes]
   wr_u32(out + 20, h.triangles);
   for (int k = 0; k < 3; ++k) wr_u32(out + 24 + 4 * k, h.origin_f32[k]);
   wr_u32(out + 36, h.step_f32);
-  if (h.up != MeshUp::y_plus) {
+  if (h.up != MeshUp::y_plus || h.tail()) {
     out[40] = static_cast<uint8_t>(h.up);
     out[41] = out[42] = out[43] = 0;
+  }
+  if (h.tail()) {
+    wr_u32(out + 44, h.tail_dummy_vertices);
+    wr_u32(out + 48, h.tail_dummy_triangles);
+    wr_u32(out + 52, h.tail_max_border);
   }
 }
 
@@ -77,7 +82,7 @@ Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out) 
   if (size < kMeshHeaderBytes) return Status::malformed;
   MeshHeader h;
   h.version = p[0];
-  if (h.version != kMeshCodecVersion) return Status::unsupported_version;
+  if (h.version != kMeshCodecVersion && h.version != kMeshCodecVersionTail) return Status::unsupported_version;
   if (p[1] > static_cast<uint8_t>(MeshCoder::arith) || p[2] > static_cast<uint8_t>(MeshPredictor::area))
     return Status::unsupported_feature;
   h.coder = static_cast<MeshCoder>(p[1]);
@@ -104,6 +109,20 @@ Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out) 
       h.triangles < h.base_triangles)
     return Status::malformed;
   if ((h.levels == 0) != (h.vertices == h.base_vertices)) return Status::malformed;
+  if (h.tail()) {
+    // The tail block; the tail is a level, coded arithmetically only. Each
+    // dummy closes a hole of three edges or more with as many triangles.
+    if (size < kMeshHeaderTailBytes) return Status::malformed;
+    h.tail_dummy_vertices = rd_u32(p + 44);
+    h.tail_dummy_triangles = rd_u32(p + 48);
+    h.tail_max_border = rd_u32(p + 52);
+    if (h.levels == 0 || h.tail_dummy_triangles < 3 * uint64_t{h.tail_dummy_vertices} || h.tail_max_border < 3 ||
+        uint64_t{h.vertices} + h.tail_dummy_vertices > 0x0FFFFFFFu ||
+        uint64_t{h.triangles} + h.tail_dummy_triangles > 0x07FFFFFFu ||
+        h.tail_max_border > 3 * (uint64_t{h.triangles} + h.tail_dummy_triangles))
+      return Status::malformed;
+    if (h.coder != MeshCoder::arith) return Status::unsupported_feature;
+  }
   *out = h;
   return Status::ok;
 }
@@ -125,13 +144,14 @@ Status read_varint(const uint8_t*& p, const uint8_t* end, uint32_t* out) {
 }
 
 size_t MeshDecoder::workspace_bytes(uint32_t max_vertices, uint32_t max_triangles, uint32_t max_base_triangles,
-                                    MeshCoder coder) {
+                                    MeshCoder coder, uint32_t tail_border) {
   const size_t mesh = MeshState::workspace_bytes(max_vertices, max_triangles);
   if (mesh == SIZE_MAX || max_base_triangles > 0x07FFFFFFu) return SIZE_MAX;
   uint64_t total = mesh;
   total += sizeof(MeshContexts) + alignof(MeshContexts);
   total += (uint64_t{max_vertices} + 7) / 8 + 4;
   total += uint64_t{max_base_triangles} * 3 * sizeof(uint32_t) + alignof(uint32_t);
+  if (tail_border > 0) total += sizeof(TailContexts) + alignof(TailContexts) + MeshTail::workspace_bytes(tail_border);
   if (coder == MeshCoder::huffman) {
     total += kHuffTableMax + 4;
     total += HuffmanTable::workspace_bytes(kHuffDeltaAlphabet) + HuffmanTable::workspace_bytes(kHuffShapeAlphabet) +
@@ -144,6 +164,9 @@ Status MeshDecoder::init(Arena& arena, uint32_t max_vertices, uint32_t max_trian
   // Member by member: a whole temporary decoder would cost ~1 KB of stack.
   arena_ = nullptr;
   ctx_ = nullptr;
+  tctx_ = nullptr;
+  tail_ = MeshTail();
+  in_tail_ = false;
   marks_ = lengths_ = nullptr;
   huff_delta_ = HuffmanTable();
   huff_shape_ = HuffmanTable();
@@ -181,6 +204,7 @@ Status MeshDecoder::consume(uint32_t type, const uint8_t* payload, uint32_t size
     case chunk::kMeshHeader: return on_header(payload, size);
     case chunk::kMeshBase: return on_base(payload, size);
     case chunk::kMeshLevel: return on_level(payload, size);
+    case chunk::kMeshTail: return on_tail(payload, size);
     default: return Status::invalid_argument;  // not a mesh chunk: the caller's mistake, nothing latched
   }
 }
@@ -323,7 +347,8 @@ void MeshDecoder::start_level() {
 
 Status MeshDecoder::on_level(const uint8_t* p, uint32_t size) {
   if (full_) return Status::ok;  // past what this client holds: skipped
-  if (!base_done_ || levels_done_ >= header_.levels) return fail(Status::malformed);
+  const uint32_t split_levels = header_.levels - (header_.tail() ? 1u : 0u);
+  if (!base_done_ || levels_done_ >= split_levels) return fail(Status::malformed);
   const uint8_t* end = p + size;
   uint32_t level = 0, first = 0, count = 0;
   Status s;
@@ -596,6 +621,139 @@ Status MeshDecoder::level_items(const uint8_t* conn, uint32_t conn_size, const u
       if (bg.bits_left() >= 8) return Status::malformed;
     }
   }
+  return Status::ok;
+}
+
+
+// --- The single-rate tail (MSHT) -------------------------------------------------
+
+Status MeshDecoder::on_tail(const uint8_t* p, uint32_t size) {
+  if (full_) return Status::ok;  // past what this client holds: skipped
+  if (!header_.tail() || !base_done_ || levels_done_ + 1 != header_.levels) return fail(Status::malformed);
+  const uint8_t* end = p + size;
+  uint32_t first = 0, count = 0;
+  Status s;
+  if ((s = read_varint(p, end, &first)) != Status::ok || (s = read_varint(p, end, &count)) != Status::ok)
+    return fail(s);
+  if (first == 0) {
+    if (in_tail_) return fail(Status::malformed);
+    TailCounts n;
+    n.vertices = header_.vertices;
+    n.triangles = header_.triangles;
+    n.dummy_vertices = header_.tail_dummy_vertices;
+    n.dummy_triangles = header_.tail_dummy_triangles;
+    n.max_border = header_.tail_max_border;
+    if (uint64_t{n.vertices} + n.dummy_vertices > cap_v_ || uint64_t{n.triangles} + n.dummy_triangles > cap_t_) {
+      full_ = true;  // the workspace cannot hold the whole mesh: keep the levels so far
+      return Status::ok;
+    }
+    old_v_ = mesh_.vertex_count();
+    old_t_ = mesh_.triangle_count();
+    // The tail's contexts and border are carved only now: a client that
+    // stops before the tail never needs them.
+    tctx_ = arena_->alloc_array<TailContexts>(1);
+    if (tctx_ == nullptr) {
+      full_ = true;
+      return Status::ok;
+    }
+    tctx_->reset();
+    s = tail_.begin(mesh_, *arena_, n);
+    if (s == Status::workspace_too_small) {
+      full_ = true;  // nor its border: the same (the mesh is untouched)
+      return Status::ok;
+    }
+    if (s != Status::ok) return fail(s);
+    in_tail_ = true;
+    items_ = 0;
+    cur_ = MeshLevelInfo{};
+    cur_.level = levels_done_ + 1;
+  } else if (!in_tail_ || first != items_) {
+    return fail(Status::malformed);
+  }
+  const uint32_t total = tail_.total() + header_.vertices;
+  if (count == 0 || count > total - items_) return fail(Status::malformed);
+  uint32_t conn_size = 0;
+  if ((s = read_varint(p, end, &conn_size)) != Status::ok) return fail(s);
+  if (conn_size > static_cast<uint32_t>(end - p)) return fail(Status::malformed);
+  const uint8_t* geom = p + conn_size;
+  const uint32_t geom_size = static_cast<uint32_t>(end - geom);
+  s = tail_items(p, conn_size, geom, geom_size, first, count);
+  if (s != Status::ok) return fail(s);
+  items_ += count;
+  cur_.connectivity_bytes += conn_size;
+  cur_.geometry_bytes += geom_size;
+  if (items_ == total) {
+    cur_.vertices_added = header_.vertices - old_v_;
+    cur_.triangles_added = header_.triangles - old_t_;
+    last_ = cur_;
+    in_tail_ = false;
+    ++levels_done_;
+  }
+  return Status::ok;
+}
+
+Status MeshDecoder::tail_items(const uint8_t* conn, uint32_t conn_size, const uint8_t* geom, uint32_t geom_size,
+                               uint32_t first, uint32_t count) {
+  const uint32_t nt = tail_.total();
+  const bool needs_conn = first < nt, needs_geom = first + count > nt;
+  if (needs_conn != (conn_size > 0) || needs_geom != (geom_size > 0)) return Status::malformed;
+  ArithDecoder ac, ag;
+  Status s = Status::ok;
+  if (needs_conn && (s = ac.init(conn, conn_size)) != Status::ok) return s;
+  if (needs_geom && (s = ag.init(geom, geom_size)) != Status::ok) return s;
+  ArithContext* c = tctx_->c;
+  using TC = TailContexts;
+  for (uint32_t item = first; item < first + count; ++item) {
+    progress_tick();
+    if (item < nt) {
+      if (tail_.needs_seed()) {
+        bool dummy[3];
+        for (bool& d : dummy) d = ac.decode_bit(c[TC::kDummy]) != 0;
+        if (!ac.ok()) return ac.status();
+        s = tail_.seed(dummy);
+      } else {
+        const uint32_t fx = tail_.fan_before(), fy = tail_.fan_after();
+        const bool l = ac.decode_bit(c[TC::left(fx, fy)]) != 0;
+        const bool r = ac.decode_bit(c[TC::right(fy, l)]) != 0;
+        TailSymbol sym = l ? (r ? TailSymbol::E : TailSymbol::L) : (r ? TailSymbol::R : TailSymbol::C);
+        bool dummy = false, backward = false;
+        uint32_t offset = 0, depth = 0;
+        if (!l && !r) {
+          if (ac.decode_bit(c[TC::fresh(fx, fy)])) {
+            dummy = ac.decode_bit(c[TC::kDummy + 1]) != 0;
+          } else if (!ac.decode_bit(c[TC::kMerge])) {
+            sym = TailSymbol::S;
+            backward = ac.decode_bit(c[TC::kDirection]) != 0;
+            offset = ac.decode_ueg(c + TC::kOffset, TC::kOffsetBins, kTailOffsetCutoff, kTailOffsetEgK) + 2;
+          } else {
+            sym = TailSymbol::M;
+            depth = ac.decode_ueg(c + TC::kDepth, TC::kOffsetBins, kTailOffsetCutoff, kTailOffsetEgK);
+            offset = ac.decode_ueg(c + TC::kOffset, TC::kOffsetBins, kTailOffsetCutoff, kTailOffsetEgK) + 1;
+          }
+        }
+        if (!ac.ok()) return ac.status();
+        s = tail_.attach(sym, dummy, backward, offset, depth);
+      }
+      if (s != Status::ok) return s;
+      if (item + 1 == nt && (s = tail_.finish()) != Status::ok) return s;
+      continue;
+    }
+    const uint32_t v = item - nt;
+    int32_t q[3];
+    uint32_t np = 0;
+    if ((s = mesh_tail_predict(mesh_, v, q, &np)) != Status::ok) return s;
+    const uint32_t cls = np;
+    for (uint32_t k = 0; k < 3; ++k) {
+      const int32_t d = ag.decode_signed(c[TC::geo_zero(k, cls)], c + TC::geo_mag(k, cls), TC::kGeoBins,
+                                         kTailGeoCutoff, kTailGeoEgK);
+      if (d > kMaxStep || d < -kMaxStep) return Status::malformed;
+      q[k] += d;
+    }
+    if (!ag.ok()) return ag.status();
+    if (mesh_.set_position(v, q) != Status::ok) return Status::malformed;
+  }
+  if (needs_conn && (s = ac.finish()) != Status::ok) return s;
+  if (needs_geom && (s = ag.finish()) != Status::ok) return s;
   return Status::ok;
 }
 

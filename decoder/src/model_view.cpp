@@ -247,6 +247,23 @@ Status plan_model_capacity(const MeshHeader& h, const ModelViewConfig& cfg, size
     out->bytes = base;
     return Status::workspace_too_small;
   }
+  // A version-2 stream's tail rebuilds the whole mesh with its hole-closing
+  // dummies, its contexts and its border: all of it, or the split levels.
+  if (h.tail()) {
+    const uint64_t tv = uint64_t{h.vertices} + h.tail_dummy_vertices;
+    const uint64_t tt = uint64_t{h.triangles} + h.tail_dummy_triangles;
+    if (tv <= kMaxPositions) {
+      const size_t dec = MeshDecoder::workspace_bytes(static_cast<uint32_t>(tv), static_cast<uint32_t>(tt),
+                                                      h.base_triangles, h.coder, h.tail_max_border);
+      const size_t view = ModelView::workspace_bytes(cfg, static_cast<uint32_t>(tv), static_cast<uint32_t>(tt));
+      if (dec != SIZE_MAX && view != 0 && dec <= SIZE_MAX - view && dec + view <= bytes) {
+        out->vertices = static_cast<uint32_t>(tv);
+        out->triangles = static_cast<uint32_t>(tt);
+        out->bytes = dec + view;
+        return Status::ok;
+      }
+    }
+  }
   // The largest vertex count that fits: the bytes grow with the count.
   uint32_t lo = h.base_vertices;
   uint32_t hi = h.vertices < kMaxPositions ? h.vertices : kMaxPositions;

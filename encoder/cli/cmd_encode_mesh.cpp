@@ -30,6 +30,7 @@ struct EncodeMeshOptions {
   double packing_weight = -1;
   int steps = 0;
   uint32_t max_chunk = 4096;
+  double tail = -1;  // not given: enc::kMeshDefaultTail with the arithmetic coder
   bool quiet = false;
 };
 
@@ -61,6 +62,11 @@ void run_encode_mesh(const EncodeMeshOptions& o) {
   if (o.packing_weight >= 0) e.simplify.packing_weight = o.packing_weight;
   if (o.steps > 0) e.simplify.steps = o.steps;
   e.max_chunk_payload = o.max_chunk;
+  // The paper's coding has no tail; the default tail goes with the default coder.
+  const bool arith = !o.paper && e.coder == MeshCoder::arith;
+  e.tail_fraction = o.tail >= 0 ? o.tail : (arith ? enc::kMeshDefaultTail : 0);
+  if (e.tail_fraction > 0 && !arith)
+    throw Failure(kExitUsage, "--tail needs the arithmetic coder: add --tail 0 for --paper or --coder huffman");
 
   enc::MeshRepairReport report;
   enc::Mesh mesh;
@@ -83,11 +89,17 @@ void run_encode_mesh(const EncodeMeshOptions& o) {
               vds::enc::mesh_predictor_name(e.predictor), r.mesh_header.base_vertices,
               100.0 * r.mesh_header.base_vertices / r.mesh_header.vertices, r.levels.size() - 1,
               enc::mesh_up_name(e.up));
+  if (!r.tail_note.empty()) std::printf("%s\n", r.tail_note.c_str());
   std::printf("%s", enc::format_mesh_table(r.levels, r.stream.size()).c_str());
   const double nv = r.mesh_header.vertices;
   std::printf("bits/vertex: split flags %.2f, arc %.2f, rotation %.2f, positions %.2f, base %.2f\n",
               r.bits.split_flags / nv, r.bits.split_shape / nv, r.bits.split_rotation / nv, r.bits.geometry / nv,
               r.bits.base / nv);
+  if (r.tail)
+    std::printf("bits/vertex of the single-rate tail (level %zu): connectivity %.2f, positions %.2f; "
+                "%u holes closed, at most %u border edges\n",
+                r.levels.size() - 1, r.bits.tail_connectivity / nv, r.bits.tail_geometry / nv,
+                r.tail_counts.dummy_vertices, r.tail_counts.max_border);
   std::printf("client: %u B workspace + %u B chunk buffer (%.1f B per vertex)\n", r.stream_header.workspace_bytes,
               r.stream_header.max_chunk_payload,
               double(r.stream_header.workspace_bytes + r.stream_header.max_chunk_payload) / nv);
@@ -126,6 +138,10 @@ void add_encode_mesh(CLI::App& app) {
   sub->add_option("--steps", o->steps, "S: threshold steps (0: from eq. 6)")->check(CLI::NonNegativeNumber);
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes (the client's chunk buffer)")
       ->capture_default_str()->check(CLI::Range(512u, 1u << 24));
+  sub->add_option("--tail", o->tail,
+                  "Send the whole mesh single-rate as the last level, after the split levels that reach this "
+                  "fraction of the vertices (default 0.04 with the arithmetic coder; 0: splits all the way)")
+      ->check(CLI::Range(0.0, 1.0));
   sub->add_flag("-q,--quiet", o->quiet, "Print nothing");
   sub->callback([o] { run_encode_mesh(*o); });
 }

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <unordered_map>
 #include <stdexcept>
 
 #include "vds/enc/arith_encoder.h"
@@ -25,7 +26,7 @@ enum class OpKind : uint8_t { bit, bypass, unary, ueg, sgn, hsym, raw, ue, table
 enum Table : uint8_t { kTabDelta = 0, kTabShape = 1, kTabPos = 2, kTabGeo = 3, kTables = 4 };
 
 // What an operation codes, for MeshBitBreakdown.
-enum Cat : uint8_t { kCatBase, kCatFlags, kCatShape, kCatRotation, kCatGeoNormal, kCatGeo, kCats };
+enum Cat : uint8_t { kCatBase, kCatFlags, kCatShape, kCatRotation, kCatGeoNormal, kCatGeo, kCatTailConn, kCatTailGeo, kCats };
 
 struct Op {
   OpKind kind;
@@ -42,6 +43,8 @@ struct Op {
 // The coded decisions of one segment (the base or one level), per item.
 struct Segment {
   bool base = false;
+  bool tail = false;  // the single-rate tail (MSHT; TailContexts)
+  TailCounts counts;
   uint32_t level = 0;
   uint32_t items = 0;
   uint32_t dv = 0, dt = 0;
@@ -207,9 +210,8 @@ uint32_t length_table_bits(const std::vector<uint8_t>& lengths) {
 
 // Codes one operation; returns its cost in bits (the arithmetic coder's
 // estimate from the context states before coding, exact for Huffman).
-double replay(const Op& o, Coder& c, MeshContexts& ctx, const Segment& seg) {
+double replay(const Op& o, Coder& c, ArithContext* cc, const Segment& seg) {
   c.used = true;
-  ArithContext* cc = ctx.c;
   double bits = 0;
   switch (o.kind) {
     case OpKind::bit: bits = arith_bin_cost_q8(cc[o.ctx], o.value); break;
@@ -239,6 +241,86 @@ double replay(const Op& o, Coder& c, MeshContexts& ctx, const Segment& seg) {
   return bits;
 }
 
+
+// The input mesh closed for the tail's traversal: every hole fanned to a
+// dummy vertex (nv + hole index), the corner table built over both.
+struct ClosedMesh {
+  std::vector<uint32_t> cv;  // corner vertex
+  std::vector<int32_t> opp;  // opposite corner
+  uint32_t real_t = 0, holes = 0;
+  uint32_t max_degree = 0;  // largest ring of the real mesh
+};
+
+uint32_t next3(uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; }
+uint32_t prev3(uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; }
+
+// "" or why the tail's traversal cannot take the mesh.
+std::string close_mesh(uint32_t nv, const std::vector<std::array<uint32_t, 3>>& tris, ClosedMesh* out) {
+  ClosedMesh& m = *out;
+  m.real_t = static_cast<uint32_t>(tris.size());
+  for (const auto& t : tris) m.cv.insert(m.cv.end(), t.begin(), t.end());
+  auto key = [](uint32_t a, uint32_t b) { return uint64_t{a} << 32 | b; };
+  std::unordered_map<uint64_t, uint32_t> edge;  // directed edge n(c) -> p(c) of corner c
+  auto add_edges = [&](uint32_t from) {
+    for (uint32_t c = from; c < m.cv.size(); ++c)
+      if (!edge.emplace(key(m.cv[next3(c)], m.cv[prev3(c)]), c).second) return false;
+    return true;
+  };
+  if (!add_edges(0)) return "an edge used twice in one direction";
+  // Border edges a -> b (no b -> a), chained into holes by their start.
+  std::unordered_map<uint32_t, uint32_t> border_from;
+  for (uint32_t c = 0; c < m.cv.size(); ++c) {
+    const uint32_t a = m.cv[next3(c)], b = m.cv[prev3(c)];
+    if (edge.count(key(b, a)) == 0 && !border_from.emplace(a, c).second) return "a vertex on two holes";
+  }
+  std::vector<uint32_t> ring_size(nv, 0);
+  for (uint32_t v : m.cv) ++ring_size[v];
+  for (const auto& [a, c] : border_from) ++ring_size[a];
+  for (uint32_t n : ring_size) m.max_degree = std::max(m.max_degree, n);
+  std::unordered_map<uint32_t, bool> done;
+  std::vector<uint32_t> starts;
+  for (const auto& [a, c] : border_from) starts.push_back(a);
+  std::sort(starts.begin(), starts.end());
+  for (uint32_t a0 : starts) {
+    if (done[a0]) continue;
+    const uint32_t d = nv + m.holes++;
+    uint32_t a = a0, len = 0;
+    do {
+      done[a] = true;
+      const auto it = border_from.find(a);
+      if (it == border_from.end()) return "a hole that does not close";
+      const uint32_t b = m.cv[prev3(it->second)];
+      m.cv.insert(m.cv.end(), {b, a, d});
+      a = b;
+      if (++len > border_from.size()) return "a hole that does not close";
+    } while (a != a0);
+    if (len < 3) return "a hole of two edges";
+  }
+  if (!add_edges(3 * m.real_t)) return "a hole that touches itself";
+  m.opp.assign(m.cv.size(), -1);
+  for (uint32_t c = 0; c < m.cv.size(); ++c) {
+    const auto it = edge.find(key(m.cv[prev3(c)], m.cv[next3(c)]));
+    if (it == edge.end()) return "an edge left open after closing the holes";
+    m.opp[c] = static_cast<int32_t>(it->second);
+  }
+  // Every vertex one fan.
+  std::vector<uint32_t> fan(nv + m.holes, 0);
+  for (uint32_t c = 0; c < m.cv.size(); ++c) ++fan[m.cv[c]];
+  for (uint32_t c0 = 0; c0 < m.cv.size(); ++c0) {
+    // Walk c0's fan; it must hold every corner of its vertex.
+    const uint32_t x = m.cv[c0];
+    if (fan[x] == 0) continue;
+    uint32_t c = c0, n = 0;
+    do {
+      c = next3(static_cast<uint32_t>(m.opp[next3(c)]));
+      if (++n > fan[x]) break;
+    } while (c != c0);
+    if (n != fan[x]) return "a vertex where two sheets of the surface meet";
+    fan[x] = 0;
+  }
+  return "";
+}
+
 class Encoder {
  public:
   Encoder(const Mesh& mesh, const MeshEncodeOptions& o) : mesh_(mesh), opt_(o) {}
@@ -248,6 +330,7 @@ class Encoder {
  private:
   void build_base(const SimplifyResult& sr);
   void trace_level(const SimplifyLevel& lvl, uint32_t level_index, Segment& seg);
+  void trace_tail(const ClosedMesh& cm, uint32_t level_index, Segment& seg);
   void finish_tables(Segment& seg, const std::vector<uint64_t> freqs[kTables]);
   void emit(const Segment& seg, StreamWriter& w, MeshLevelStats& stats);
   uint32_t dec(uint32_t orig) const {
@@ -264,6 +347,7 @@ class Encoder {
   Arena arena_;
   MeshState st_;
   MeshContexts ctx_{};
+  TailContexts tctx_{};
   std::vector<uint32_t> dec_of_, orig_of_;
   Segment base_seg_;
   MeshBitBreakdown bits_;
@@ -564,6 +648,164 @@ void Encoder::trace_level(const SimplifyLevel& lvl, uint32_t level_index, Segmen
   if (!arith) finish_tables(seg, freqs);
 }
 
+// The tail: the Edgebreaker traversal of the closed input mesh, run in step
+// with the client's own MeshTail (so the contexts, the border walks and the
+// vertex and triangle numbering are the client's), then the positions in
+// the client's vertex order against its own prediction.
+void Encoder::trace_tail(const ClosedMesh& cm, uint32_t level_index, Segment& seg) {
+  using TC = TailContexts;
+  const uint32_t nv = static_cast<uint32_t>(mesh_.positions.size());
+  seg.tail = true;
+  seg.level = level_index;
+  seg.counts.vertices = nv;
+  seg.counts.triangles = cm.real_t;
+  seg.counts.dummy_vertices = cm.holes;
+  seg.counts.dummy_triangles = static_cast<uint32_t>(cm.cv.size() / 3) - cm.real_t;
+  seg.counts.max_border = 3 * (seg.counts.triangles + seg.counts.dummy_triangles);  // declared below: the peak
+  MeshTail tail;
+  if (tail.begin(st_, arena_, seg.counts) != Status::ok) throw std::logic_error("encode_mesh: tail does not fit");
+  const uint32_t nt = tail.total();
+  std::vector<uint32_t> dec(nv + cm.holes, kMeshNone);  // client vertex of each input vertex
+  std::vector<uint32_t> input_corner(3 * size_t{nt}, kMeshNone);  // input corner of each client corner
+  std::vector<char> used(nt, 0);
+  uint32_t next_seed = 0;
+  auto conn = [&](Op o) { seg.conn.push_back(with(kCatTailConn, o)); };
+  auto record = [&](uint32_t f) {
+    used[f] = 1;
+    // The client numbers the triangle it just built like this.
+    const bool dummy = cm.cv[3 * f] >= nv || cm.cv[3 * f + 1] >= nv || cm.cv[3 * f + 2] >= nv;
+    return tail.next_triangle(dummy);
+  };
+  for (uint32_t item = 0; item < nt; ++item) {
+    Status st;
+    if (tail.needs_seed()) {
+      while (used[next_seed]) ++next_seed;
+      const uint32_t f = next_seed;
+      bool dummy[3];
+      for (uint32_t k = 0; k < 3; ++k) {
+        dummy[k] = cm.cv[3 * f + k] >= nv;
+        conn(op_bit(TC::kDummy, dummy[k]));
+      }
+      const uint32_t t = record(f);
+      if ((st = tail.seed(dummy)) != Status::ok) throw std::logic_error("encode_mesh: tail seed rejected");
+      for (uint32_t k = 0; k < 3; ++k) {
+        input_corner[3 * t + k] = 3 * f + k;
+        dec[cm.cv[3 * f + k]] = st_.corner_vertex(3 * t + k);
+      }
+    } else {
+      const uint32_t g = tail.gate();
+      const uint32_t ic = static_cast<uint32_t>(cm.opp[input_corner[g]]);  // the input corner facing the gate
+      const uint32_t f = ic / 3;
+      if (used[f]) throw std::logic_error("encode_mesh: tail gate faces a built triangle");
+      const uint32_t tip = cm.cv[ic];
+      const uint32_t fx = tail.fan_before(), fy = tail.fan_after();
+      TailSymbol sym = TailSymbol::C;
+      bool backward = false;
+      uint32_t offset = 0, depth = 0;
+      if (dec[tip] != kMeshNone) {
+        const bool l = dec[tip] == tail.vertex_before(), r = dec[tip] == tail.vertex_after();
+        sym = l ? (r ? TailSymbol::E : TailSymbol::L) : (r ? TailSymbol::R : TailSymbol::S);
+      }
+      if (sym == TailSymbol::S) {
+        // Where a loop passes the tip more than once (after a handle), the
+        // right pass is the one whose unbuilt wedge at the tip holds f.
+        auto wedge_holds_f = [&](uint32_t e) {
+          uint32_t from = input_corner[tail.edge_corner(e)] / 3;
+          uint32_t tri = static_cast<uint32_t>(cm.opp[input_corner[tail.edge_corner(e)]]) / 3;
+          for (uint32_t steps = 0; steps <= cm.cv.size() / 3; ++steps) {
+            if (tri == f) return true;
+            if (used[tri]) return false;
+            uint32_t k = 3 * tri;
+            while (cm.cv[k] != tip) ++k;
+            const uint32_t t1 = static_cast<uint32_t>(cm.opp[next3(k)]) / 3;
+            const uint32_t t2 = static_cast<uint32_t>(cm.opp[prev3(k)]) / 3;
+            const uint32_t to = t1 == from ? t2 : t1;
+            from = tri;
+            tri = to;
+          }
+          return false;
+        };
+        // The current loop, both ways at once; the nearer side is coded.
+        uint32_t h[2] = {tail.border_first(false), tail.border_first(true)};
+        const uint32_t stop[2] = {tail.border_first(true), tail.border_first(false)};
+        bool open[2] = {true, true};
+        for (uint32_t k = 2; offset == 0 && (open[0] || open[1]); ++k) {
+          for (int side = 0; side < 2 && offset == 0; ++side) {
+            if (!open[side]) continue;
+            h[side] = tail.border_next(h[side], side == 1);
+            if (h[side] == stop[side]) {
+              open[side] = false;
+            } else if (tail.border_reach(h[side], side == 1) == dec[tip] && wedge_holds_f(h[side])) {
+              offset = k;
+              backward = side == 1;
+            }
+          }
+        }
+        // Else a waiting loop: a handle.
+        for (uint32_t d = 0; offset == 0 && d < tail.waiting(); ++d) {
+          const uint32_t e0 = tail.waiting_edge(d);
+          uint32_t e = e0;
+          for (uint32_t k = 1; offset == 0; ++k) {
+            if (tail.border_reach(e, false) == dec[tip] && wedge_holds_f(e)) {
+              sym = TailSymbol::M;
+              depth = d;
+              offset = k;
+            }
+            e = tail.border_next(e, false);
+            if (e == e0) break;
+          }
+        }
+        if (offset == 0) throw std::logic_error("encode_mesh: tail vertex on no border loop");
+      }
+      conn(op_bit(TC::left(fx, fy), sym == TailSymbol::L || sym == TailSymbol::E));
+      conn(op_bit(TC::right(fy, sym == TailSymbol::L || sym == TailSymbol::E), sym == TailSymbol::R || sym == TailSymbol::E));
+      const bool dummy = tip >= nv;
+      const bool far = sym == TailSymbol::S || sym == TailSymbol::M;
+      if (sym == TailSymbol::C || far) conn(op_bit(TC::fresh(fx, fy), sym == TailSymbol::C));
+      if (sym == TailSymbol::C) conn(op_bit(TC::kDummy + 1, dummy));
+      if (far) conn(op_bit(TC::kMerge, sym == TailSymbol::M));
+      if (sym == TailSymbol::S) {
+        conn(op_bit(TC::kDirection, backward));
+        conn(op_ueg(TC::kOffset, TC::kOffsetBins, offset - 2, kTailOffsetCutoff, kTailOffsetEgK));
+      }
+      if (sym == TailSymbol::M) {
+        conn(op_ueg(TC::kDepth, TC::kOffsetBins, depth, kTailOffsetCutoff, kTailOffsetEgK));
+        conn(op_ueg(TC::kOffset, TC::kOffsetBins, offset - 1, kTailOffsetCutoff, kTailOffsetEgK));
+      }
+      const uint32_t t = record(f);
+      if ((st = tail.attach(sym, dummy, backward, offset, depth)) != Status::ok)
+        throw std::logic_error("encode_mesh: tail step rejected");
+      input_corner[3 * t] = ic;
+      input_corner[3 * t + 1] = next3(ic);
+      input_corner[3 * t + 2] = prev3(ic);
+      if (sym == TailSymbol::C) dec[tip] = st_.corner_vertex(3 * t);
+    }
+    seg.end_item();
+  }
+  if (tail.finish() != Status::ok) throw std::logic_error("encode_mesh: tail not closed");
+  seg.counts.max_border = tail.border_peak();
+  orig_of_.assign(nv, kMeshNone);
+  for (uint32_t v = 0; v < nv; ++v) {
+    if (dec[v] == kMeshNone || dec[v] >= nv) throw std::logic_error("encode_mesh: tail lost a vertex");
+    orig_of_[dec[v]] = v;
+  }
+  for (uint32_t v = 0; v < nv; ++v) {
+    int32_t p[3];
+    uint32_t np = 0;
+    if (mesh_tail_predict(st_, v, p, &np) != Status::ok) throw std::logic_error("encode_mesh: tail prediction");
+    const uint32_t cls = np;
+    const auto& q = q_[orig_of_[v]];
+    for (uint32_t k = 0; k < 3; ++k)
+      seg.geom.push_back(with(kCatTailGeo, op_signed(TC::geo_zero(k, cls), TC::geo_mag(k, cls), TC::kGeoBins,
+                                                     q[k] - p[k], kTailGeoCutoff, kTailGeoEgK)));
+    const int32_t actual[3] = {q[0], q[1], q[2]};
+    if (st_.set_position(v, actual) != Status::ok) throw std::logic_error("encode_mesh: tail position");
+    seg.end_item();
+  }
+  seg.dv = nv;
+  seg.dt = cm.real_t;
+}
+
 void Encoder::finish_tables(Segment& seg, const std::vector<uint64_t> freqs[kTables]) {
   for (int t = 0; t < kTables; ++t) {
     std::vector<uint64_t> f = freqs[t];
@@ -582,10 +824,10 @@ void Encoder::emit(const Segment& seg, StreamWriter& w, MeshLevelStats& stats) {
   const bool arith = opt_.coder == MeshCoder::arith;
   auto header = [&](uint32_t first, uint32_t count) {
     std::vector<uint8_t> h;
-    if (!seg.base) put_varint(h, seg.level);
+    if (!seg.base && !seg.tail) put_varint(h, seg.level);
     put_varint(h, first);
     put_varint(h, count);
-    if (!seg.base && first == 0) {
+    if (!seg.base && !seg.tail && first == 0) {
       put_varint(h, seg.dv);
       put_varint(h, seg.dt);
       h.push_back(static_cast<uint8_t>(seg.weight_q4));
@@ -594,14 +836,15 @@ void Encoder::emit(const Segment& seg, StreamWriter& w, MeshLevelStats& stats) {
   };
   auto encode_item = [&](uint32_t j, Coder& cc, Coder& gc) {
     for (uint32_t o = seg.conn_at[j]; o < seg.conn_at[j + 1]; ++o)
-      cost[seg.conn[o].cat] += replay(seg.conn[o], cc, ctx_, seg);
+      cost[seg.conn[o].cat] += replay(seg.conn[o], cc, seg.tail ? tctx_.c : ctx_.c, seg);
     for (uint32_t o = seg.geom_at[j]; o < seg.geom_at[j + 1]; ++o)
-      cost[seg.geom[o].cat] += replay(seg.geom[o], gc, ctx_, seg);
+      cost[seg.geom[o].cat] += replay(seg.geom[o], gc, seg.tail ? tctx_.c : ctx_.c, seg);
   };
   const size_t limit = opt_.max_chunk_payload;
   uint32_t i = 0;
   while (i < seg.items) {
     const MeshContexts snapshot = ctx_;
+    const TailContexts tail_snapshot = tctx_;
     double cost_before[kCats];
     std::copy(cost, cost + kCats, cost_before);
     Coder cc, gc;
@@ -619,6 +862,7 @@ void Encoder::emit(const Segment& seg, StreamWriter& w, MeshLevelStats& stats) {
     if (j < seg.items) {
       // Item j overflowed: code i .. j-1 again from the snapshot.
       ctx_ = snapshot;
+      tctx_ = tail_snapshot;
       std::copy(cost_before, cost_before + kCats, cost);
       cc = Coder{};
       gc = Coder{};
@@ -630,7 +874,7 @@ void Encoder::emit(const Segment& seg, StreamWriter& w, MeshLevelStats& stats) {
     if (!seg.base) put_varint(payload, static_cast<uint32_t>(conn.size()));
     payload.insert(payload.end(), conn.begin(), conn.end());
     payload.insert(payload.end(), geom.begin(), geom.end());
-    w.add_chunk(seg.base ? chunk::kMeshBase : chunk::kMeshLevel, payload);
+    w.add_chunk(seg.base ? chunk::kMeshBase : (seg.tail ? chunk::kMeshTail : chunk::kMeshLevel), payload);
     stats.connectivity_bytes += conn.size();
     stats.geometry_bytes += geom.size();
     stats.chunk_bytes += payload.size() + kChunkHeadBytes + kChunkTailBytes;
@@ -643,6 +887,8 @@ void Encoder::emit(const Segment& seg, StreamWriter& w, MeshLevelStats& stats) {
   bits_.split_rotation += cost[kCatRotation];
   bits_.geometry_normal += cost[kCatGeoNormal];
   bits_.geometry += cost[kCatGeoNormal] + cost[kCatGeo];
+  bits_.tail_connectivity += cost[kCatTailConn];
+  bits_.tail_geometry += cost[kCatTailGeo];
 }
 
 MeshEncodeResult Encoder::run() {
@@ -659,22 +905,64 @@ MeshEncodeResult Encoder::run() {
   const SimplifyResult sr = simplify_progressive(q_, mesh_.triangles, mesh_simplify_options(opt_));
   const uint32_t nv = static_cast<uint32_t>(mesh_.positions.size());
   const uint32_t nt = static_cast<uint32_t>(mesh_.triangles.size());
-  workspace_.assign(MeshState::workspace_bytes(nv, nt) + 12 * size_t{nt} + 256, 0);
+  const uint32_t split_levels = static_cast<uint32_t>(sr.levels.size());
+  // The tail: how many split levels come before it, and the closed mesh it
+  // traverses.
+  ClosedMesh closed;
+  uint32_t levels = split_levels;  // levels after the base, the tail included
+  bool tail = false;
+  if (opt_.tail_fraction > 0) {
+    if (opt_.coder != MeshCoder::arith) throw std::invalid_argument("encode_mesh: the tail needs the arithmetic coder");
+    const std::string why = close_mesh(nv, mesh_.triangles, &closed);
+    if (!why.empty()) {
+      res.tail_note = "no single-rate tail: " + why;
+    } else if (closed.max_degree > kMeshMaxDegree) {
+      res.tail_note = "no single-rate tail: a vertex ring above " + std::to_string(kMeshMaxDegree);
+    } else if (split_levels < 2) {
+      res.tail_note = "no single-rate tail: fewer than two levels";
+    } else {
+      // Split levels while they reach at most tail_fraction of the vertices,
+      // at least tail_min_levels of them, and at least one split level and
+      // one level's worth of vertices left for the tail.
+      uint32_t k = 0, v = static_cast<uint32_t>(sr.base_vertices.size());
+      while (k + 1 < split_levels) {
+        const uint32_t next_v = v + static_cast<uint32_t>(sr.levels[split_levels - 1 - k].collapses.size());
+        if (next_v > opt_.tail_fraction * nv && k >= opt_.tail_min_levels) break;
+        v = next_v;
+        ++k;
+      }
+      tail = k >= 1;
+      if (tail) levels = k + 1;
+      else res.tail_note = "no single-rate tail: no split level before it";
+    }
+  }
+  const uint32_t cap_v = tail ? nv + closed.holes : nv;
+  const uint32_t cap_t = tail ? static_cast<uint32_t>(closed.cv.size() / 3) : nt;
+  workspace_.assign(MeshState::workspace_bytes(cap_v, cap_t) + 12 * size_t{cap_t} +
+                        (tail ? MeshTail::workspace_bytes(3 * cap_t) : 0) + 256,
+                    0);
   arena_ = Arena(workspace_.data(), workspace_.size());
-  if (st_.init(arena_, nv, nt) != Status::ok) throw std::logic_error("encode_mesh: workspace");
+  if (st_.init(arena_, cap_v, cap_t) != Status::ok) throw std::logic_error("encode_mesh: workspace");
   st_.clear(opt_.bits);
   ctx_.reset();
+  tctx_.reset();
   dec_of_.assign(nv, kMeshNone);
   orig_of_.clear();
   build_base(sr);
   const uint32_t base_t = st_.triangle_count();
-  const uint32_t levels = static_cast<uint32_t>(sr.levels.size());
   std::vector<uint64_t> sums(levels + 1);
   sums[0] = mesh_checksum(st_);
   std::vector<Segment> segs(levels);
-  for (uint32_t l = 1; l <= levels; ++l) {
-    trace_level(sr.levels[levels - l], l, segs[l - 1]);
+  const uint32_t splits = tail ? levels - 1 : levels;
+  for (uint32_t l = 1; l <= splits; ++l) {
+    trace_level(sr.levels[split_levels - l], l, segs[l - 1]);
     sums[l] = mesh_checksum(st_);
+  }
+  uint32_t max_degree = st_.max_degree_seen();
+  if (tail) {
+    max_degree = std::max(max_degree, closed.max_degree);
+    trace_tail(closed, levels, segs[levels - 1]);
+    sums[levels] = mesh_checksum(st_);
   }
 
   // The reconstruction must be the input, on the grid.
@@ -701,13 +989,14 @@ MeshEncodeResult Encoder::run() {
   }
 
   MeshHeader mh;
+  if (tail) mh.version = kMeshCodecVersionTail;
   mh.coder = opt_.coder;
   mh.predictor = opt_.predictor;
   mh.up = opt_.up;
   mh.bits = static_cast<uint8_t>(opt_.bits);
   if (levels > 0xFFFF) throw std::invalid_argument("encode_mesh: too many levels");
   mh.levels = static_cast<uint16_t>(levels);
-  mh.max_degree = static_cast<uint16_t>(std::max<uint32_t>(3, st_.max_degree_seen()));
+  mh.max_degree = static_cast<uint16_t>(std::max<uint32_t>(3, max_degree));
   mh.base_vertices = static_cast<uint32_t>(sr.base_vertices.size());
   mh.base_triangles = base_t;
   mh.vertices = nv;
@@ -722,17 +1011,25 @@ MeshEncodeResult Encoder::run() {
   }
   StreamHeader hdr = default_header(StreamMode::model, opt_.width, opt_.height);
   hdr.max_chunk_payload = opt_.max_chunk_payload;
-  hdr.max_vertices = nv;
-  hdr.max_triangles = nt;
-  const size_t ws = MeshDecoder::workspace_bytes(nv, nt, base_t, opt_.coder);
+  hdr.max_vertices = cap_v;
+  hdr.max_triangles = cap_t;
+  const size_t ws =
+      MeshDecoder::workspace_bytes(cap_v, cap_t, base_t, opt_.coder, tail ? segs[levels - 1].counts.max_border : 0);
   if (ws > 0xFFFFFFFFu) throw std::invalid_argument("encode_mesh: mesh too large for a client workspace");
   hdr.workspace_bytes = static_cast<uint32_t>(ws);
   StreamWriter w(hdr);
-  uint8_t mhb[kMeshHeaderViewBytes];
+  if (tail) {
+    const TailCounts& tc = segs[levels - 1].counts;
+    mh.tail_dummy_vertices = tc.dummy_vertices;
+    mh.tail_dummy_triangles = tc.dummy_triangles;
+    mh.tail_max_border = tc.max_border;
+  }
+  uint8_t mhb[kMeshHeaderTailBytes];
   mesh_header_to_bytes(mh, mhb);
   w.add_chunk(chunk::kMeshHeader, std::span<const uint8_t>(mhb, mesh_header_size(mh)));
 
   ctx_.reset();
+  tctx_.reset();
   res.levels.resize(levels + 1);
   MeshLevelStats& b = res.levels[0];
   b.level = 0;
@@ -745,14 +1042,22 @@ MeshEncodeResult Encoder::run() {
     MeshLevelStats& s = res.levels[l];
     const Segment& seg = segs[l - 1];
     s.level = l;
-    s.vertices_added = seg.dv;
-    s.triangles_added = seg.dt;
-    v_total += seg.dv;
-    t_total += seg.dt;
+    if (seg.tail) {
+      s.tail = true;
+      s.vertices_added = nv - v_total;  // net: the tail sends every vertex again
+      s.triangles_added = nt - t_total;
+      v_total = nv;
+      t_total = nt;
+    } else {
+      s.vertices_added = seg.dv;
+      s.triangles_added = seg.dt;
+      v_total += seg.dv;
+      t_total += seg.dt;
+    }
     s.vertices = v_total;
     s.triangles = t_total;
     s.weight_q4 = seg.weight_q4;
-    s.error_threshold = sr.levels[levels - l].threshold;
+    s.error_threshold = seg.tail ? 0 : sr.levels[split_levels - l].threshold;
     s.checksum = sums[l];
     emit(seg, w, s);
   }
@@ -766,6 +1071,8 @@ MeshEncodeResult Encoder::run() {
   res.vertex_order = orig_of_;
   res.max_degree = mh.max_degree;
   res.error_limit = sr.error_limit;
+  res.tail = tail;
+  if (tail) res.tail_counts = segs[levels - 1].counts;
   return res;
 }
 
@@ -848,7 +1155,9 @@ std::string format_mesh_table(const std::vector<MeshLevelStats>& levels, size_t 
                     static_cast<unsigned long long>(l.chunk_bytes), static_cast<unsigned long long>(cum), l.vertices);
     } else {
       const double dt = l.triangles_added ? double(l.triangles_added) : 1.0;
-      std::snprintf(line, sizeof line, "%5u %8u %8u %7.2f %7.2f %9.2f %9llu %10llu %9u\n", l.level, l.vertices_added,
+      char level[16];
+      std::snprintf(level, sizeof level, l.tail ? "%uT" : "%u", l.level);
+      std::snprintf(line, sizeof line, "%5s %8u %8u %7.2f %7.2f %9.2f %9llu %10llu %9u\n", level, l.vertices_added,
                     l.triangles_added, 8.0 * double(l.connectivity_bytes) / dt, 8.0 * double(l.geometry_bytes) / dt,
                     8.0 * double(l.connectivity_bytes + l.geometry_bytes) / dt,
                     static_cast<unsigned long long>(l.chunk_bytes), static_cast<unsigned long long>(cum), l.vertices);
@@ -866,6 +1175,12 @@ std::string format_mesh_table(const std::vector<MeshLevelStats>& levels, size_t 
                   8.0 * double(c_sum + g_sum) / double(dt_sum), levels.empty() ? 0u : levels.back().level);
     s += line;
   }
+  if (!levels.empty() && levels.back().tail) {
+    std::snprintf(line, sizeof line,
+                  "(level %uT: the single-rate tail; it sends the whole mesh again, dV and dT are net)\n",
+                  levels.back().level);
+    s += line;
+  }
   if (!levels.empty() && levels.back().triangles) {
     std::snprintf(line, sizeof line,
                   "total: %zu bytes = %.3f bits/triangle, %.3f bits/vertex (%u vertices, %u triangles, %zu levels)\n",
@@ -876,6 +1191,20 @@ std::string format_mesh_table(const std::vector<MeshLevelStats>& levels, size_t 
   }
   return s;
 }
+
+namespace {
+
+// A level or tail chunk's two substreams, from its connectivity size on.
+void count_substreams(MeshLevelStats& l, const uint8_t* p, const uint8_t* end, uint32_t size) {
+  uint32_t conn = 0;
+  if (read_varint(p, end, &conn) != Status::ok || conn > static_cast<uint32_t>(end - p)) return;
+  l.connectivity_bytes += conn;
+  l.geometry_bytes += static_cast<uint64_t>(end - p) - conn;
+  l.chunk_bytes += size + kChunkHeadBytes + kChunkTailBytes;
+  ++l.chunks;
+}
+
+}  // namespace
 
 bool MeshChunkSummary::add(uint32_t type, const uint8_t* payload, uint32_t size) {
   const uint8_t* p = payload;
@@ -888,7 +1217,19 @@ bool MeshChunkSummary::add(uint32_t type, const uint8_t* payload, uint32_t size)
     levels_[0].triangles_added = levels_[0].triangles = header_.base_triangles;
     return true;
   }
-  if (!have_header_) return type == chunk::kMeshBase || type == chunk::kMeshLevel;
+  if (!have_header_) return type == chunk::kMeshBase || type == chunk::kMeshLevel || type == chunk::kMeshTail;
+  if (type == chunk::kMeshTail) {
+    uint32_t first = 0, count = 0;
+    if (!header_.tail() || read_varint(p, end, &first) != Status::ok || read_varint(p, end, &count) != Status::ok)
+      return true;
+    const uint32_t level = header_.levels;
+    if (levels_.size() <= level) levels_.resize(level + 1);
+    MeshLevelStats& l = levels_[level];
+    l.level = level;
+    l.tail = true;
+    count_substreams(l, p, end, size);
+    return true;
+  }
   if (type == chunk::kMeshBase) {
     uint32_t first = 0, count = 0;
     if (read_varint(p, end, &first) != Status::ok || read_varint(p, end, &count) != Status::ok) return true;
@@ -898,7 +1239,7 @@ bool MeshChunkSummary::add(uint32_t type, const uint8_t* payload, uint32_t size)
     return true;
   }
   if (type == chunk::kMeshLevel) {
-    uint32_t level = 0, first = 0, count = 0, dv = 0, dt = 0, conn = 0;
+    uint32_t level = 0, first = 0, count = 0, dv = 0, dt = 0;
     if (read_varint(p, end, &level) != Status::ok || read_varint(p, end, &first) != Status::ok ||
         read_varint(p, end, &count) != Status::ok || level == 0 || level > header_.levels)
       return true;
@@ -911,11 +1252,7 @@ bool MeshChunkSummary::add(uint32_t type, const uint8_t* payload, uint32_t size)
       l.vertices_added = dv;
       l.triangles_added = dt;
     }
-    if (read_varint(p, end, &conn) != Status::ok || conn > static_cast<uint32_t>(end - p)) return true;
-    l.connectivity_bytes += conn;
-    l.geometry_bytes += static_cast<uint64_t>(end - p) - conn;
-    l.chunk_bytes += size + kChunkHeadBytes + kChunkTailBytes;
-    ++l.chunks;
+    count_substreams(l, p, end, size);
     return true;
   }
   return false;
@@ -926,6 +1263,10 @@ std::string MeshChunkSummary::table() const {
   std::vector<MeshLevelStats> rows = levels_;
   uint32_t v = 0, t = 0;
   for (MeshLevelStats& r : rows) {
+    if (r.tail) {  // net of the levels before it
+      r.vertices_added = header_.vertices - v;
+      r.triangles_added = header_.triangles - t;
+    }
     v += r.vertices_added;
     t += r.triangles_added;
     r.vertices = v;

@@ -41,6 +41,8 @@ struct Run {
   Status init_status = Status::ok;
   uint64_t instructions = 0;        // inside MeshDecoder::consume, all chunks
   uint64_t level_instructions = 0;  // since the last completed level
+  uint64_t last_level_instructions = 0;
+  uint32_t tail_from_vertices = 0;  // vertices before the last completed level
   uint32_t level_vertices = 0;      // vertex count when that level completed
   uint64_t base_instructions = 0;
   uint32_t base_vertices = 0;
@@ -135,6 +137,8 @@ vds::ChunkResult on_chunk(void*, uint32_t type, const uint8_t* payload, uint32_t
     c.str("count level=").dec(g_run.decoder.levels_done()).str(" splits=").dec(splits);
     c.str(" instructions=").dec(g_run.level_instructions).str("\n");
     board::log(c.c_str());
+    g_run.last_level_instructions = g_run.level_instructions;
+    g_run.tail_from_vertices = g_run.level_vertices;  // before this level
     g_run.level_instructions = 0;
     g_run.level_vertices = m.vertex_count();
     ++g_run.levels;
@@ -178,6 +182,11 @@ bool run_file(const char* path, int* failures) {
   l.str("m4 stream=").str(base).str(" status=").str(vds::status_name(s)).str(" vertices=").dec(m.vertex_count());
   l.str(" splits=").dec(splits).str(" levels=").dec(g_run.levels).str(" instructions=").dec(g_run.instructions);
   l.str(" base_instructions=").dec(g_run.base_instructions);
+  // A version-2 stream's last level is the single-rate tail: its own count.
+  if (g_run.decoder.have_header() && g_run.decoder.header().tail() && g_run.decoder.complete()) {
+    l.str(" tail_instructions=").dec(g_run.last_level_instructions);
+    l.str(" tail_split_vertices=").dec(g_run.tail_from_vertices - g_run.base_vertices);
+  }
   l.str(" workspace=").dec(g_arena.high_water() - g_run.view_bytes).str("\n");
   board::log(l.c_str());
   Line v;

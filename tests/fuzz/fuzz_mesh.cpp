@@ -1,8 +1,9 @@
 // libFuzzer: the progressive mesh decoder on hostile input, three ways
 // (first byte): raw chunk records straight into MeshDecoder; byte flips in
-// the chunks of valid streams (both coders), past any CRC; and round trips
-// of small meshes built from the input, which must come back exactly, in
-// full and in a client that holds only the levels that fit.
+// the chunks of valid streams (both coders, and with the single-rate tail),
+// past any CRC; and round trips of small meshes built from the input, with
+// and without the tail, which must come back exactly, in full and in a
+// client that holds only the levels that fit.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -55,22 +56,27 @@ std::vector<Chunk> mesh_chunks(const std::vector<uint8_t>& stream) {
   return out;
 }
 
-const std::vector<Chunk>& reference(int coder) {
-  static std::vector<Chunk> refs[2];
-  if (refs[coder].empty()) {
+// 0 arithmetic, 1 Huffman, 2 arithmetic with the tail.
+const std::vector<Chunk>& reference(int variant) {
+  static std::vector<Chunk> refs[3];
+  if (refs[variant].empty()) {
     vds::enc::MeshEncodeOptions o;
-    o.coder = coder ? vds::MeshCoder::huffman : vds::MeshCoder::arith;
+    o.coder = variant == 1 ? vds::MeshCoder::huffman : vds::MeshCoder::arith;
     o.max_chunk_payload = 512;
+    if (variant == 2) {
+      o.tail_fraction = 0.3;
+      o.tail_min_levels = 2;
+    }
     const uint8_t z[] = {3, 9, 1, 7, 12, 0, 5, 8, 2, 11, 6};
-    refs[coder] = mesh_chunks(vds::enc::encode_mesh(grid(9, 8, z, sizeof z), o).stream);
+    refs[variant] = mesh_chunks(vds::enc::encode_mesh(grid(9, 8, z, sizeof z), o).stream);
   }
-  return refs[coder];
+  return refs[variant];
 }
 
 // Feeds the chunks to a fresh decoder in an exactly sized copy each.
 void decode(const std::vector<Chunk>& chunks) {
   static std::vector<uint8_t> ws(vds::MeshDecoder::workspace_bytes(kMaxVertices, kMaxTriangles, kMaxTriangles,
-                                                                    vds::MeshCoder::huffman));
+                                                                    vds::MeshCoder::huffman, 3 * kMaxTriangles));
   vds::Arena arena(ws.data(), ws.size());
   vds::MeshDecoder dec;
   if (dec.init(arena, kMaxVertices, kMaxTriangles) != vds::Status::ok) __builtin_trap();
@@ -97,11 +103,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   size -= 1;
   if (mode == 0) {
     // Records: type selector, 16-bit length, payload.
-    static const uint32_t types[3] = {vds::chunk::kMeshHeader, vds::chunk::kMeshBase, vds::chunk::kMeshLevel};
+    static const uint32_t types[4] = {vds::chunk::kMeshHeader, vds::chunk::kMeshBase, vds::chunk::kMeshLevel,
+                                      vds::chunk::kMeshTail};
     std::vector<Chunk> chunks;
     size_t at = 0;
     while (at + 3 <= size) {
-      const uint32_t type = types[data[at] % 3];
+      const uint32_t type = types[data[at] % 4];
       const size_t len = std::min<size_t>(size - at - 3, size_t{data[at + 1]} | size_t{data[at + 2]} << 8);
       chunks.push_back({type, std::vector<uint8_t>(data + at + 3, data + at + 3 + len)});
       at += 3 + len;
@@ -109,7 +116,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     decode(chunks);
   } else if (mode == 1) {
     // Byte flips (chunk, offset, xor) in a valid stream's chunks.
-    std::vector<Chunk> chunks = reference(data[0] & 1);
+    std::vector<Chunk> chunks = reference(data[0] % 3);
     for (size_t at = 1; at + 3 <= size; at += 3) {
       Chunk& c = chunks[data[at] % chunks.size()];
       if (c.payload.empty()) continue;
@@ -124,6 +131,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     o.predictor = (data[1] & 2) ? vds::MeshPredictor::laplacian
                                 : ((data[1] & 0x80) ? vds::MeshPredictor::parallelogram : vds::MeshPredictor::area);
     o.bits = 4 + (data[1] >> 2) % 13;
+    if ((data[1] & 0x40) && o.coder == vds::MeshCoder::arith) {
+      o.tail_fraction = 0.3;
+      o.tail_min_levels = 2;
+    }
     const vds::enc::Mesh m = grid(nx, ny, data + 2, size > 2 ? size - 2 : 0);
     vds::enc::MeshEncodeResult r;
     try {
@@ -155,9 +166,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       if (part.consume(c.type, c.payload.data(), static_cast<uint32_t>(c.payload.size())) != vds::Status::ok)
         __builtin_trap();
     const uint32_t k = part.levels_done();
+    // What level k + 1 needs: its vertices, or for the tail HEAD's count (its dummies too).
+    const auto needs = [&](uint32_t l) { return r.levels[l].tail ? full_v : r.levels[l].vertices; };
     if (part.finish() != vds::Status::ok || part.mesh().vertex_count() > limit ||
         vds::enc::mesh_checksum(part.mesh()) != r.levels[k].checksum ||
-        (k + 1 < r.levels.size() && r.levels[k + 1].vertices <= limit) ||
+        (k + 1 < r.levels.size() && needs(k + 1) <= limit) ||
         part.capacity_reached() == (k + 1 == r.levels.size()))
       __builtin_trap();
   }

@@ -170,6 +170,36 @@ TEST(ModelView, ASmallClientShowsTheLevelsThatFit) {
   EXPECT_TRUE(none.crcs.empty());
 }
 
+// A version-2 stream (split levels, then the single-rate tail of a mesh
+// with holes): a client plans for the whole tail when it fits, dummies,
+// contexts and border included, and shows it; a little less, and it shows
+// every split level and stops before the tail.
+TEST(ModelView, ATailStreamPlaysWholeOrStopsBeforeTheTail) {
+  vds::enc::MeshEncodeOptions o;
+  o.tail_fraction = 0.3;
+  o.tail_min_levels = 2;
+  const vds::enc::MeshEncodeResult r =
+      vds::enc::encode_mesh(vds::test::with_hole(vds::test::grid_mesh(12, 10, 0.3), 0.5, 0.5, 0.25), o);
+  ASSERT_TRUE(r.tail);
+  ASSERT_GT(r.tail_counts.dummy_vertices, 0u);
+  const std::vector<uint32_t> want = vds::enc::client_frame_crcs(r.stream);
+  ASSERT_EQ(want.size(), r.levels.size());
+  SmallClient full(8u << 20);
+  ASSERT_EQ(full.play(r.stream), Status::ok);
+  EXPECT_EQ(full.crcs, want);
+  ASSERT_TRUE(full.mesh.complete());
+  EXPECT_EQ(full.cap.vertices, r.mesh_header.vertices + r.tail_counts.dummy_vertices);
+  EXPECT_EQ(full.cap.triangles, r.mesh_header.triangles + r.tail_counts.dummy_triangles);
+  for (size_t less : {size_t{1}, size_t{64}, size_t{2048}}) {
+    SmallClient part(full.cap.bytes - less);
+    ASSERT_EQ(part.play(r.stream), Status::ok) << less;
+    EXPECT_LE(part.model_arena.high_water(), full.cap.bytes - less);
+    EXPECT_TRUE(part.mesh.capacity_reached()) << less;
+    EXPECT_EQ(part.mesh.levels_done(), r.levels.size() - 2) << less;
+    EXPECT_EQ(part.crcs, std::vector<uint32_t>(want.begin(), want.end() - 1)) << less;
+  }
+}
+
 // The golden mesh, and the same mesh turned so that its +y is the grid's
 // +z (grid (x, y, z) -> (x, K - z, y), exact in integers), each in a
 // MeshState of its own.

@@ -33,9 +33,12 @@ namespace chunk {
 constexpr uint32_t kMeshHeader = fourcc('M', 'S', 'H', 'H');  // mesh codec parameters, once, before MSHB
 constexpr uint32_t kMeshBase = fourcc('M', 'S', 'H', 'B');    // base mesh (one or more chunks)
 constexpr uint32_t kMeshLevel = fourcc('M', 'S', 'H', 'L');   // one refinement level (one or more chunks)
+constexpr uint32_t kMeshTail = fourcc('M', 'S', 'H', 'T');    // the single-rate last level (one or more chunks)
 }  // namespace chunk
 
 constexpr uint8_t kMeshCodecVersion = 1;
+// MSHH version of a stream whose last level is a single-rate tail (MSHT).
+constexpr uint8_t kMeshCodecVersionTail = 2;
 // Largest vertex degree (ring size) the decoder handles; the stream's
 // MSHH declares its own maximum and is refused above this.
 constexpr uint32_t kMeshMaxDegree = VDS_CONFIG_MESH_MAX_DEGREE;
@@ -66,7 +69,10 @@ enum class MeshUp : uint8_t { y_plus = 0, z_plus = 1, x_plus = 2, y_minus = 3, z
 
 // MSHH payload (docs/stream-format.md).
 struct MeshHeader {
+  // kMeshCodecVersion, or kMeshCodecVersionTail when the last of `levels`
+  // is a single-rate tail (MSHT chunks) instead of vertex splits.
   uint8_t version = kMeshCodecVersion;
+  constexpr bool tail() const { return version == kMeshCodecVersionTail; }
   MeshCoder coder = MeshCoder::arith;
   MeshPredictor predictor = MeshPredictor::parallelogram;
   uint8_t bits = 10;        // quantisation bits per axis, 2..16
@@ -81,14 +87,22 @@ struct MeshHeader {
   uint32_t origin_f32[3] = {0, 0, 0};
   uint32_t step_f32 = 0;
   MeshUp up = MeshUp::y_plus;  // the view block, present when not +y
+  // Version 2, the tail block: what the tail needs beyond `vertices` and
+  // `triangles` (one dummy vertex per hole and its fan of triangles) and
+  // the most border edges its traversal keeps at once.
+  uint32_t tail_dummy_vertices = 0;
+  uint32_t tail_dummy_triangles = 0;
+  uint32_t tail_max_border = 0;
 };
 constexpr uint32_t kMeshHeaderBytes = 40;      // without the view block
 constexpr uint32_t kMeshHeaderViewBytes = 44;  // with it: up axis, three zero bytes
-// Bytes mesh_header_to_bytes writes for `h`: 40, or 44 when up is not +y.
+constexpr uint32_t kMeshHeaderTailBytes = 56;  // version 2: the view block, then the tail block
+// Bytes mesh_header_to_bytes writes for `h`: 40, or 44 when up is not +y;
+// 56 for version 2.
 constexpr uint32_t mesh_header_size(const MeshHeader& h) {
-  return h.up == MeshUp::y_plus ? kMeshHeaderBytes : kMeshHeaderViewBytes;
+  return h.tail() ? kMeshHeaderTailBytes : (h.up == MeshUp::y_plus ? kMeshHeaderBytes : kMeshHeaderViewBytes);
 }
-void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderViewBytes]);
+void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderTailBytes]);
 Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out);
 
 // LEB128 unsigned varints as used in the mesh chunk headers (at most 5
@@ -230,6 +244,7 @@ class MeshState {
   uint32_t max_degree_seen() const { return max_degree_seen_; }
 
  private:
+  friend class MeshTail;
   // ring()'s walk for tables of the given entry types (mesh_state.cpp).
   template <typename VertexIndex, typename CornerIndex>
   static uint32_t walk_ring(const VertexIndex* cv, const CornerIndex* opp, uint32_t x, uint32_t c0,
@@ -258,6 +273,173 @@ class MeshState {
   uint32_t* ring_vertex_[2] = {nullptr, nullptr};
   uint32_t* ring_corner_[2] = {nullptr, nullptr};
 };
+
+// --- Single-rate tail (docs/mesh-codec.md, "The single-rate tail") -------------
+//
+// The last level of a version-2 stream is not a set of vertex splits but
+// the whole mesh again, coded single-rate: an Edgebreaker traversal
+// (Rossignac 1999) builds the corner table one triangle at a time, then the
+// positions follow in the order the traversal created the vertices, each
+// predicted from the parallelograms across its already decoded neighbours.
+// Holes are closed for the traversal by one dummy vertex each, fanned to the
+// hole's border; dummy vertices and triangles live above the real ones
+// (indices vertices .. and triangles ..) and are dropped once the
+// connectivity is complete, so the real ones end up contiguous.
+//
+// Each triangle after the first of a component is attached to the current
+// gate, a border edge of what is built so far, and says where its third
+// vertex (the tip) is: a new vertex (C), the border vertex before the gate
+// (L), the one after it (R), both (E: the border loop closes), or another
+// vertex of the border loop, given as a direction and a count of border
+// edges (S: the loop splits in two, one half waits on a stack), or a
+// vertex of a loop waiting on the stack, given as its depth there and a
+// count of border edges (M: a handle; the two loops merge into one).
+struct TailCounts {
+  uint32_t vertices = 0, triangles = 0;              // real, = MSHH's
+  uint32_t dummy_vertices = 0, dummy_triangles = 0;  // closing the holes
+  uint32_t max_border = 0;                           // most border edges at once, every loop counted
+};
+enum class TailSymbol : uint8_t { C = 0, L = 1, R = 2, E = 3, S = 4, M = 5 };
+
+// Arithmetic-coder contexts of the tail, one flat array (as MeshContexts;
+// carved and reset when the tail starts). Groups:
+//   left      the tip is the border vertex before the gate: by both gate fans
+//   right     ... after the gate: by the fan after it and whether `left` held
+//   fresh     neither: a new vertex (C) rather than a split (S), by the fans' sum
+//   dummy     a new vertex is a dummy: seed vertices, C vertices
+//   direction, offset   where an S vertex lies on the border
+//   merge, depth        the tip lies on a waiting loop (M), and which
+//   geo_zero, geo_mag   position corrections by axis and prediction context
+struct TailContexts {
+  static constexpr uint32_t kFanClasses = 9;  // conquered triangles around a gate vertex, 0..8+
+  static constexpr uint32_t kOffsetBins = 12;
+  static constexpr uint32_t kGeoScales = 6;  // log2 classes 0..5 (mesh_tail_log_class)
+  // Position contexts: no parallelogram; one, by the length of its edge;
+  // two or more, by how far apart they land (mesh_tail_predict).
+  static constexpr uint32_t kGeoClasses = 1 + 2 * kGeoScales;
+  static constexpr uint32_t kGeoBins = 12;
+  static constexpr uint32_t kLeft = 0;
+  static constexpr uint32_t kRight = kLeft + kFanClasses * kFanClasses;
+  static constexpr uint32_t kFresh = kRight + kFanClasses * 2;
+  static constexpr uint32_t kDummy = kFresh + kFanClasses;
+  static constexpr uint32_t kDirection = kDummy + 2;
+  static constexpr uint32_t kOffset = kDirection + 1;
+  static constexpr uint32_t kMerge = kOffset + kOffsetBins;
+  static constexpr uint32_t kDepth = kMerge + 1;
+  static constexpr uint32_t kGeoZero = kDepth + kOffsetBins;
+  static constexpr uint32_t kGeoMag = kGeoZero + 3 * kGeoClasses;
+  static constexpr uint32_t kCount = kGeoMag + 3 * kGeoClasses * kGeoBins;
+
+  static constexpr uint32_t left(uint32_t fx, uint32_t fy) { return kLeft + fx * kFanClasses + fy; }
+  static constexpr uint32_t right(uint32_t fy, bool l) { return kRight + fy * 2 + (l ? 1 : 0); }
+  static constexpr uint32_t fresh(uint32_t fx, uint32_t fy) {
+    return kFresh + (fx + fy < kFanClasses - 1 ? fx + fy : kFanClasses - 1);
+  }
+  static constexpr uint32_t geo_zero(uint32_t axis, uint32_t cls) { return kGeoZero + axis * kGeoClasses + cls; }
+  static constexpr uint32_t geo_mag(uint32_t axis, uint32_t cls) {
+    return kGeoMag + (axis * kGeoClasses + cls) * kGeoBins;
+  }
+
+  ArithContext c[kCount];
+  void reset();
+};
+constexpr uint32_t kTailOffsetCutoff = 8;
+constexpr int kTailOffsetEgK = 1;
+constexpr uint32_t kTailGeoCutoff = 12;
+constexpr int kTailGeoEgK = 1;
+
+// Builds the tail's connectivity into a MeshState (decoder and encoder).
+// The border loops are kept as linked lists of border edges (a pool of
+// max_border nodes): where loops touch, a vertex's built triangles fall
+// apart into several fans, and turning around it cannot tell which loop an
+// open edge belongs to.
+class MeshTail {
+ public:
+  // Bytes begin() carves for max_border border edges, alignment included.
+  static size_t workspace_bytes(uint32_t max_border) {
+    return 3 * (size_t{max_border} * sizeof(uint32_t) + alignof(uint32_t));
+  }
+  // Forgets m's mesh and prepares to build one of n's size: malformed if
+  // it would not fit m's capacity, workspace_too_small if `arena` cannot
+  // hold the border. The loop stack uses m's vertex-corner table and the
+  // conquered-triangle counts its position array, until finish().
+  Status begin(MeshState& m, Arena& arena, const TailCounts& n);
+  // Triangles built so far (real and dummy).
+  uint32_t built() const { return built_; }
+  uint32_t total() const { return n_.triangles + n_.dummy_triangles; }
+  // The next triangle starts a new component (three new vertices).
+  bool needs_seed() const { return gate_ == kMeshNone; }
+  // For the next attached triangle: triangles built so far around the
+  // gate's first and second vertex (capped at TailContexts::kFanClasses - 1).
+  uint32_t fan_before() const { return fan_x_; }
+  uint32_t fan_after() const { return fan_y_; }
+  Status seed(const bool dummy[3]);
+  // `dummy`: the C vertex is a dummy; `backward`, `offset`: the S vertex is
+  // `offset` (>= 2) border edges before the gate (backward) or after it;
+  // `depth`, `offset`: the M vertex is reached `offset` (>= 1) border edges
+  // after the edge waiting `depth` entries below the top of the stack.
+  Status attach(TailSymbol s, bool dummy, bool backward, uint32_t offset, uint32_t depth = 0);
+  // For the encoder: the waiting loops (entry 0 is the top of the stack).
+  uint32_t waiting() const { return depth_; }
+  uint32_t waiting_edge(uint32_t depth) const { return m_->vertex_corner_.get(depth_ - 1 - depth); }
+  // The corner a border edge faces.
+  uint32_t edge_corner(uint32_t e) const { return corner_[e]; }
+  // After total() triangles: checks the mesh is closed, drops the dummies,
+  // sets every vertex's corner; malformed if anything is left open.
+  Status finish();
+  // Most border edges alive at once so far (what an encoder declares).
+  uint32_t border_peak() const { return peak_; }
+
+  // For the encoder, before attach(): the gate corner, the border vertices
+  // before and after it, and the border walk attach() makes for S: the
+  // first border edge before (backward) or after the gate, the next one,
+  // and the vertex that edge reaches going that way.
+  uint32_t gate() const { return gate_ == kMeshNone ? kMeshNone : corner_[gate_]; }
+  uint32_t vertex_before() const { return x_; }
+  uint32_t vertex_after() const { return y_; }
+  uint32_t border_first(bool backward) const { return backward ? prev_[gate_] : next_[gate_]; }
+  uint32_t border_next(uint32_t e, bool backward) const { return backward ? prev_[e] : next_[e]; }
+  uint32_t border_reach(uint32_t e, bool backward) const {
+    return m_->corner_vertex(backward ? MeshState::next(corner_[e]) : MeshState::prev(corner_[e]));
+  }
+  // The vertex and triangle indices the next new ones get.
+  uint32_t next_vertex(bool dummy) const { return dummy ? n_.vertices + dummy_v_ : real_v_; }
+  uint32_t next_triangle(bool dummy) const { return dummy ? n_.triangles + dummy_t_ : real_t_; }
+
+ private:
+  Status new_triangle(uint32_t a, uint32_t b, uint32_t c, uint32_t* t);
+  Status new_vertex(bool dummy, uint32_t* v);
+  uint32_t new_edge(uint32_t corner);  // kMeshNone when the pool is empty
+  void free_edge(uint32_t e);
+  void join(uint32_t a, uint32_t b) {  // b follows a
+    next_[a] = b;
+    prev_[b] = a;
+  }
+  void prepare();  // x_, y_ and the fan counts of the current gate
+  bool push(uint32_t e);
+  bool pop(uint32_t* e);
+
+  MeshState* m_ = nullptr;
+  TailCounts n_{};
+  uint32_t* corner_ = nullptr;  // border edge -> the corner facing it
+  uint32_t* next_ = nullptr;    // along its loop (the built side on the left)
+  uint32_t* prev_ = nullptr;
+  uint32_t free_ = kMeshNone, live_ = 0, peak_ = 0;
+  uint32_t built_ = 0, real_v_ = 0, dummy_v_ = 0, real_t_ = 0, dummy_t_ = 0;
+  uint32_t gate_ = kMeshNone;  // border edge
+  uint32_t x_ = kMeshNone, y_ = kMeshNone;
+  uint32_t fan_x_ = 0, fan_y_ = 0;
+  uint32_t depth_ = 0;  // stack entries
+};
+
+// Predicted position of tail vertex v from its neighbours below v: the
+// mean of the parallelograms across its fan's far edges whose three
+// vertices are below v, else the mean of those neighbours, else vertex
+// v - 1 (the grid centre for v = 0). *context is the position context
+// (TailContexts::kGeoClasses). malformed if v's fan cannot be walked.
+Status mesh_tail_predict(MeshState& m, uint32_t v, int32_t out[3], uint32_t* context);
+// 0 for x < 2, then one class per octave up to kGeoScales - 1.
+uint32_t mesh_tail_log_class(int64_t x);
 
 // --- Split ranking (docs/mesh-codec.md, "Split ranking") ------------------------
 // Smaller score = likelier. Positions are x, y, z per vertex; `r` needs only
@@ -359,8 +541,11 @@ class MeshDecoder {
   // budgets) whose base mesh has up to max_base_triangles (scratch used once
   // to connect the base) with the given coder (Huffman adds its tables).
   // An encoder writes this into HEAD.workspace_bytes.
+  // A version-2 stream adds its TailContexts and the tail's border of
+  // `tail_border` edges (its MSHT max_border); its max_vertices and
+  // max_triangles include the tail's dummies (HEAD's budgets).
   static size_t workspace_bytes(uint32_t max_vertices, uint32_t max_triangles, uint32_t max_base_triangles,
-                                MeshCoder coder);
+                                MeshCoder coder, uint32_t tail_border = 0);
 
   // Carves the mesh, the contexts and the split flags from `arena` for a
   // mesh of up to max_vertices / max_triangles (the stream's full counts, or
@@ -371,10 +556,11 @@ class MeshDecoder {
 
   // True for the chunk types this decoder consumes.
   static bool handles(uint32_t type) {
-    return type == chunk::kMeshHeader || type == chunk::kMeshBase || type == chunk::kMeshLevel;
+    return type == chunk::kMeshHeader || type == chunk::kMeshBase || type == chunk::kMeshLevel ||
+           type == chunk::kMeshTail;
   }
   // Consumes one verified chunk payload (MSHH, then MSHB chunks, then MSHL
-  // chunks level by level). The first error is latched and returned again.
+  // chunks level by level, then for version 2 the MSHT chunks). The first error is latched and returned again.
   Status consume(uint32_t type, const uint8_t* payload, uint32_t size);
   // ok once every level of the header is in, or once the workspace is full
   // (capacity_reached()); truncated before that.
@@ -416,6 +602,15 @@ class MeshDecoder {
   Status on_header(const uint8_t* p, uint32_t size);
   Status on_base(const uint8_t* p, uint32_t size);
   Status on_level(const uint8_t* p, uint32_t size);
+  Status on_tail(const uint8_t* p, uint32_t size);
+  Status tail_items(const uint8_t* conn, uint32_t conn_size, const uint8_t* geom, uint32_t geom_size,
+                    uint32_t first, uint32_t count);
+  void progress_tick() {
+    if (progress_ != nullptr && ++progress_count_ >= progress_every_) {
+      progress_count_ = 0;
+      progress_(progress_user_);
+    }
+  }
   Status base_items(const uint8_t* data, uint32_t size, uint32_t first, uint32_t count);
   Status level_items(const uint8_t* conn, uint32_t conn_size, const uint8_t* geom, uint32_t geom_size,
                      uint32_t first, uint32_t count);
@@ -429,6 +624,9 @@ class MeshDecoder {
   Arena* arena_ = nullptr;
   MeshState mesh_;
   MeshContexts* ctx_ = nullptr;
+  TailContexts* tctx_ = nullptr;  // carved when the tail starts
+  MeshTail tail_;
+  bool in_tail_ = false;
   uint8_t* marks_ = nullptr;    // one bit per vertex: split vertices of the current level
   uint8_t* lengths_ = nullptr;  // code lengths while a Huffman table is read
   HuffmanTable huff_delta_, huff_shape_, huff_pos_, huff_geo_;

@@ -84,7 +84,9 @@ struct ModelCapacity {
 // header is `h`: MeshDecoder::init, its Huffman tables and base scratch, and
 // ModelView::init, all for `vertices` and `triangles` = base triangles plus
 // two per vertex above the base (no split adds more), at most the stream's
-// counts and 65,535 vertices (the view's limit). workspace_too_small when not
+// counts and 65,535 vertices (the view's limit). For a version-2 stream the
+// whole tail when it fits (the counts with its dummies, its contexts and
+// border), else the split levels that fit. workspace_too_small when not
 // even the base fits (then `out->bytes` is what the base needs),
 // unsupported_feature for a base above the view's limit, invalid_argument for
 // a bad configuration.

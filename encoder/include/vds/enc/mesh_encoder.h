@@ -18,6 +18,11 @@
 
 namespace vds::enc {
 
+// `vds encode-mesh`'s tail_fraction: split levels up to 4 % of the
+// vertices (the bunny's first 20 levels, 1,292 vertices in 4.8 KB), then
+// the single-rate tail.
+constexpr double kMeshDefaultTail = 0.04;
+
 struct MeshEncodeOptions {
   MeshEncodeOptions() {
     simplify.rate_weight = 4.0;
@@ -32,6 +37,15 @@ struct MeshEncodeOptions {
   uint32_t max_chunk_payload = 4096;  // >= 512
   uint16_t width = 240, height = 180;  // HEAD frame size (the client's display)
   MeshUp up = MeshUp::y_plus;          // the axis a viewer shows up (MSHH's view block)
+  // The single-rate tail (docs/mesh-codec.md): after the vertex-split
+  // levels that reach at most tail_fraction of the vertices (but at least
+  // tail_min_levels of them, when there are that many), the whole mesh is
+  // sent once more single-rate, which costs far less than the remaining
+  // splits. 0 turns it off; meshes it cannot take (a component with a
+  // handle, a vertex ring above kMeshMaxDegree) are coded without it, and
+  // MeshEncodeResult::tail_note says why. Arithmetic coder only.
+  double tail_fraction = 0;
+  uint32_t tail_min_levels = 11;
 };
 
 // The paper's choices: Huffman coding, the Laplacian predictor of eq. 13
@@ -68,6 +82,7 @@ struct MeshLevelStats {
   int weight_q4 = 0;                // parallelogram weight used
   uint64_t checksum = 0;            // mesh_checksum of the client's mesh after the level (encoder only)
   double error_threshold = 0;       // simplification threshold in force (grid units)
+  bool tail = false;                // the single-rate tail (the last level; dV, dT net)
 };
 
 // Where the entropy-coded bits go: the arithmetic coder's estimate from its
@@ -80,6 +95,8 @@ struct MeshBitBreakdown {
   double split_rotation = 0;  // which rotation of the arc (rank; the paper's F position)
   double geometry = 0;        // position corrections, all axes
   double geometry_normal = 0; // of which along the axis nearest the ring normal (arithmetic coder only)
+  double tail_connectivity = 0;  // the single-rate tail: its traversal
+  double tail_geometry = 0;      // and its positions
   double connectivity() const { return split_flags + split_shape + split_rotation; }
 };
 
@@ -95,6 +112,9 @@ struct MeshEncodeResult {
   int max_degree = 0;
   double error_limit = 0;  // E in grid units
   MeshBitBreakdown bits;
+  bool tail = false;       // the last level is the single-rate tail
+  TailCounts tail_counts;  // its MSHT counts (holes closed, border edges at most)
+  std::string tail_note;   // why a requested tail was not used
 };
 
 // Encodes a repaired mesh (import_mesh / repair_mesh; check_manifold must
