@@ -59,9 +59,11 @@ for coding in default splits paper; do
   cat "$dir/names.txt" >>"$ROWS"
   grep '^m4 stream=' "$dir/m4.txt" | sed "s/^/$coding /" >>"$WORK/summary.txt"
   grep '^m4 view stream=' "$dir/m4.txt" | sed "s/^/$coding /" >>"$WORK/view.txt"
+  { grep '^m4 tail stream=' "$dir/m4.txt" || true; } | sed "s/^/$coding /" >>"$WORK/tail.txt"
 done
 
-/usr/bin/python3 - "$ROWS" "$WORK/summary.txt" "$OUT" "$(qemu-system-arm --version | head -n 1)" "$WORK/view.txt" <<'PY'
+touch "$WORK/tail.txt"
+/usr/bin/python3 - "$ROWS" "$WORK/summary.txt" "$OUT" "$(qemu-system-arm --version | head -n 1)" "$WORK/view.txt" "$WORK/tail.txt" <<'PY'
 import re, sys, datetime
 rows = [l.split() for l in open(sys.argv[1])]
 summ = {}
@@ -69,6 +71,10 @@ for l in open(sys.argv[2]):
     coding = l.split()[0]
     kv = dict(re.findall(r"(\w+)=(\S+)", l))
     summ[(coding, kv["stream"])] = kv
+for l in open(sys.argv[6]):
+    coding = l.split()[0]
+    kv = dict(re.findall(r"(\w+)=(\S+)", l))
+    summ[(coding, kv["stream"])].update(kv)
 view = {}
 for l in open(sys.argv[5]):
     coding = l.split()[0]
@@ -95,7 +101,7 @@ for name, model, bits, coding, size in rows:
     ws = int(kv["workspace"])
     tail = int(kv.get("tail_instructions", 0))
     # Vertices the split levels add: up to the tail's level, or all of them.
-    splits = int(kv["tail_split_vertices"]) if "tail_split_vertices" in kv else int(kv["splits"])
+    splits = int(kv["split_vertices"]) if "split_vertices" in kv else int(kv["splits"])
     per = (ins - base - tail) / splits if splits else 0
     tail_cols = f"{tail:,} | {tail / v:,.0f}" if tail else "- | -"
     L.append(f"| {model} | {bits} | {names[coding]} | {int(size):,} | {v:,} | "

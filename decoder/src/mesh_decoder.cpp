@@ -256,8 +256,19 @@ Status MeshDecoder::on_base(const uint8_t* p, uint32_t size) {
     last_ = MeshLevelInfo{};
     last_.vertices_added = header_.base_vertices;
     last_.triangles_added = header_.base_triangles;
+    check_tail_fits();
   }
   return Status::ok;
+}
+
+void MeshDecoder::check_tail_fits() {
+  if (!header_.tail() || levels_done_ + 1 != header_.levels) return;
+  // Next comes the tail: MSHH says what it needs, so a client that cannot
+  // hold it stops now rather than after the tail's first chunk.
+  const size_t extra = sizeof(TailContexts) + alignof(TailContexts) + MeshTail::workspace_bytes(header_.tail_max_border);
+  if (uint64_t{header_.vertices} + header_.tail_dummy_vertices > cap_v_ ||
+      uint64_t{header_.triangles} + header_.tail_dummy_triangles > cap_t_ || arena_->remaining() < extra)
+    full_ = true;
 }
 
 Status MeshDecoder::base_items(const uint8_t* data, uint32_t size, uint32_t first, uint32_t count) {
@@ -403,6 +414,7 @@ Status MeshDecoder::on_level(const uint8_t* p, uint32_t size) {
     if (levels_done_ == header_.levels &&
         (mesh_.vertex_count() != header_.vertices || mesh_.triangle_count() != header_.triangles))
       return fail(Status::malformed);
+    check_tail_fits();
   }
   return Status::ok;
 }

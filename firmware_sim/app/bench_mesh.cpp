@@ -182,13 +182,15 @@ bool run_file(const char* path, int* failures) {
   l.str("m4 stream=").str(base).str(" status=").str(vds::status_name(s)).str(" vertices=").dec(m.vertex_count());
   l.str(" splits=").dec(splits).str(" levels=").dec(g_run.levels).str(" instructions=").dec(g_run.instructions);
   l.str(" base_instructions=").dec(g_run.base_instructions);
-  // A version-2 stream's last level is the single-rate tail: its own count.
-  if (g_run.decoder.have_header() && g_run.decoder.header().tail() && g_run.decoder.complete()) {
-    l.str(" tail_instructions=").dec(g_run.last_level_instructions);
-    l.str(" tail_split_vertices=").dec(g_run.tail_from_vertices - g_run.base_vertices);
-  }
   l.str(" workspace=").dec(g_arena.high_water() - g_run.view_bytes).str("\n");
   board::log(l.c_str());
+  // A version-2 stream's last level is the single-rate tail: its own count.
+  if (g_run.decoder.have_header() && g_run.decoder.header().tail() && g_run.decoder.complete()) {
+    Line t;
+    t.str("m4 tail stream=").str(base).str(" tail_instructions=").dec(g_run.last_level_instructions);
+    t.str(" split_vertices=").dec(g_run.tail_from_vertices - g_run.base_vertices).str("\n");
+    board::log(t.c_str());
+  }
   Line v;
   v.str("m4 view stream=").str(base).str(" triangles=").dec(m.triangle_count()).str(" view_workspace=").dec(g_run.view_bytes);
   v.str(" frames=").dec(g_run.shown.drawn);

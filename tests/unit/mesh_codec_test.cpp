@@ -71,6 +71,7 @@ struct Client {
   Status init_status = Status::ok;
   uint32_t limit_vertices = 0;  // if set, the decoder gets this capacity instead of HEAD's
   uint32_t limit_triangles = 0;
+  int full_at_tail = -1;  // capacity_reached() when the first tail chunk arrived (-1: none arrived)
 
   explicit Client(size_t bytes = 8u << 20) : workspace(bytes) {
     arena = vds::Arena(workspace.data(), workspace.size());
@@ -85,6 +86,7 @@ struct Client {
     sink.on_chunk = [](void* ctx, uint32_t type, const uint8_t* payload, uint32_t size) {
       auto* c = static_cast<Client*>(ctx);
       if (!MeshDecoder::handles(type)) return ChunkResult::unknown;
+      if (type == vds::chunk::kMeshTail && c->full_at_tail < 0) c->full_at_tail = c->decoder.capacity_reached();
       const uint32_t before = c->decoder.levels_done();
       const bool had_base = c->decoder.drawable();
       if (c->decoder.consume(type, payload, size) != Status::ok) return ChunkResult::abort;
@@ -769,6 +771,7 @@ TEST(MeshTail, ASmallClientStopsAtTheTail) {
   Client full;
   ASSERT_EQ(full.feed(s, s.size()), Status::ok);
   ASSERT_TRUE(full.decoder.complete());
+  EXPECT_EQ(full.full_at_tail, 0);
   const vds::MeshHeader& h = full.decoder.header();
   ASSERT_TRUE(h.tail());
   for (uint32_t extra : {0u, 1u}) {
@@ -778,6 +781,9 @@ TEST(MeshTail, ASmallClientStopsAtTheTail) {
     EXPECT_EQ(k.decoder.finish(), Status::ok);
     EXPECT_EQ(k.decoder.levels_done(), h.levels - 1u);
     EXPECT_TRUE(k.decoder.capacity_reached());
+    // Known from MSHH as soon as the last split level is in, before any
+    // tail chunk: a client reports its workspace full a chunk earlier.
+    EXPECT_EQ(k.full_at_tail, 1);
     ASSERT_EQ(k.checksums.size(), h.levels + 0u);
     for (size_t i = 0; i < k.checksums.size(); ++i) EXPECT_EQ(k.checksums[i], full.checksums[i]) << i;
   }

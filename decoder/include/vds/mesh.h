@@ -574,8 +574,10 @@ class MeshDecoder {
   // Complete levels applied after the base.
   uint32_t levels_done() const { return levels_done_; }
   bool complete() const { return base_done_ && levels_done_ == header_.levels; }
-  // A level did not fit init's counts: the mesh stays at levels_done() and
-  // every later level chunk is skipped unread. Only the base has to fit
+  // A level did not fit init's counts (for a version-2 stream's tail, as
+  // soon as the level before it is in: MSHH says what the tail needs, its
+  // dummies, contexts and border included): the mesh stays at
+  // levels_done() and every later level chunk is skipped unread. Only the base has to fit
   // (workspace_too_small otherwise), so a small client plays a prefix.
   bool capacity_reached() const { return full_; }
   const MeshState& mesh() const { return mesh_; }
@@ -603,6 +605,8 @@ class MeshDecoder {
   Status on_base(const uint8_t* p, uint32_t size);
   Status on_level(const uint8_t* p, uint32_t size);
   Status on_tail(const uint8_t* p, uint32_t size);
+  // Before the tail: capacity_reached() if this client cannot hold it.
+  void check_tail_fits();
   Status tail_items(const uint8_t* conn, uint32_t conn_size, const uint8_t* geom, uint32_t geom_size,
                     uint32_t first, uint32_t count);
   void progress_tick() {
