@@ -58,10 +58,14 @@ for ax, m in zip(axes[0], models):
         d = [r for r in rows if r["model"] == m and int(r["bits"]) == b and r["codec"] == "draco"]
         x = [int(r["bytes"]) / 1024 for r in v]
         c = colors.get(b, None)
-        ax.plot(x, [100 * float(r["hausdorff"]) for r in v], "-o", ms=3, color=c, label=f"vds {b} bits: Hausdorff")
-        ax.plot(x, [100 * float(r["rms"]) for r in v], "--s", ms=3, color=c, label=f"vds {b} bits: RMS")
+        # Steps: what the client shows stays until the next level is in (the
+        # last step of vds is the single-rate tail).
+        ax.plot(x, [100 * float(r["hausdorff"]) for r in v], "-o", ms=3, color=c, drawstyle="steps-post",
+                label=f"vds {b} bits: Hausdorff")
+        ax.plot(x, [100 * float(r["rms"]) for r in v], "--s", ms=3, color=c, drawstyle="steps-post",
+                label=f"vds {b} bits: RMS")
         xs_ = [int(r["bytes"]) / 1024 for r in s]
-        ax.plot(xs_, [100 * float(r["rms"]) for r in s], ":", lw=1, color=c, alpha=0.7,
+        ax.plot(xs_, [100 * float(r["rms"]) for r in s], ":", lw=1, color=c, alpha=0.7, drawstyle="steps-post",
                 label=f"vds splits only {b} bits: RMS")
         for r in d:
             ax.plot([int(r["bytes"]) / 1024], [100 * float(r["hausdorff"])], "*", ms=13, color=c,

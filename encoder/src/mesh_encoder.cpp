@@ -672,7 +672,7 @@ void Encoder::trace_tail(const ClosedMesh& cm, uint32_t level_index, Segment& se
   auto conn = [&](Op o) { seg.conn.push_back(with(kCatTailConn, o)); };
   auto record = [&](uint32_t f) {
     used[f] = 1;
-    // The client numbers the triangle it just built like this.
+    // The index the client gives the triangle it builds next.
     const bool dummy = cm.cv[3 * f] >= nv || cm.cv[3 * f + 1] >= nv || cm.cv[3 * f + 2] >= nv;
     return tail.next_triangle(dummy);
   };

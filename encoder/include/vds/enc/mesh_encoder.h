@@ -19,7 +19,7 @@
 namespace vds::enc {
 
 // `vds encode-mesh`'s tail_fraction: split levels up to 4 % of the
-// vertices (the bunny's first 20 levels, 1,292 vertices in 4.8 KB), then
+// vertices (the bunny's base and 19 levels, 1,292 vertices in 4.8 KB), then
 // the single-rate tail.
 constexpr double kMeshDefaultTail = 0.04;
 
