@@ -34,6 +34,10 @@ def level_table(info_stdout):
     return rows
 
 
+def skipped_levels(n):
+    return "the level" if n == 1 else f"the {n} levels"
+
+
 def cortex_m4_prefix(a, stream, want):
     """The stream on the Cortex-M4 board with its own workspace: the frames
     of the levels it holds, each equal to the replay's. Returns failures."""
@@ -61,7 +65,7 @@ def cortex_m4_prefix(a, stream, want):
               f"{'yes' if not failures else 'NO'}. "
               + (f"It then reported its workspace full after the first {full['bytes']:,} bytes and the host "
                  f"stopped the stream: {full['acked']:,} of its {full['stream']:,} bytes had been delivered when it "
-                 f"closed, so the {prefix['levels'] - prefix['level']} levels the client could not hold cost the "
+                 f"closed, so {skipped_levels(prefix['levels'] - prefix['level'])} the client could not hold cost the "
                  f"line only the {full['acked'] - full['bytes']:,} bytes already in flight "
                  if full else "It did not report its workspace full ")
               + "(log: `out/demo/model/serve_cortex_m4.log`).\n")

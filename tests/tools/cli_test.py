@@ -99,5 +99,13 @@ check(code == 0 and "up +z" in out, "info shows the stored up axis")
 code, out, err = run("encode-mesh", obj, "-o", model + ".bad", "--up", "w")
 check(code == 2 and "--up must be" in err and not os.path.exists(model + ".bad"), "a bad --up is refused, nothing written")
 
+# The single-rate tail: with the paper's coding it is a usage error that
+# writes nothing; --tail 0 splits all the way.
+code, out, err = run("encode-mesh", obj, "-o", model + ".paper", "--paper", "--tail", "0.1")
+check(code == 2 and "--tail needs the arithmetic coder" in err and not os.path.exists(model + ".paper"),
+      "--tail with --paper is refused, nothing written")
+code, out, err = run("encode-mesh", obj, "-o", model + ".splits", "--tail", "0")
+check(code == 0 and "single-rate tail" not in out, "--tail 0 splits all the way")
+
 print(f"{len(failures)} failed" if failures else "all CLI checks passed")
 sys.exit(1 if failures else 0)

@@ -542,7 +542,7 @@ class MeshDecoder {
   // to connect the base) with the given coder (Huffman adds its tables).
   // An encoder writes this into HEAD.workspace_bytes.
   // A version-2 stream adds its TailContexts and the tail's border of
-  // `tail_border` edges (its MSHT max_border); its max_vertices and
+  // `tail_border` edges (MSHH's tail_max_border); its max_vertices and
   // max_triangles include the tail's dummies (HEAD's budgets).
   static size_t workspace_bytes(uint32_t max_vertices, uint32_t max_triangles, uint32_t max_base_triangles,
                                 MeshCoder coder, uint32_t tail_border = 0);
