@@ -200,6 +200,12 @@ int main(int argc, char** argv) {
       row.vertices = mesh.positions.size();
       row.triangles = mesh.triangles.size();
       row.diag = diag;
+      // One line of mesh_rd.csv: a decoded mesh, its bytes and its distances.
+      auto csv_row = [&](const char* codec, long level, const Mesh& m, uint64_t bytes, const SurfaceDistance& d) {
+        csv += fmt("%s,%d,%s,%ld,%zu,%zu,%llu,%.9g,%.9g,%.9g\n", name.c_str(), bits, codec, level, m.positions.size(),
+                   m.triangles.size(), static_cast<unsigned long long>(bytes), d.hausdorff / diag, d.rms / diag,
+                   d.mean / diag);
+      };
       // Draco, the real command line tool, on the same welded mesh.
       const std::string drc = tmp + "/" + name + "_" + bs + ".drc";
       const std::string cmd = draco_encoder + " -i '" + ply + "' -o '" + drc + "' -qp " + bs + " -cl 10 > /dev/null";
@@ -225,9 +231,7 @@ int main(int argc, char** argv) {
         }
         row.draco_decode_ms = fastest(t);
       }
-      csv += fmt("%s,%d,draco,-1,%zu,%zu,%zu,%.9g,%.9g,%.9g\n", name.c_str(), bits, draco_mesh.positions.size(),
-                 draco_mesh.triangles.size(), row.draco, row.draco_dist.hausdorff / diag, row.draco_dist.rms / diag,
-                 row.draco_dist.mean / diag);
+      csv_row("draco", -1, draco_mesh, row.draco, row.draco_dist);
 
       // vds as `vds encode-mesh` writes it (split levels, then the
       // single-rate tail), vds splits only, and the paper's coding.
@@ -278,9 +282,7 @@ int main(int argc, char** argv) {
         for (size_t l = 0; l < cs.levels.size(); ++l) {
           const auto& [bytes, m] = cs.levels[l];
           const SurfaceDistance d = surface_distance(mesh, m, samples);
-          csv += fmt("%s,%d,vds-splits,%zu,%zu,%zu,%llu,%.9g,%.9g,%.9g\n", name.c_str(), bits, l, m.positions.size(),
-                     m.triangles.size(), static_cast<unsigned long long>(bytes), d.hausdorff / diag, d.rms / diag,
-                     d.mean / diag);
+          csv_row("vds-splits", static_cast<long>(l), m, bytes, d);
         }
       }
       md_rd += fmt("### %s, %d bits\n\n| level | vertices | bytes | seconds at 2 KB/s | Hausdorff (%% diag) | RMS (%% diag) |\n"
@@ -297,9 +299,7 @@ int main(int argc, char** argv) {
         md_rd += fmt("| %zu | %zu | %llu | %.2f | %.4f | %.4f |\n", l, m.positions.size(),
                      static_cast<unsigned long long>(bytes), bytes / 2048.0, 100 * d.hausdorff / diag,
                      100 * d.rms / diag);
-        csv += fmt("%s,%d,vds,%zu,%zu,%zu,%llu,%.9g,%.9g,%.9g\n", name.c_str(), bits, l, m.positions.size(),
-                   m.triangles.size(), static_cast<unsigned long long>(bytes), d.hausdorff / diag, d.rms / diag,
-                   d.mean / diag);
+        csv_row("vds", static_cast<long>(l), m, bytes, d);
       }
       md_rd += fmt("| Draco | %zu | %zu | %.2f | %.4f | %.4f |\n\n", draco_mesh.positions.size(), row.draco,
                    row.draco / 2048.0, 100 * row.draco_dist.hausdorff / diag, 100 * row.draco_dist.rms / diag);

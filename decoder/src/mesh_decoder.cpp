@@ -151,7 +151,7 @@ size_t MeshDecoder::workspace_bytes(uint32_t max_vertices, uint32_t max_triangle
   total += sizeof(MeshContexts) + alignof(MeshContexts);
   total += (uint64_t{max_vertices} + 7) / 8 + 4;
   total += uint64_t{max_base_triangles} * 3 * sizeof(uint32_t) + alignof(uint32_t);
-  if (tail_border > 0) total += sizeof(TailContexts) + alignof(TailContexts) + MeshTail::workspace_bytes(tail_border);
+  if (tail_border > 0) total += tail_workspace_bytes(tail_border);
   if (coder == MeshCoder::huffman) {
     total += kHuffTableMax + 4;
     total += HuffmanTable::workspace_bytes(kHuffDeltaAlphabet) + HuffmanTable::workspace_bytes(kHuffShapeAlphabet) +
@@ -265,9 +265,9 @@ void MeshDecoder::check_tail_fits() {
   if (!header_.tail() || levels_done_ + 1 != header_.levels) return;
   // Next comes the tail: MSHH says what it needs, so a client that cannot
   // hold it stops now rather than after the tail's first chunk.
-  const size_t extra = sizeof(TailContexts) + alignof(TailContexts) + MeshTail::workspace_bytes(header_.tail_max_border);
   if (uint64_t{header_.vertices} + header_.tail_dummy_vertices > cap_v_ ||
-      uint64_t{header_.triangles} + header_.tail_dummy_triangles > cap_t_ || arena_->remaining() < extra)
+      uint64_t{header_.triangles} + header_.tail_dummy_triangles > cap_t_ ||
+      arena_->remaining() < tail_workspace_bytes(header_.tail_max_border))
     full_ = true;
 }
 
@@ -752,9 +752,9 @@ Status MeshDecoder::tail_items(const uint8_t* conn, uint32_t conn_size, const ui
     }
     const uint32_t v = item - nt;
     int32_t q[3];
-    uint32_t np = 0;
-    if ((s = mesh_tail_predict(mesh_, v, q, &np)) != Status::ok) return s;
-    const uint32_t cls = np;
+    uint32_t context = 0;
+    if ((s = mesh_tail_predict(mesh_, v, q, &context)) != Status::ok) return s;
+    const uint32_t cls = context;  // a copy the loop keeps in a register: context's address escaped
     for (uint32_t k = 0; k < 3; ++k) {
       const int32_t d = ag.decode_signed(c[TC::geo_zero(k, cls)], c + TC::geo_mag(k, cls), TC::kGeoBins,
                                          kTailGeoCutoff, kTailGeoEgK);

@@ -224,13 +224,18 @@ uint32_t triangles_for(const MeshHeader& h, uint32_t v) {
   return t < h.triangles ? static_cast<uint32_t>(t) : h.triangles;
 }
 
-// Decoder and view bytes for v vertices; SIZE_MAX if they cannot be had.
-size_t model_bytes(const MeshHeader& h, const ModelViewConfig& cfg, uint32_t v) {
-  const uint32_t t = triangles_for(h, v);
-  const size_t dec = MeshDecoder::workspace_bytes(v, t, h.base_triangles, h.coder);
+// Decoder and view bytes for v vertices and t triangles (and a tail's
+// border of that many edges); SIZE_MAX if they cannot be had.
+size_t client_bytes(const MeshHeader& h, const ModelViewConfig& cfg, uint32_t v, uint32_t t, uint32_t tail_border) {
+  const size_t dec = MeshDecoder::workspace_bytes(v, t, h.base_triangles, h.coder, tail_border);
   const size_t view = ModelView::workspace_bytes(cfg, v, t);
   if (dec == SIZE_MAX || view == 0 || dec > SIZE_MAX - view) return SIZE_MAX;
   return dec + view;
+}
+
+// The same for the split levels up to v vertices.
+size_t model_bytes(const MeshHeader& h, const ModelViewConfig& cfg, uint32_t v) {
+  return client_bytes(h, cfg, v, triangles_for(h, v), 0);
 }
 
 }  // namespace
@@ -249,19 +254,16 @@ Status plan_model_capacity(const MeshHeader& h, const ModelViewConfig& cfg, size
   }
   // A version-2 stream's tail rebuilds the whole mesh with its hole-closing
   // dummies, its contexts and its border: all of it, or the split levels.
-  if (h.tail()) {
-    const uint64_t tv = uint64_t{h.vertices} + h.tail_dummy_vertices;
-    const uint64_t tt = uint64_t{h.triangles} + h.tail_dummy_triangles;
-    if (tv <= kMaxPositions) {
-      const size_t dec = MeshDecoder::workspace_bytes(static_cast<uint32_t>(tv), static_cast<uint32_t>(tt),
-                                                      h.base_triangles, h.coder, h.tail_max_border);
-      const size_t view = ModelView::workspace_bytes(cfg, static_cast<uint32_t>(tv), static_cast<uint32_t>(tt));
-      if (dec != SIZE_MAX && view != 0 && dec <= SIZE_MAX - view && dec + view <= bytes) {
-        out->vertices = static_cast<uint32_t>(tv);
-        out->triangles = static_cast<uint32_t>(tt);
-        out->bytes = dec + view;
-        return Status::ok;
-      }
+  // (mesh_header_from_bytes bounds both sums far below 2^32.)
+  if (h.tail() && uint64_t{h.vertices} + h.tail_dummy_vertices <= kMaxPositions) {
+    const uint32_t tv = h.vertices + h.tail_dummy_vertices;
+    const uint32_t tt = h.triangles + h.tail_dummy_triangles;
+    const size_t need = client_bytes(h, cfg, tv, tt, h.tail_max_border);
+    if (need <= bytes) {
+      out->vertices = tv;
+      out->triangles = tt;
+      out->bytes = need;
+      return Status::ok;
     }
   }
   // The largest vertex count that fits: the bytes grow with the count.

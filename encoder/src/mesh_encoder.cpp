@@ -251,9 +251,6 @@ struct ClosedMesh {
   uint32_t max_degree = 0;  // largest ring of the real mesh
 };
 
-uint32_t next3(uint32_t c) { return c % 3 == 2 ? c - 2 : c + 1; }
-uint32_t prev3(uint32_t c) { return c % 3 == 0 ? c + 2 : c - 1; }
-
 // "" or why the tail's traversal cannot take the mesh.
 std::string close_mesh(uint32_t nv, const std::vector<std::array<uint32_t, 3>>& tris, ClosedMesh* out) {
   ClosedMesh& m = *out;
@@ -263,14 +260,14 @@ std::string close_mesh(uint32_t nv, const std::vector<std::array<uint32_t, 3>>& 
   std::unordered_map<uint64_t, uint32_t> edge;  // directed edge n(c) -> p(c) of corner c
   auto add_edges = [&](uint32_t from) {
     for (uint32_t c = from; c < m.cv.size(); ++c)
-      if (!edge.emplace(key(m.cv[next3(c)], m.cv[prev3(c)]), c).second) return false;
+      if (!edge.emplace(key(m.cv[MeshState::next(c)], m.cv[MeshState::prev(c)]), c).second) return false;
     return true;
   };
   if (!add_edges(0)) return "an edge used twice in one direction";
   // Border edges a -> b (no b -> a), chained into holes by their start.
   std::unordered_map<uint32_t, uint32_t> border_from;
   for (uint32_t c = 0; c < m.cv.size(); ++c) {
-    const uint32_t a = m.cv[next3(c)], b = m.cv[prev3(c)];
+    const uint32_t a = m.cv[MeshState::next(c)], b = m.cv[MeshState::prev(c)];
     if (edge.count(key(b, a)) == 0 && !border_from.emplace(a, c).second) return "a vertex on two holes";
   }
   std::vector<uint32_t> ring_size(nv, 0);
@@ -289,7 +286,7 @@ std::string close_mesh(uint32_t nv, const std::vector<std::array<uint32_t, 3>>& 
       done[a] = true;
       const auto it = border_from.find(a);
       if (it == border_from.end()) return "a hole that does not close";
-      const uint32_t b = m.cv[prev3(it->second)];
+      const uint32_t b = m.cv[MeshState::prev(it->second)];
       m.cv.insert(m.cv.end(), {b, a, d});
       a = b;
       if (++len > border_from.size()) return "a hole that does not close";
@@ -299,7 +296,7 @@ std::string close_mesh(uint32_t nv, const std::vector<std::array<uint32_t, 3>>& 
   if (!add_edges(3 * m.real_t)) return "a hole that touches itself";
   m.opp.assign(m.cv.size(), -1);
   for (uint32_t c = 0; c < m.cv.size(); ++c) {
-    const auto it = edge.find(key(m.cv[prev3(c)], m.cv[next3(c)]));
+    const auto it = edge.find(key(m.cv[MeshState::prev(c)], m.cv[MeshState::next(c)]));
     if (it == edge.end()) return "an edge left open after closing the holes";
     m.opp[c] = static_cast<int32_t>(it->second);
   }
@@ -312,7 +309,7 @@ std::string close_mesh(uint32_t nv, const std::vector<std::array<uint32_t, 3>>& 
     if (fan[x] == 0) continue;
     uint32_t c = c0, n = 0;
     do {
-      c = next3(static_cast<uint32_t>(m.opp[next3(c)]));
+      c = MeshState::next(static_cast<uint32_t>(m.opp[MeshState::next(c)]));
       if (++n > fan[x]) break;
     } while (c != c0);
     if (n != fan[x]) return "a vertex where two sheets of the surface meet";
@@ -710,15 +707,16 @@ void Encoder::trace_tail(const ClosedMesh& cm, uint32_t level_index, Segment& se
         // Where a loop passes the tip more than once (after a handle), the
         // right pass is the one whose unbuilt wedge at the tip holds f.
         auto wedge_holds_f = [&](uint32_t e) {
-          uint32_t from = input_corner[tail.edge_corner(e)] / 3;
-          uint32_t tri = static_cast<uint32_t>(cm.opp[input_corner[tail.edge_corner(e)]]) / 3;
+          const uint32_t built = input_corner[tail.edge_corner(e)];
+          uint32_t from = built / 3;
+          uint32_t tri = static_cast<uint32_t>(cm.opp[built]) / 3;
           for (uint32_t steps = 0; steps <= cm.cv.size() / 3; ++steps) {
             if (tri == f) return true;
             if (used[tri]) return false;
             uint32_t k = 3 * tri;
             while (cm.cv[k] != tip) ++k;
-            const uint32_t t1 = static_cast<uint32_t>(cm.opp[next3(k)]) / 3;
-            const uint32_t t2 = static_cast<uint32_t>(cm.opp[prev3(k)]) / 3;
+            const uint32_t t1 = static_cast<uint32_t>(cm.opp[MeshState::next(k)]) / 3;
+            const uint32_t t2 = static_cast<uint32_t>(cm.opp[MeshState::prev(k)]) / 3;
             const uint32_t to = t1 == from ? t2 : t1;
             from = tri;
             tri = to;
@@ -776,8 +774,8 @@ void Encoder::trace_tail(const ClosedMesh& cm, uint32_t level_index, Segment& se
       if ((st = tail.attach(sym, dummy, backward, offset, depth)) != Status::ok)
         throw std::logic_error("encode_mesh: tail step rejected");
       input_corner[3 * t] = ic;
-      input_corner[3 * t + 1] = next3(ic);
-      input_corner[3 * t + 2] = prev3(ic);
+      input_corner[3 * t + 1] = MeshState::next(ic);
+      input_corner[3 * t + 2] = MeshState::prev(ic);
       if (sym == TailSymbol::C) dec[tip] = st_.corner_vertex(3 * t);
     }
     seg.end_item();
@@ -791,9 +789,8 @@ void Encoder::trace_tail(const ClosedMesh& cm, uint32_t level_index, Segment& se
   }
   for (uint32_t v = 0; v < nv; ++v) {
     int32_t p[3];
-    uint32_t np = 0;
-    if (mesh_tail_predict(st_, v, p, &np) != Status::ok) throw std::logic_error("encode_mesh: tail prediction");
-    const uint32_t cls = np;
+    uint32_t cls = 0;
+    if (mesh_tail_predict(st_, v, p, &cls) != Status::ok) throw std::logic_error("encode_mesh: tail prediction");
     const auto& q = q_[orig_of_[v]];
     for (uint32_t k = 0; k < 3; ++k)
       seg.geom.push_back(with(kCatTailGeo, op_signed(TC::geo_zero(k, cls), TC::geo_mag(k, cls), TC::kGeoBins,
@@ -834,11 +831,12 @@ void Encoder::emit(const Segment& seg, StreamWriter& w, MeshLevelStats& stats) {
     }
     return h;
   };
+  ArithContext* const contexts = seg.tail ? tctx_.c : ctx_.c;
   auto encode_item = [&](uint32_t j, Coder& cc, Coder& gc) {
     for (uint32_t o = seg.conn_at[j]; o < seg.conn_at[j + 1]; ++o)
-      cost[seg.conn[o].cat] += replay(seg.conn[o], cc, seg.tail ? tctx_.c : ctx_.c, seg);
+      cost[seg.conn[o].cat] += replay(seg.conn[o], cc, contexts, seg);
     for (uint32_t o = seg.geom_at[j]; o < seg.geom_at[j + 1]; ++o)
-      cost[seg.geom[o].cat] += replay(seg.geom[o], gc, seg.tail ? tctx_.c : ctx_.c, seg);
+      cost[seg.geom[o].cat] += replay(seg.geom[o], gc, contexts, seg);
   };
   const size_t limit = opt_.max_chunk_payload;
   uint32_t i = 0;

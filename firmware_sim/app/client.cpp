@@ -262,19 +262,17 @@ vds::ChunkResult on_model_chunk(uint32_t type, const uint8_t* payload, uint32_t 
   vds::ChunkResult result = vds::ChunkResult::consumed;
   if (vds::is_error(s)) {
     log_status("mesh", s);
-    g.feed_mark = work_clock();
-    return vds::ChunkResult::abort;
-  }
-  // The level a chunk completed is drawn even when the decoder knows at once
-  // that the next one will not fit (a version-2 stream's tail).
-  if (g.mesh.capacity_reached() && !g.full) {
+    result = vds::ChunkResult::abort;
+  } else if (g.mesh.capacity_reached() && !g.full) {
     g.full = true;
     Line l;
     l.str("client: model: workspace full after level ").dec(g.mesh.levels_done()).str(" of ");
     l.dec(g.mesh.header().levels).str(" (").dec(g.mesh.mesh().vertex_count()).str(" vertices)\n");
     board::log(l.c_str());
   }
-  if (g.model_frames.due(g.mesh)) {
+  // The level a chunk completed is drawn even when the decoder knows at once
+  // that the next one will not fit (a version-2 stream's tail).
+  if (result == vds::ChunkResult::consumed && g.model_frames.due(g.mesh)) {
     board::display_begin_frame(g.header.width, g.header.height);
     g.in_frame = true;
     g.frame_crc = 0;

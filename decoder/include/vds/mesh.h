@@ -364,8 +364,6 @@ class MeshTail {
   // hold the border. The loop stack uses m's vertex-corner table and the
   // conquered-triangle counts its position array, until finish().
   Status begin(MeshState& m, Arena& arena, const TailCounts& n);
-  // Triangles built so far (real and dummy).
-  uint32_t built() const { return built_; }
   uint32_t total() const { return n_.triangles + n_.dummy_triangles; }
   // The next triangle starts a new component (three new vertices).
   bool needs_seed() const { return gate_ == kMeshNone; }
@@ -402,8 +400,7 @@ class MeshTail {
   uint32_t border_reach(uint32_t e, bool backward) const {
     return m_->corner_vertex(backward ? MeshState::next(corner_[e]) : MeshState::prev(corner_[e]));
   }
-  // The vertex and triangle indices the next new ones get.
-  uint32_t next_vertex(bool dummy) const { return dummy ? n_.vertices + dummy_v_ : real_v_; }
+  // The triangle index the next new one gets.
   uint32_t next_triangle(bool dummy) const { return dummy ? n_.triangles + dummy_t_ : real_t_; }
 
  private:
@@ -546,6 +543,10 @@ class MeshDecoder {
   // max_triangles include the tail's dummies (HEAD's budgets).
   static size_t workspace_bytes(uint32_t max_vertices, uint32_t max_triangles, uint32_t max_base_triangles,
                                 MeshCoder coder, uint32_t tail_border = 0);
+  // What the tail carves when it starts: its contexts and its border.
+  static size_t tail_workspace_bytes(uint32_t tail_border) {
+    return sizeof(TailContexts) + alignof(TailContexts) + MeshTail::workspace_bytes(tail_border);
+  }
 
   // Carves the mesh, the contexts and the split flags from `arena` for a
   // mesh of up to max_vertices / max_triangles (the stream's full counts, or
