@@ -24,6 +24,7 @@ struct ServeArgs {
   double frame_loss = 0;
   uint64_t seed = 1;
   std::string crc_out;
+  bool unpaced = false;
 };
 
 void run_serve(const ServeArgs& a) {
@@ -36,6 +37,7 @@ void run_serve(const ServeArgs& a) {
   link::ServeOptions o;
   o.link = a.link;
   o.baud = a.baud;
+  o.paced = !a.unpaced;
   o.timeout_s = a.timeout;
   o.faults.seed = a.seed;
   o.faults.bit_error_rate = a.ber;
@@ -55,10 +57,10 @@ void run_serve(const ServeArgs& a) {
               a.link.c_str(), a.baud, r.simulated ? " (simulated time)" : "");
   std::printf("  time               %.3f s, goodput %.1f %% of %u bytes/s\n", r.seconds, r.goodput * 100, a.baud / 10);
   std::printf("  sessions           %u\n", r.sessions);
-  std::printf("  frames             %u data, %u retransmitted (%u timeouts, %u losses inferred from acks), "
-              "final payload %u B\n",
-              r.host.data_frames_sent, r.host.retransmissions, r.host.timeouts, r.host.fast_losses,
-              r.final_frame_payload);
+  std::printf("  frames             %u data, %u resent (%u lost on the line, %u received twice), %u probes "
+              "after %u timeouts, %u waits for the client's line buffer, final payload %u B\n",
+              r.host.data_frames_sent, r.host.retransmissions, r.host.losses, r.host.spurious, r.host.probes,
+              r.host.timeouts, r.host.line_waits, r.final_frame_payload);
   if (r.simulated)
     std::printf("  client             %u chunks verified, %u frames dropped (bad CRC %u)\n", r.client_chunks,
                 r.client.dropped(), r.client.bad_crc);
@@ -95,7 +97,7 @@ void run_serve(const ServeArgs& a) {
     std::printf("  goodbye            %s\n", r.goodbye_acked  ? "acknowledged by the client"
                                           : !r.goodbye_sent ? "not sent"
                                           : r.client_closed ? "sent; then the client closed the line"
-                                                            : "sent; not acknowledged within 2 s");
+                                                            : "sent; not acknowledged within 10 s");
   } else if (r.report_seen && r.report_status == static_cast<int32_t>(Status::ok)) {
     char crc[16];
     std::snprintf(crc, sizeof crc, "%08x", r.receipt_crc);
@@ -128,6 +130,9 @@ void add_serve(CLI::App& app) {
   sub->add_option("--frame-loss", a->frame_loss, "Loopback: fraction of frames lost")->check(CLI::Range(0.0, 0.5));
   sub->add_option("--crc-out", a->crc_out, "Write the CRC of every frame the client displayed, one hex line each");
   sub->add_option("--seed", a->seed, "Loopback: fault seed")->capture_default_str();
+  sub->add_flag("--unpaced", a->unpaced,
+                "pty and TCP: do not pace at --baud; write as fast as the client's line reports allow "
+                "(measures how fast a client drains; goodput is still given against --baud)");
   sub->callback([a] { run_serve(*a); });
 }
 

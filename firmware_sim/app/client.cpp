@@ -453,7 +453,7 @@ extern "C" int vds_app_main() {
   size_t budget = board::workspace_budget();
   if (budget > sizeof g_workspace) budget = sizeof g_workspace;
   g.arena = vds::Arena(g_workspace, budget);
-  const link::LinkConfig cfg = link::device_config(board::millis() + 1);
+  const link::LinkConfig cfg = link::device_config(board::millis() + 1, board::uart_rx_ring_bytes());
   Status s = g.link.init(cfg, g.arena);
   if (s != Status::ok) {
     log_status("link", s);

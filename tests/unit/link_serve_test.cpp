@@ -9,8 +9,8 @@
 #include <chrono>
 #include <thread>
 
+#include "link_stream.h"
 #include "vds/crc32c.h"
-#include "vds/enc/stream_writer.h"
 #include "vds/link/fd_backends.h"
 #include "vds/link/messages.h"
 #include "vds/link/serve.h"
@@ -18,19 +18,8 @@
 namespace {
 
 using namespace vds::link;
+using vds::link::linktest::make_stream;
 using vds::Status;
-
-std::vector<uint8_t> make_stream(size_t chunks, size_t chunk_bytes) {
-  vds::StreamHeader h = vds::enc::default_header(vds::StreamMode::images, 64, 48);
-  h.max_chunk_payload = static_cast<uint32_t>(chunk_bytes);
-  vds::enc::StreamWriter w(h);
-  std::vector<uint8_t> p(chunk_bytes);
-  for (size_t c = 0; c < chunks; ++c) {
-    for (size_t i = 0; i < p.size(); ++i) p[i] = static_cast<uint8_t>(i * 31 + c * 7);
-    w.add_chunk(vds::fourcc('D', 'A', 'T', 'A'), p);
-  }
-  return w.finish();
-}
 
 TEST(LinkServe, LoopbackClientVerifiesTheStream) {
   const std::vector<uint8_t> s = make_stream(20, 8000);

@@ -43,6 +43,8 @@ std::vector<uint8_t> hello_payload(uint8_t major, uint8_t flags, uint32_t nonce,
   p.push_back(0x04);
   p.push_back(0);  // no channels
   p.push_back(0);
+  p.push_back(0);  // no line buffer declared
+  p.push_back(0);
   return p;
 }
 
@@ -92,7 +94,7 @@ TEST(LinkSession, SameRoleNeverEstablishes) {
 TEST(LinkSession, RefusesAnotherMajorVersion) {
   LinkSim sim(115200, {}, {}, host_config(1), device_config(2));
   Link& dev = sim.device();
-  const auto f = frame(FrameType::hello, 0, 0, 0, hello_payload(2, 0, 0x1234, 0));
+  const auto f = frame(FrameType::hello, 0, 0, 0, hello_payload(kVersionMajor - 1, 0, 0x1234, 0));
   dev.receive(f.data(), f.size(), 0);
   EXPECT_EQ(dev.stats().bad_version, 1u);
   EXPECT_EQ(dev.peer_nonce(), 0u);
@@ -158,10 +160,10 @@ TEST(LinkSession, MalformedFramesOfEveryKindAreCountedAndDropped) {
        &LinkStats::bad_session},
       {"duplicate of delivered data", frame(FrameType::data, channel::kStream, tag, 100, {7, 7}),
        &LinkStats::duplicates},
-      {"ack of bytes never sent", frame(FrameType::ack, channel::kControl, tag, 500, {0, 1}), &LinkStats::bad_ack},
+      {"ack of bytes never sent", frame(FrameType::ack, channel::kControl, tag, 500, {0, 1, 0, 0, 0, 0, 0}), &LinkStats::bad_ack},
       {"ack with a ragged length", frame(FrameType::ack, channel::kControl, tag, 0, {0, 1, 2}), &LinkStats::bad_ack},
       {"hello too short", frame(FrameType::hello, 0, 0, 0, {1, 0, 0}), &LinkStats::bad_hello},
-      {"hello from a device", frame(FrameType::hello, 0, 0, 0, hello_payload(1, 0x02, 99, 0)), &LinkStats::bad_hello},
+      {"hello from a device", frame(FrameType::hello, 0, 0, 0, hello_payload(kVersionMajor, 0x02, 99, 0)), &LinkStats::bad_hello},
   };
   for (const Case& c : cases) {
     const LinkStats before = dev.stats();

@@ -164,6 +164,8 @@ size_t uart_read(uint8_t* buf, size_t max) {
   return n;
 }
 
+uint16_t uart_rx_ring_bytes() { return static_cast<uint16_t>(kMaxCreditBytes); }
+
 bool uart_closed() { return g_uart_closed; }
 
 void uart_write(const uint8_t* data, size_t n) {

@@ -140,6 +140,7 @@ void uart_write(const uint8_t* data, size_t n) {
   }
 }
 
+uint16_t uart_rx_ring_bytes() { return static_cast<uint16_t>(kRingBytes); }
 bool uart_closed() { return false; }  // a socket closing is invisible behind the UART
 
 void wait_for_event(uint32_t max_ms) {

@@ -15,6 +15,10 @@ void init();
 size_t uart_read(uint8_t* buf, size_t max);
 // Sends `n` bytes; blocks until the UART has taken them all.
 void uart_write(const uint8_t* data, size_t n);
+// Bytes the UART's receive ring holds between the line and uart_read. The
+// application declares it to the host's link, which then never has more
+// than this on the line unread, so the ring cannot overflow by its doing.
+uint16_t uart_rx_ring_bytes();
 
 // True once the far end of the UART has gone away for good (the host
 // board's pty or socket peer closed after traffic); never on hardware, where

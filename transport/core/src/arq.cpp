@@ -1,8 +1,11 @@
 // Reliable link channels: selective-repeat ARQ over 16-bit byte offsets with
-// cumulative + selective acknowledgements (after TCP SACK, RFC 2018), loss
-// inferred when a later transmission is acknowledged (the FIFO-pipe case of
-// RACK, RFC 8985), RTO from Jacobson/Karels smoothing (RFC 6298) with
-// exponential back-off, and a frame size chosen from the observed loss rate.
+// cumulative + selective acknowledgements (after TCP SACK, RFC 2018); flow
+// control and loss detection from the receiver's line report (the last data
+// frame it took off the line intact, as TCP's timestamp echo names a
+// segment, and the wire bytes it took since): a frame is lost only once the
+// receiver has taken it and not accepted it, never because it is late; RTO
+// from Jacobson/Karels smoothing (RFC 6298, Karn's rule) with back-off, which
+// only sends a small probe; and a frame size chosen from the loss rate.
 #include <cstring>
 
 #include "vds/link/link.h"
@@ -34,6 +37,12 @@ constexpr uint32_t kWireOverhead = kFrameOverhead + 2;
 constexpr uint32_t kEstimateWindow = 16384;
 constexpr uint32_t kLostOne = 256;  // one lost frame in est_lost_q8_ (Q8)
 constexpr uint8_t kMaxBackoff = 16;
+// Line report, byte 0: the channel of the echoed frame, and two flags.
+constexpr uint8_t kEchoChannelMask = 0x0F;
+constexpr uint8_t kEchoValid = 0x10;      // a data frame was taken intact this session
+constexpr uint8_t kEchoDuplicate = 0x20;  // it carried nothing new
+// A probe resends at most this many bytes: the tail of the oldest frame.
+constexpr uint16_t kProbePayload = 16;
 
 uint64_t isqrt64(uint64_t x) {
   uint64_t r = 0;
@@ -57,9 +66,26 @@ uint64_t isqrt64(uint64_t x) {
 
 void Link::rx_data(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
   RxReliable& r = *ch_[c].rxr;
-  r.ack_due = true;  // every data frame, even a duplicate, is answered
-  if (n == 0) return;
+  // Whatever becomes of it, this frame left the line intact: the next line
+  // report names it.
+  echo_valid_ = true;
+  echo_ch_ = c;
+  echo_seq_ = seq;
+  echo_end_ = rx_wire_;
+  echo_dup_ = false;
+  if (n == 0) {
+    r.ack_due = true;
+    return;
+  }
+  // Every data frame is answered, at once unless it is the next in order
+  // on a line with no holes (then every second frame, or kAckDelayMs).
   const uint32_t off = widen(seq, r.nxt);
+  if (off == r.nxt && r.range_count == 0) {
+    if (r.held++ == 0) r.held_since_ms = now_;
+    if (r.held >= kAckEveryFrames) r.ack_due = true;
+  } else {
+    r.ack_due = true;
+  }
   const uint32_t end = off + static_cast<uint32_t>(n);
   if (diff(end, r.rd + r.cap) > 0) {
     ++stats_.out_of_window;
@@ -67,6 +93,7 @@ void Link::rx_data(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
   }
   if (diff(end, r.nxt) <= 0) {
     ++stats_.duplicates;
+    echo_dup_ = true;
     return;
   }
   const uint32_t start = diff(off, r.nxt) < 0 ? r.nxt : off;
@@ -79,6 +106,7 @@ void Link::rx_data(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
       if (diff(g.start, e) > 0 || diff(g.end, s) < 0) continue;
       if (diff(g.start, s) <= 0 && diff(g.end, e) >= 0) {
         ++stats_.duplicates;  // wholly inside what we hold
+        echo_dup_ = true;
         return;
       }
       if (merged == 0) first = i;
@@ -133,7 +161,16 @@ bool Link::build_ack(uint8_t c) {
   const uint32_t wnd = r.rd + r.cap - r.nxt;
   p[0] = static_cast<uint8_t>(wnd);
   p[1] = static_cast<uint8_t>(wnd >> 8);
-  size_t n = 2;
+  // The line report: the last data frame taken intact (any channel) and
+  // the wire bytes taken after its delimiter (saturating).
+  const uint32_t after = rx_wire_ - echo_end_;
+  const uint16_t after16 = after > 0xFFFF ? 0xFFFF : static_cast<uint16_t>(after);
+  p[2] = echo_valid_ ? static_cast<uint8_t>(kEchoValid | (echo_dup_ ? kEchoDuplicate : 0) | echo_ch_) : 0;
+  p[3] = static_cast<uint8_t>(echo_seq_);
+  p[4] = static_cast<uint8_t>(echo_seq_ >> 8);
+  p[5] = static_cast<uint8_t>(after16);
+  p[6] = static_cast<uint8_t>(after16 >> 8);
+  size_t n = kAckFixedBytes;
   // The block with the newest arrival first (the sender's loss detection
   // needs it), then the highest others.
   uint8_t order[kSackBlocks];
@@ -155,6 +192,7 @@ bool Link::build_ack(uint8_t c) {
   h.tag = tag_;
   h.seq = static_cast<uint16_t>(r.nxt);
   r.ack_due = false;
+  r.held = 0;
   r.last_ack_ms = now_;
   r.advertised_end = r.rd + r.cap;
   return emit(h, p, n);
@@ -266,9 +304,11 @@ void Link::rtt_sample(uint32_t ms) {
 
 void Link::note_outcome(uint16_t len, bool lost) {
   est_bytes_ += len + kWireOverhead;
+  est_frames_q8_ += kLostOne;
   if (lost) est_lost_q8_ += kLostOne;
   if (est_bytes_ > kEstimateWindow) {
     est_bytes_ >>= 1;
+    est_frames_q8_ >>= 1;
     est_lost_q8_ >>= 1;
   }
   update_frame_size();
@@ -277,15 +317,19 @@ void Link::note_outcome(uint16_t len, bool lost) {
 // With a per-byte loss probability q and h bytes of overhead per frame,
 // selective repeat delivers (L - h) / L * (1 - q)^L of the line rate with
 // frames of L wire bytes; the optimum satisfies L^2 - h*L = h/q (first order
-// in q), so L = h/2 + sqrt(h^2/4 + h/q). q is estimated as lost frames per
-// wire byte of frames whose fate is known.
+// in q), so L = h/2 + sqrt(h^2/4 + h/q). q is estimated from the frames
+// whose fate is known: a frame of W bytes is lost with probability
+// f = 1 - (1-q)^W ~ qW (1 - qW/2), so q ~ lost / (bytes (1 - f/2)), f the
+// fraction of frames lost (lost / bytes alone underestimates q by f/2,
+// 15 % at a bit-error rate of 1e-3, and picks frames too long).
 void Link::update_frame_size() {
   uint32_t cap = cfg_.max_tx_payload;
   if (peer_max_payload_ != 0 && peer_max_payload_ < cap) cap = peer_max_payload_;
   uint32_t fp = cap;
-  if (cfg_.adaptive && est_lost_q8_ != 0) {
+  if (cfg_.adaptive && est_lost_q8_ != 0 && est_frames_q8_ != 0) {
     const uint64_t h = kWireOverhead;
-    const uint64_t h_over_q = h * est_bytes_ * kLostOne / est_lost_q8_;
+    const uint64_t bytes = est_bytes_ - static_cast<uint64_t>(est_bytes_) * est_lost_q8_ / (2u * est_frames_q8_);
+    const uint64_t h_over_q = h * bytes * kLostOne / est_lost_q8_;
     const uint64_t wire = h / 2 + isqrt64(h * h / 4 + h_over_q);
     fp = wire > h + cap ? cap : static_cast<uint32_t>(wire - h);
   }
@@ -294,18 +338,87 @@ void Link::update_frame_size() {
   frame_payload_ = static_cast<uint16_t>(fp);
 }
 
-void Link::segment_acked(TxReliable& t, Segment& s, uint32_t* max_order) {
-  (void)t;
+void Link::segment_acked(Segment& s) {
   if (s.state == SegState::sacked) return;
   if (s.tries == 1) rtt_sample(now_ - s.sent_ms);  // Karn: never time a retransmitted frame
   note_outcome(s.len, false);
-  if (*max_order == 0 || diff(s.order, *max_order) > 0) *max_order = s.order;
   s.state = SegState::sacked;
+}
+
+// The peer has taken every wire byte below `wire` off its line: the data
+// frames that ended there are out of the pipe, accepted or not.
+void Link::resolve_to(uint32_t wire) {
+  if (diff(wire, tx_wire_) > 0) wire = tx_wire_;
+  if (diff(wire, resolved_wire_) <= 0) return;
+  resolved_wire_ = wire;
+  progress_ms_ = rto_from_ms_ = now_;
+  backoff_ = 0;
+  while (log_count_ != 0 && diff(log_[log_head_].wire_end, wire) <= 0) {
+    const detail::Sent& e = log_[log_head_];
+    // A frame split after it was sent leaves pieces with its order: all of
+    // them were on the line in that frame.
+    if (e.ch < kChannels && ch_[e.ch].txr != nullptr) {
+      TxReliable& t = *ch_[e.ch].txr;
+      for (uint16_t i = 0; i < t.seg_count; ++i)
+        if (t.segs[i].order == e.order) t.segs[i].taken = true;
+    }
+    log_head_ = static_cast<uint16_t>((log_head_ + 1) % log_cap_);
+    --log_count_;
+  }
+}
+
+// A line report (docs/protocol.md, "Flow control and loss"): find the
+// echoed frame in the log (the oldest copy not yet known to be taken: the
+// pipe keeps order), and count the wire bytes taken after it. Every
+// misreading errs towards "still in flight": a report that repeats the last
+// echo is read as that frame, even if a later copy with the same offset
+// arrived, and bytes lost on the line are never counted as taken.
+void Link::on_line_report(const uint8_t* p) {
+  report_ms_ = now_;
+  if ((p[0] & kEchoValid) == 0) return;
+  const uint8_t ch = p[0] & kEchoChannelMask;
+  const uint16_t seq = static_cast<uint16_t>(p[1] | p[2] << 8);
+  const uint32_t after = static_cast<uint32_t>(p[3] | p[4] << 8);
+  uint32_t base = 0;
+  if (last_echo_valid_ && last_echo_ch_ == ch && last_echo_seq_ == seq) {
+    base = last_echo_end_;
+  } else {
+    uint16_t i = 0;
+    while (i < log_count_) {
+      const detail::Sent& e = log_[(log_head_ + i) % log_cap_];
+      if (e.ch == ch && e.seq == seq) break;
+      ++i;
+    }
+    if (i == log_count_) return;  // stale: about a frame already accounted for
+    const detail::Sent& e = log_[(log_head_ + i) % log_cap_];
+    base = e.wire_end;
+    if ((p[0] & kEchoDuplicate) != 0 && !e.probe) ++stats_.spurious;
+    last_echo_valid_ = true;
+    last_echo_ch_ = ch;
+    last_echo_seq_ = seq;
+    last_echo_end_ = base;
+  }
+  resolve_to(base + after);
+}
+
+// Frames of channel `c` the peer took off its line and did not accept
+// (damaged, cut short, or refused) are lost: only now, never for being late.
+void Link::declare_taken_lost(uint8_t c) {
+  TxReliable& t = *ch_[c].txr;
+  for (uint16_t i = 0; i < t.seg_count; ++i) {
+    Segment& g = t.segs[i];
+    if (g.state != SegState::in_flight || !g.taken) continue;
+    g.state = SegState::lost;
+    g.taken = false;
+    ++stats_.losses;
+    note_outcome(g.len, true);
+  }
 }
 
 void Link::rx_ack(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
   TxReliable& t = *ch_[c].txr;
-  if (n < 2 || (n - 2) % 4 != 0 || (n - 2) / 4 > kSackBlocks) {
+  if (n < kAckFixedBytes || (n - kAckFixedBytes) % 4 != 0 || (n - kAckFixedBytes) / 4 > kSackBlocks ||
+      (p[2] & ~(kEchoValid | kEchoDuplicate | kEchoChannelMask)) != 0) {
     ++stats_.bad_ack;
     return;
   }
@@ -318,10 +431,9 @@ void Link::rx_ack(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
     return;
   }
   if (diff(ack + wnd, t.wnd_end) > 0) t.wnd_end = ack + wnd;
-  uint32_t max_order = 0;
   uint16_t done = 0;
   while (done < t.seg_count && diff(t.segs[done].start + t.segs[done].len, ack) <= 0) {
-    segment_acked(t, t.segs[done], &max_order);
+    segment_acked(t.segs[done]);
     ++done;
   }
   if (done != 0) {
@@ -337,8 +449,9 @@ void Link::rx_ack(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
     t.base_pos = (t.base_pos + (ack - t.base)) % t.cap;
     t.base = ack;
     backoff_ = 0;
+    progress_ms_ = rto_from_ms_ = now_;
   }
-  for (size_t b = 2; b < n; b += 4) {
+  for (size_t b = kAckFixedBytes; b < n; b += 4) {
     const uint32_t s = widen(static_cast<uint16_t>(p[b] | p[b + 1] << 8), ack);
     const uint32_t e = widen(static_cast<uint16_t>(p[b + 2] | p[b + 3] << 8), ack);
     if (diff(s, ack) <= 0 || diff(e, s) <= 0 || diff(e, t.nxt) > 0) {
@@ -353,57 +466,106 @@ void Link::rx_ack(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
       else hi = mid;
     }
     for (uint16_t i = lo; i < t.seg_count && diff(t.segs[i].start + t.segs[i].len, e) <= 0; ++i)
-      segment_acked(t, t.segs[i], &max_order);
+      segment_acked(t.segs[i]);
   }
-  if (max_order == 0) return;
-  // The pipe keeps order: a frame sent before one that arrived is lost.
-  for (uint16_t i = 0; i < t.seg_count; ++i) {
-    Segment& g = t.segs[i];
-    if (g.state == SegState::in_flight && diff(g.order, max_order) < 0) {
-      g.state = SegState::lost;
-      ++stats_.fast_losses;
-      note_outcome(g.len, true);
-    }
-  }
+  // The report was made after the acknowledgements it travels with, so a
+  // frame it shows taken and they do not show accepted is lost.
+  on_line_report(p + 2);
+  declare_taken_lost(c);
 }
 
+// The RTO (with back-off) counts from the later of the oldest frame in
+// flight leaving and the last progress (bytes taken or acknowledged). When
+// it fires nothing is declared lost: the peer may only be slow. One probe
+// goes out instead, the last few bytes of the oldest frame, so a line
+// whose last frame and its report were lost still moves.
 void Link::check_timeouts() {
   uint32_t rto = rto_ms_ << backoff_;
   if (backoff_ >= kMaxBackoff || rto > cfg_.rto_max_ms) rto = cfg_.rto_max_ms;
-  // oldest_sent_ms_ is a lower bound of every in-flight send time (sends
-  // only come later), so nothing can have expired before it plus the RTO.
-  if (now_ - oldest_sent_ms_ < rto) return;
+  const uint32_t from = diff(rto_from_ms_, oldest_sent_ms_) > 0 ? rto_from_ms_ : oldest_sent_ms_;
+  if (now_ - from < rto) return;
   uint32_t oldest = now_;
-  bool fired = false;
+  bool pending = false;
   for (detail::Channel& ch : ch_) {
     if (ch.txr == nullptr) continue;
-    TxReliable& t = *ch.txr;
+    const TxReliable& t = *ch.txr;
     for (uint16_t i = 0; i < t.seg_count; ++i) {
-      Segment& g = t.segs[i];
-      // The frame still leaving the transmit buffer has not been sent yet.
+      const Segment& g = t.segs[i];
       const bool leaving = txf_pos_ < txf_len_ && txf_type_ == FrameType::data && g.order == txf_order_;
-      if (g.state != SegState::in_flight) continue;
-      if (!leaving && now_ - g.sent_ms >= rto) {
-        g.state = SegState::lost;
-        note_outcome(g.len, true);
-        fired = true;
-      } else if (diff(g.sent_ms, oldest) < 0) {
-        oldest = g.sent_ms;
-      }
+      if (g.state != SegState::in_flight || leaving) continue;
+      if (diff(g.sent_ms, oldest) < 0) oldest = g.sent_ms;
+      pending = true;
     }
   }
   oldest_sent_ms_ = oldest;
-  if (fired) {
-    ++stats_.timeouts;
-    if (backoff_ < kMaxBackoff) ++backoff_;
+  if (!pending || now_ - (diff(rto_from_ms_, oldest) > 0 ? rto_from_ms_ : oldest) < rto) return;
+  ++stats_.timeouts;
+  if (backoff_ < kMaxBackoff) ++backoff_;
+  rto_from_ms_ = now_;  // the next RTO counts from here
+  probe_due_ = true;
+  lost_on_line_ = now_ - progress_ms_ >= rto && report_ms_ - progress_ms_ >= rto && log_count_ != 0;
+}
+
+// Whether a frame of `wire` bytes may go now without the peer's line
+// buffer holding more than it declared. New data leaves kLineReserve for
+// the small frames that are never held back, and probes.
+bool Link::line_has_room(size_t wire, bool probe) const {
+  if (peer_line_bytes_ == 0) return true;
+  const uint32_t limit = probe ? peer_line_bytes_ : peer_line_bytes_ - kLineReserve;
+  return line_in_flight() + wire <= limit;
+}
+
+// One probe after an RTO: the last bytes of the oldest frame in flight,
+// sent as a frame of their own (a new offset, so the peer's report of it
+// cannot be mistaken for the original's). If the line has no room even for
+// that, and the peer has kept reporting for an RTO since the last progress
+// without taking what we count as in flight, those bytes never reached it
+// (dropped on the line): forget them, and their frames are lost.
+bool Link::build_probe() {
+  probe_due_ = false;
+  const bool dropped = lost_on_line_;
+  lost_on_line_ = false;
+  for (uint8_t c = 0; c < kChannels; ++c) {
+    detail::Channel& ch = ch_[c];
+    if (ch.txr == nullptr || ch.peer_rx != Mode::reliable) continue;
+    TxReliable& t = *ch.txr;
+    for (uint16_t i = 0; i < t.seg_count; ++i) {
+      Segment& g = t.segs[i];
+      const bool leaving = txf_pos_ < txf_len_ && txf_type_ == FrameType::data && g.order == txf_order_;
+      if (g.state != SegState::in_flight || leaving) continue;
+      const uint16_t plen = g.len < kProbePayload ? g.len : kProbePayload;
+      if (!line_has_room(frame_wire_bound(plen) + 1, true) || log_count_ == log_cap_ ||
+          (g.len > plen && t.seg_count == t.seg_cap)) {
+        if (dropped) {
+          resolve_to(tx_wire_);
+          for (uint8_t k = 0; k < kChannels; ++k)
+            if (ch_[k].txr != nullptr) declare_taken_lost(k);
+        }
+        return false;
+      }
+      if (g.len > plen) {
+        memmove(&t.segs[i + 2], &t.segs[i + 1], sizeof(Segment) * (t.seg_count - i - 1));
+        Segment tail = g;
+        tail.start = g.start + (g.len - plen);
+        tail.len = plen;
+        t.segs[i + 1] = tail;
+        ++t.seg_count;
+        g.len = static_cast<uint16_t>(g.len - plen);
+        ++i;
+      }
+      ++stats_.probes;
+      return send_segment(c, t.segs[i], true);
+    }
   }
+  return false;
 }
 
 bool Link::build_data(uint8_t c) {
   detail::Channel& ch = ch_[c];
-  if (ch.peer_rx != Mode::reliable) return false;
+  // Data waits until the peer is established: before that it would drop
+  // every frame, and the line would fill with bytes no report accounts for.
+  if (ch.peer_rx != Mode::reliable || !peer_est_) return false;
   TxReliable& t = *ch.txr;
-  Segment* seg = nullptr;
   for (uint16_t i = 0; i < t.seg_count; ++i) {
     Segment& g = t.segs[i];
     if (g.state != SegState::lost) continue;
@@ -421,55 +583,53 @@ bool Link::build_data(uint8_t c) {
       ++t.seg_count;
       g.len = head;
     }
-    seg = &g;
-    ++stats_.retransmissions;
-    break;
-  }
-  if (seg == nullptr) {
-    const uint32_t avail = t.wr - t.nxt;
-    const uint32_t room = diff(t.wnd_end, t.nxt) > 0 ? t.wnd_end - t.nxt : 0;
-    const uint32_t want = avail < frame_payload_ ? avail : frame_payload_;
-    const uint32_t len = want < room ? want : room;
-    // Avoid a silly window: while frames are in flight, wait until a
-    // whole frame fits rather than dribbling small ones.
-    if (avail != 0 && len != 0 && t.seg_count < t.seg_cap && (len == want || t.seg_count == 0)) {
-      seg = &t.segs[t.seg_count++];
-      *seg = Segment{t.nxt, static_cast<uint16_t>(len), SegState::in_flight, 0, 0, 0};
-      t.nxt += len;
-    } else {
-      // Nothing new may go out: rather than leave the line idle, probe with
-      // the oldest frame once its ack is overdue (a tail-loss probe, RFC
-      // 8985 section 7). A lost retransmission at the head of a full
-      // window is then found in about one round trip instead of one RTO.
-      if (!have_rtt_) return false;
-      const int32_t srtt = srtt_q3_ >> 3;
-      const uint32_t pto = static_cast<uint32_t>(srtt + srtt / 4 + 2);
-      for (uint16_t i = 0; i < t.seg_count && seg == nullptr; ++i) {
-        Segment& g = t.segs[i];
-        const bool leaving = txf_pos_ < txf_len_ && txf_type_ == FrameType::data && g.order == txf_order_;
-        if (g.state == SegState::in_flight && !leaving && now_ - g.sent_ms >= pto) seg = &g;
-      }
-      if (seg == nullptr) return false;
-      ++stats_.probes;
+    if (!line_has_room(frame_wire_bound(g.len) + 1, false) || log_count_ == log_cap_) {
+      ++stats_.line_waits;
+      return false;  // lost data goes first, when the line has room
     }
+    ++stats_.retransmissions;
+    return send_segment(c, g, false);
   }
-  seg->state = SegState::in_flight;
-  ++seg->tries;
-  if (seg->tries == 0) seg->tries = 2;  // saturate: still "retransmitted"
-  seg->sent_ms = now_;
-  seg->order = ++order_;
-  if (order_ == 0) seg->order = order_ = 1;
+  const uint32_t avail = t.wr - t.nxt;
+  const uint32_t room = diff(t.wnd_end, t.nxt) > 0 ? t.wnd_end - t.nxt : 0;
+  const uint32_t want = avail < frame_payload_ ? avail : frame_payload_;
+  const uint32_t len = want < room ? want : room;
+  // Avoid a silly window: while frames are in flight, wait until a
+  // whole frame fits rather than dribbling small ones.
+  if (avail == 0 || len == 0 || t.seg_count == t.seg_cap || (len != want && t.seg_count != 0)) return false;
+  if (!line_has_room(frame_wire_bound(len) + 1, false) || log_count_ == log_cap_) {
+    ++stats_.line_waits;
+    return false;
+  }
+  Segment& g = t.segs[t.seg_count++];
+  g = Segment{t.nxt, static_cast<uint16_t>(len), SegState::in_flight, 0, 0, 0, false};
+  t.nxt += len;
+  return send_segment(c, g, false);
+}
+
+// Puts one segment of channel `c` into the transmit buffer as a data frame.
+bool Link::send_segment(uint8_t c, Segment& seg, bool probe) {
+  TxReliable& t = *ch_[c].txr;
+  seg.state = SegState::in_flight;
+  seg.taken = false;
+  ++seg.tries;
+  if (seg.tries == 0) seg.tries = 2;  // saturate: still "retransmitted"
+  seg.sent_ms = now_;
+  seg.order = ++order_;
+  if (order_ == 0) seg.order = order_ = 1;
   FrameHeader h;
   h.type = FrameType::data;
   h.channel = c;
   h.tag = tag_;
-  h.seq = static_cast<uint16_t>(seg->start);
-  const uint32_t pos = (t.base_pos + (seg->start - t.base)) % t.cap;
-  const uint32_t first_part = seg->len < t.cap - pos ? seg->len : t.cap - pos;
+  h.seq = static_cast<uint16_t>(seg.start);
+  const uint32_t pos = (t.base_pos + (seg.start - t.base)) % t.cap;
+  const uint32_t first_part = seg.len < t.cap - pos ? seg.len : t.cap - pos;
   ++stats_.data_frames_sent;
-  stats_.payload_sent += seg->len;
-  if (!emit_parts(h, t.ring + pos, first_part, t.ring, seg->len - first_part)) return false;
-  txf_order_ = seg->order;
+  stats_.payload_sent += seg.len;
+  if (!emit_parts(h, t.ring + pos, first_part, t.ring, seg.len - first_part)) return false;
+  txf_order_ = seg.order;
+  txf_seq_ = h.seq;
+  txf_probe_ = probe;
   return true;
 }
 

@@ -48,7 +48,7 @@ Status Link::init(const LinkConfig& c, Arena& arena) {
       c.max_tx_payload < kMinFramePayload || c.max_tx_payload > kMaxFramePayload ||
       c.min_tx_payload < kMinFramePayload || c.min_tx_payload > c.max_tx_payload || c.rto_min_ms == 0 ||
       c.rto_initial_ms < c.rto_min_ms || c.rto_max_ms < c.rto_initial_ms || c.hello_interval_ms == 0 ||
-      c.keepalive_ms == 0)
+      c.keepalive_ms == 0 || (c.rx_line_bytes != 0 && c.rx_line_bytes < 2 * kLineReserve))
     return Status::invalid_argument;
   for (const ChannelConfig& ch : c.channels) {
     if (ch.tx == Mode::reliable && (ch.tx_bytes == 0 || ch.tx_segments == 0)) return Status::invalid_argument;
@@ -66,12 +66,14 @@ Status Link::init(const LinkConfig& c, Arena& arena) {
   line_idle_ = true;
   txf_type_ = FrameType::hello;
   txf_channel_ = 0;
-  txf_order_ = hello_sent_ms_ = 0;
-  hello_sent_ = false;
+  txf_order_ = 0;
+  txf_seq_ = 0;
+  txf_probe_ = false;
   for (Channel& ch : ch_) ch = Channel{};
   rr_ = 0;
   now_ = 0;
   established_ = false;
+  peer_est_ = false;
   hello_due_ = true;
   hello_next_ms_ = my_nonce_ = peer_nonce_ = 0;
   tag_ = peer_caps_ = 0;
@@ -84,7 +86,22 @@ Status Link::init(const LinkConfig& c, Arena& arena) {
   rto_ms_ = 0;
   backoff_ = 0;
   order_ = oldest_sent_ms_ = 0;
-  est_bytes_ = est_lost_q8_ = 0;
+  probe_due_ = false;
+  rx_wire_ = echo_end_ = 0;
+  echo_seq_ = 0;
+  echo_ch_ = 0;
+  echo_valid_ = echo_dup_ = damaged_ = false;
+  tx_wire_ = resolved_wire_ = 0;
+  log_ = nullptr;
+  log_cap_ = log_head_ = log_count_ = 0;
+  last_echo_valid_ = false;
+  last_echo_ch_ = 0;
+  last_echo_seq_ = 0;
+  last_echo_end_ = 0;
+  peer_line_bytes_ = 0;
+  report_ms_ = progress_ms_ = rto_from_ms_ = 0;
+  lost_on_line_ = false;
+  est_bytes_ = est_lost_q8_ = est_frames_q8_ = 0;
   frame_payload_ = 0;
   stats_ = LinkStats{};
 
@@ -95,6 +112,13 @@ Status Link::init(const LinkConfig& c, Arena& arena) {
   txf_ = carve<uint8_t>(arena, txf_cap_);
   if (rxbuf == nullptr || txf_ == nullptr) return Status::workspace_too_small;
   rx_.init(rxbuf, rx_cap);
+  const size_t log_entries = detail::sent_log_entries(c);
+  if (log_entries > UINT16_MAX) return Status::invalid_argument;
+  if (log_entries != 0) {
+    log_ = carve<detail::Sent>(arena, log_entries);
+    if (log_ == nullptr) return Status::workspace_too_small;
+    log_cap_ = static_cast<uint16_t>(log_entries);
+  }
 
   for (uint8_t i = 0; i < kChannels; ++i) {
     const ChannelConfig& cc = c.channels[i];
@@ -170,6 +194,8 @@ void Link::reset_channels() {
       r.range_count = 0;
       r.latest = 0xFF;
       r.ack_due = false;
+      r.held = 0;
+      r.held_since_ms = 0;
     }
     if (ch.rxd != nullptr) {
       ch.rxd->len = 0;
@@ -186,39 +212,49 @@ void Link::restart() {
   end_session(ResetReason::local);
 }
 
+// The last byte of the frame in txf_ has left: a data frame's round trip
+// and retransmission timer start now, and it joins the sent-frame log at
+// its place on the line.
 void Link::frame_left() {
-  if (txf_type_ == FrameType::hello) {
-    hello_sent_ms_ = now_;
-    hello_sent_ = true;
-  } else if (txf_type_ == FrameType::data && txf_channel_ < kChannels && ch_[txf_channel_].txr != nullptr) {
-    TxReliable& t = *ch_[txf_channel_].txr;
-    for (uint16_t i = 0; i < t.seg_count; ++i) {
-      if (t.segs[i].order == txf_order_) {
-        t.segs[i].sent_ms = now_;
-        break;
-      }
-    }
-  }
+  if (txf_type_ != FrameType::data || txf_channel_ >= kChannels || ch_[txf_channel_].txr == nullptr) return;
+  TxReliable& t = *ch_[txf_channel_].txr;
+  for (uint16_t i = 0; i < t.seg_count; ++i)
+    if (t.segs[i].order == txf_order_) t.segs[i].sent_ms = now_;
+  if (log_count_ == log_cap_) return;  // never: build_data waits for room
+  detail::Sent& e = log_[(log_head_ + log_count_) % log_cap_];
+  e = detail::Sent{tx_wire_, txf_order_, txf_seq_, txf_channel_, txf_probe_};
+  ++log_count_;
 }
 
 void Link::end_session(ResetReason why) {
   if (established_) ++stats_.resets;
   established_ = false;
+  peer_est_ = false;
   last_reset_ = why;
   reset_channels();
   my_nonce_ = next_nonce(my_nonce_);
   peer_nonce_ = 0;
   tag_ = 0;
   hello_due_ = true;
-  hello_sent_ = false;
   // A frame cut short here reaches the peer as noise; a delimiter before
   // the next HELLO ends it, so the HELLO itself arrives intact.
   if (txf_pos_ != 0 && txf_pos_ < txf_len_) line_idle_ = true;
   txf_len_ = txf_pos_ = 0;
+  forget_line();
+}
+
+// Nothing of a session's line accounting outlives it.
+void Link::forget_line() {
+  resolved_wire_ = tx_wire_;
+  log_head_ = log_count_ = 0;
+  last_echo_valid_ = false;
+  echo_valid_ = echo_dup_ = damaged_ = false;
+  probe_due_ = false;
 }
 
 void Link::establish() {
   established_ = true;
+  peer_est_ = false;
   ++epoch_;
   ++stats_.sessions;
   // The tag marks every non-HELLO frame of this session; derived from both
@@ -230,13 +266,22 @@ void Link::establish() {
   tag_ = static_cast<uint8_t>(crc32c(ids, sizeof ids));
   have_rtt_ = false;
   oldest_sent_ms_ = now_;
+  // The first RTO is rto_initial_ms, not the HELLO's round trip: a HELLO is
+  // short and meets an empty line, a data frame may queue behind a full
+  // line buffer. Losses are found from the peer's line reports, so the
+  // RTO only decides when to probe a line that has gone quiet.
   rto_ms_ = cfg_.rto_initial_ms;
   backoff_ = 0;
-  // The handshake is the first round trip: HELLO sent, HELLO echoing it
-  // received. Without it the first lost frame would wait rto_initial_ms.
-  if (hello_sent_) rtt_sample(now_ - hello_sent_ms_);
-  est_bytes_ = est_lost_q8_ = 0;
+  forget_line();
+  report_ms_ = progress_ms_ = rto_from_ms_ = now_;
+  lost_on_line_ = false;
+  est_bytes_ = est_lost_q8_ = est_frames_q8_ = 0;
   update_frame_size();
+  // Until the first data frame is acknowledged the line's error rate is
+  // unknown: start with frames small enough to get through a bad line, so
+  // the peer's first line report comes at once (it names a frame it took
+  // intact); the first outcome sets the size from what was seen.
+  if (frame_payload_ > kFirstFramePayload) frame_payload_ = kFirstFramePayload < cfg_.min_tx_payload ? cfg_.min_tx_payload : kFirstFramePayload;
   for (Channel& ch : ch_) {
     if (ch.txr != nullptr) ch.txr->wnd_end = ch.txr->base + (ch.peer_rx == Mode::reliable ? ch.peer_window : 0);
     if (ch.rxr != nullptr) {
@@ -265,9 +310,11 @@ void Link::on_hello(const uint8_t* p, size_t n) {
   const uint32_t echo = get32(p + 8);
   const uint16_t max_payload = get16(p + 12);
   const uint8_t count = p[14];
+  const uint16_t line_bytes = get16(p + 16);
   const bool peer_device = (flags & kHelloFlagDevice) != 0;
   if (nonce == 0 || count > kMaxChannelId + 1 || n != kHelloFixedBytes + kHelloChannelBytes * count ||
-      peer_device == (cfg_.role == Role::device) || max_payload < kMinFramePayload) {
+      peer_device == (cfg_.role == Role::device) || max_payload < kMinFramePayload ||
+      (line_bytes != 0 && line_bytes < 2 * kLineReserve)) {
     ++stats_.bad_hello;
     return;
   }
@@ -275,6 +322,7 @@ void Link::on_hello(const uint8_t* p, size_t n) {
   if (established_) {
     if (nonce == peer_nonce_ && echo == my_nonce_) {
       if (!peer_established) hello_due_ = true;
+      else peer_est_ = true;
       return;
     }
     end_session(ResetReason::peer_restarted);
@@ -282,6 +330,7 @@ void Link::on_hello(const uint8_t* p, size_t n) {
   peer_nonce_ = nonce;
   peer_caps_ = p[3];
   peer_max_payload_ = max_payload;
+  peer_line_bytes_ = line_bytes;
   for (Channel& ch : ch_) {
     ch.peer_rx = Mode::none;
     ch.peer_window = 0;
@@ -298,6 +347,7 @@ void Link::on_hello(const uint8_t* p, size_t n) {
     ch_[e[0]].peer_window = w;
   }
   if (echo == my_nonce_) establish();
+  if (established_ && peer_established) peer_est_ = true;
   if (!(peer_established && established_)) hello_due_ = true;
 }
 
@@ -324,6 +374,7 @@ void Link::on_frame(const RxFrame& f) {
     ++stats_.bad_session;
     return;
   }
+  peer_est_ = true;  // only an established peer tags its frames
   Channel& ch = ch_[c];
   switch (f.header.type) {
     case FrameType::data:
@@ -376,16 +427,17 @@ void Link::receive(const uint8_t* data, size_t n, uint32_t now_ms) {
     const size_t k = rx_.push(data, n, &ev, &f);
     data += k;
     n -= k;
+    rx_wire_ += static_cast<uint32_t>(k);  // a frame's delimiter is counted before it is handled
     switch (ev) {
       case RxEvent::frame:
         ++stats_.frames_ok;
         heard_ms_ = now_ms;
         on_frame(f);
         break;
-      case RxEvent::too_long: ++stats_.too_long; break;
-      case RxEvent::bad_cobs: ++stats_.bad_cobs; break;
-      case RxEvent::too_short: ++stats_.too_short; break;
-      case RxEvent::bad_crc: ++stats_.bad_crc; break;
+      case RxEvent::too_long: ++stats_.too_long; damaged_ = true; break;
+      case RxEvent::bad_cobs: ++stats_.bad_cobs; damaged_ = true; break;
+      case RxEvent::too_short: ++stats_.too_short; damaged_ = true; break;
+      case RxEvent::bad_crc: ++stats_.bad_crc; damaged_ = true; break;
       case RxEvent::none:
       case RxEvent::empty: break;
     }
@@ -402,9 +454,25 @@ void Link::poll(uint32_t now_ms) {
     }
     return;
   }
+  // Acks: a delayed one falls due; a damaged frame was taken off the line
+  // (report the line at once on every channel that carries data to us, so
+  // the sender learns of the loss in one round trip); keepalives, only on
+  // channels that have carried data (the others' windows went in the
+  // HELLO), or on the first channel if none has, so the peer still hears
+  // from us and the line report still travels.
+  bool any = false;
   for (Channel& ch : ch_) {
-    if (ch.rxr != nullptr && now_ms - ch.rxr->last_ack_ms >= cfg_.keepalive_ms) ch.rxr->ack_due = true;
+    if (ch.rxr != nullptr && ch.rxr->held != 0 && now_ms - ch.rxr->held_since_ms >= kAckDelayMs) ch.rxr->ack_due = true;
+    if (ch.rxr == nullptr || ch.rxr->nxt == 0) continue;
+    any = true;
+    if (now_ms - ch.rxr->last_ack_ms >= cfg_.keepalive_ms || damaged_) ch.rxr->ack_due = true;
   }
+  for (Channel& ch : ch_) {
+    if (any || ch.rxr == nullptr) continue;
+    if (now_ms - ch.rxr->last_ack_ms >= cfg_.keepalive_ms) ch.rxr->ack_due = true;
+    break;
+  }
+  damaged_ = false;
   check_timeouts();
 }
 
@@ -450,6 +518,7 @@ bool Link::build_hello() {
   }
   p[14] = count;
   p[15] = 0;
+  put16(p + 16, cfg_.rx_line_bytes);
   FrameHeader h;
   h.type = FrameType::hello;
   return emit(h, p, kHelloFixedBytes + kHelloChannelBytes * count);
@@ -464,6 +533,11 @@ bool Link::build_next_frame() {
     if (build_hello()) return true;
   }
   if (!established_) return false;
+  if (probe_due_ && build_probe()) return true;
+  // Acks and datagrams are never held back for new data, but they too
+  // wait when the peer's line buffer is full (a paused peer).
+  if (!line_has_room(frame_wire_bound(kAckMaxPayload > kHelloMaxPayload ? kAckMaxPayload : kHelloMaxPayload) + 1, true))
+    return false;
   for (uint8_t i = 0; i < kChannels; ++i) {
     if (ch_[i].rxr != nullptr && ch_[i].rxr->ack_due && build_ack(i)) return true;
   }
@@ -506,6 +580,7 @@ size_t Link::transmit(uint8_t* out, size_t max, uint32_t now_ms) {
     memcpy(out + w, txf_ + txf_pos_, k);
     txf_pos_ += k;
     w += k;
+    tx_wire_ += static_cast<uint32_t>(k);
     if (txf_pos_ == txf_len_) frame_left();
   }
   stats_.tx_bytes += w;

@@ -173,10 +173,12 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     Client cli(2 * chunk + hdr.workspace_bytes + 64);
     FaultConfig up = o.faults;
     up.seed = o.faults.seed + 0x5EED;
-    LinkSim sim(o.baud, o.faults, up, host_config(seed), device_config(seed + 1));
+    const uint16_t line = o.drain.ring_bytes != 0 ? static_cast<uint16_t>(o.drain.ring_bytes) : 4096;
+    LinkSim sim(o.baud, o.faults, up, host_config(seed), device_config(seed + 1, line), 1, o.drain);
     rep.simulated = true;
     // Simulated time is free; still bound it so a broken link cannot spin forever.
-    const uint64_t limit_ms = 1000ull * (60 + stream.size() * 10 * 200 / o.baud);
+    const uint64_t rate = o.drain.ring_bytes != 0 && o.drain.rate_permille != 0 ? o.drain.rate_permille : 1000;
+    const uint64_t limit_ms = 1000ull * (60 + stream.size() * 10 * 200 / o.baud * 1000 / rate);
     while (sim.now_ms() < limit_ms) {
       srv.pump(sim.host(), sim.now_ms());
       sim.step();
@@ -190,6 +192,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     if (!srv.receipt) throw std::runtime_error("the transfer did not finish within " + std::to_string(limit_ms / 1000) + " simulated seconds");
     rep.seconds = static_cast<double>(sim.now_ms() - srv.started_ms) / 1000.0;
     rep.client = sim.device().stats();
+    if (sim.slow_device() != nullptr) rep.drain = sim.slow_device()->stats();
     rep.client_chunks = cli.chunks;
     rep.host = sim.host().stats();
     rep.sessions = sim.host().session_epoch();
@@ -199,7 +202,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     rep.client_goodbye_verified = cli.goodbye && cli.bye.verified == 1;
     rep.bytes_acked = srv.written - sim.host().unacked(channel::kStream);
   } else {
-    std::unique_ptr<Backend> b = open_backend(o.link, o.baud);
+    std::unique_ptr<Backend> b = open_backend(o.link, o.baud, o.paced);
     if (log) log("link " + b->describe() + " open; waiting for the client");
     const LinkConfig hc = host_config(seed);
     std::vector<uint64_t> ws((link_workspace_size(hc) + 7) / 8);
@@ -212,7 +215,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     uint32_t owed_at = 0;  // last time the client's stats showed frame records still to come
     std::optional<uint32_t> receipt_at, goodbye_at;  // when the report had arrived, when the Goodbye went
     constexpr uint32_t kRecordWaitMs = 5000;   // frame records missing after this are reported missing
-    constexpr uint32_t kGoodbyeWaitMs = 2000;  // a client that does not acknowledge the Goodbye by then has gone
+    constexpr uint32_t kGoodbyeWaitMs = 10000;  // a client that does not acknowledge the Goodbye by then has gone (a loaded machine may hold an emulated client back for seconds)
     bool announced = false;
     for (;;) {
       const uint32_t now = monotonic_ms();

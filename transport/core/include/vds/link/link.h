@@ -1,8 +1,10 @@
 // vds link core: one endpoint of a link session (docs/protocol.md). The same
 // code runs on the host and on the client: hello handshake with session
 // nonces, reliable in-order channels with selective-repeat ARQ (cumulative +
-// selective acks, RTO with back-off, a window the receiver sets), latest-wins
-// datagram channels, and a data frame size adapted to the observed losses.
+// selective acks, a window the receiver sets), flow control by the wire
+// bytes the receiver has taken off its line (so a slow reader makes the
+// sender wait instead of overrunning it, and delay is never taken for loss),
+// latest-wins datagram channels, and a data frame size adapted to losses.
 // No heap, no float: every buffer is carved from the caller's Arena at init
 // and all time comes from the caller's millisecond clock.
 #pragma once
@@ -18,7 +20,7 @@ namespace vds::link {
 
 // Protocol version carried in HELLO. A peer with another major version is
 // refused (no session); minor versions only add optional fields.
-constexpr uint8_t kVersionMajor = 1;
+constexpr uint8_t kVersionMajor = 2;
 constexpr uint8_t kVersionMinor = 0;
 
 constexpr uint8_t kChannels = VDS_CONFIG_LINK_CHANNELS;
@@ -26,13 +28,25 @@ constexpr uint8_t kRxRanges = VDS_CONFIG_LINK_RX_RANGES;
 constexpr uint32_t kMaxWindow = VDS_CONFIG_LINK_MAX_WINDOW;
 static_assert(kChannels <= kMaxChannelId + 1, "channel ids are 4 bits");
 
-// HELLO payload: 16 fixed bytes, then 4 bytes per channel the sender receives.
-constexpr size_t kHelloFixedBytes = 16;
+// HELLO payload: 18 fixed bytes, then 4 bytes per channel the sender receives.
+constexpr size_t kHelloFixedBytes = 18;
 constexpr size_t kHelloChannelBytes = 4;
 constexpr size_t kHelloMaxPayload = kHelloFixedBytes + kHelloChannelBytes * kChannels;
-// ACK payload: 2-byte window, then up to 3 selective-ack blocks of 4 bytes.
+// ACK payload: 2-byte window, 5-byte line report (the last data frame taken
+// off the line intact and the wire bytes taken since), then up to 3
+// selective-ack blocks of 4 bytes.
 constexpr uint8_t kSackBlocks = 3;
-constexpr size_t kAckMaxPayload = 2 + 4 * kSackBlocks;
+constexpr size_t kAckFixedBytes = 7;
+constexpr size_t kAckMaxPayload = kAckFixedBytes + 4 * kSackBlocks;
+// Of a peer's line buffer, what new data leaves free for frames the sender
+// does not hold back (acks, datagrams, a hello) and for retransmission probes.
+constexpr uint16_t kLineReserve = 128;
+// Delayed acknowledgement: in-order data is acknowledged every second frame
+// or this long after the first unacknowledged one; anything else at once.
+constexpr uint8_t kAckEveryFrames = 2;
+constexpr uint32_t kAckDelayMs = 10;
+// Data frame payload of a new session until its first frame is acknowledged.
+constexpr uint16_t kFirstFramePayload = 128;
 // Smallest data frame payload the adaptation may choose, and the largest a
 // frame may carry (the 16-bit window arithmetic needs far less than 32 KiB).
 constexpr uint16_t kMinFramePayload = 8;
@@ -77,9 +91,13 @@ struct LinkConfig {
   uint16_t max_tx_payload = 1024;  // largest data frame payload it sends
   uint16_t min_tx_payload = 16;    // the adaptation never goes below this
   bool adaptive = true;            // adapt the data frame size to observed losses
-  uint16_t rto_initial_ms = 1000;  // before the first round-trip sample (RFC 6298)
-  uint16_t rto_min_ms = 10;
+  uint16_t rto_initial_ms = 1000;  // before the first round-trip sample of a data frame (RFC 6298)
+  uint16_t rto_min_ms = 50;
   uint16_t rto_max_ms = 4000;  // cap of the exponential back-off
+  // Wire bytes this endpoint can hold between its line and receive() (a
+  // UART receive ring), declared in HELLO: the peer never has more than
+  // this on the line unread. 0 = no limit (a host reading a pipe).
+  uint16_t rx_line_bytes = 0;
   uint16_t hello_interval_ms = 250;
   uint16_t keepalive_ms = 500;  // an idle receiver repeats its ack this often
   ChannelConfig channels[kChannels] = {};
@@ -93,7 +111,17 @@ struct Segment {
   SegState state;
   uint8_t tries;
   uint32_t sent_ms;
-  uint32_t order;  // transmission order of its last copy (loss detection)
+  uint32_t order;  // transmission order of its last copy
+  bool taken;      // the peer has taken its last copy off the line (accepted or not)
+};
+// One data frame on the line, in transmission order (the pipe keeps order):
+// where its last byte lies in this endpoint's count of wire bytes sent.
+struct Sent {
+  uint32_t wire_end;
+  uint32_t order;
+  uint16_t seq;  // low 16 bits of its offset, as the peer echoes it
+  uint8_t ch;
+  bool probe;    // a probe after an RTO (a few bytes, not a whole frame)
 };
 struct TxReliable {
   uint8_t* ring;
@@ -123,6 +151,8 @@ struct RxReliable {
   uint8_t range_count;
   uint8_t latest;  // range holding the newest arrival, reported first
   bool ack_due;
+  uint8_t held;  // in-order frames received since the last ack (delayed ack)
+  uint32_t held_since_ms;
 };
 struct TxDatagram {
   uint8_t* buf;
@@ -146,6 +176,14 @@ struct Channel {
 };
 
 constexpr size_t carve(size_t bytes, size_t align) { return bytes + align - 1; }
+// Entries of the sent-frame log: every frame in flight on every channel, and
+// the retransmission probes (one per segment at most).
+constexpr size_t sent_log_entries(const LinkConfig& c) {
+  size_t n = 0;
+  for (const ChannelConfig& ch : c.channels)
+    if (ch.tx == Mode::reliable) n += 2u * ch.tx_segments;
+  return n;
+}
 constexpr uint16_t max16(uint16_t a, uint16_t b) { return a > b ? a : b; }
 }  // namespace detail
 
@@ -159,7 +197,7 @@ constexpr size_t tx_frame_buffer_size(const LinkConfig& c) {
 constexpr size_t link_workspace_size(const LinkConfig& c) {
   using namespace detail;
   size_t n = carve(frame_rx_buffer_size(c.max_rx_payload > kHelloMaxPayload ? c.max_rx_payload : kHelloMaxPayload), 1) +
-             carve(tx_frame_buffer_size(c), 1);
+             carve(tx_frame_buffer_size(c), 1) + carve(sizeof(Sent) * sent_log_entries(c), alignof(Sent));
   for (const ChannelConfig& ch : c.channels) {
     if (ch.tx == Mode::reliable)
       n += carve(sizeof(TxReliable), alignof(TxReliable)) + carve(ch.tx_bytes, 1) +
@@ -175,12 +213,14 @@ constexpr size_t link_workspace_size(const LinkConfig& c) {
 }
 
 // The client's configuration: a 4 x 1 KiB stream window, small upward
-// channels. Its RAM (sizeof(Link) + workspace) is the figure in
+// channels, and the board's UART receive ring (`line_bytes`) declared to the
+// host. Its RAM (sizeof(Link) + workspace) is the figure in
 // bench/results/link.md.
-constexpr LinkConfig device_config(uint32_t nonce_seed) {
+constexpr LinkConfig device_config(uint32_t nonce_seed, uint16_t line_bytes = 4096) {
   LinkConfig c{};
   c.role = Role::device;
   c.nonce_seed = nonce_seed;
+  c.rx_line_bytes = line_bytes;
   c.max_rx_payload = 1024;
   c.max_tx_payload = 128;
   c.channels[channel::kStream] = {Mode::none, 0, 0, Mode::reliable, 4096};
@@ -196,6 +236,7 @@ constexpr LinkConfig host_config(uint32_t nonce_seed) {
   LinkConfig c{};
   c.role = Role::host;
   c.nonce_seed = nonce_seed;
+  c.keepalive_ms = 2000;  // its acks share the line with the stream
   c.max_rx_payload = 256;
   c.max_tx_payload = 1024;
   c.channels[channel::kStream] = {Mode::reliable, 16384, 512, Mode::none, 0};
@@ -231,9 +272,11 @@ struct LinkStats {
   uint32_t frames_sent = 0;
   uint32_t data_frames_sent = 0;
   uint32_t retransmissions = 0;
-  uint32_t timeouts = 0;     // RTO expiries (each doubles the RTO up to rto_max_ms)
-  uint32_t fast_losses = 0;  // losses inferred from a later frame being acknowledged
-  uint32_t probes = 0;       // overdue frames resent on an otherwise idle line
+  uint32_t timeouts = 0;  // RTO expiries (each sends a probe and doubles the RTO up to rto_max_ms)
+  uint32_t losses = 0;    // frames the peer took off the line and did not accept (damaged or cut)
+  uint32_t probes = 0;    // small retransmissions sent when a frame's fate was unknown for an RTO
+  uint32_t spurious = 0;  // retransmitted frames the peer reported receiving twice
+  uint32_t line_waits = 0;  // times new data waited because the peer's line buffer was full
   uint64_t tx_bytes = 0;     // wire bytes sent
   uint64_t payload_sent = 0;  // reliable payload bytes sent, retransmissions included
   // Sessions.
@@ -297,6 +340,10 @@ class Link {
   uint16_t peer_max_payload() const { return peer_max_payload_; }
   // The payload size of the next new data frame (adapted to losses).
   uint16_t frame_payload() const { return frame_payload_; }
+  // Wire bytes sent that the peer may not have taken off its line yet, and
+  // the most it declared it can hold (0: no limit).
+  uint32_t line_in_flight() const { return tx_wire_ - resolved_wire_; }
+  uint16_t peer_line_bytes() const { return peer_line_bytes_; }
   uint32_t rto_ms() const { return rto_ms_; }
   uint32_t last_heard_ms() const { return heard_ms_; }
   const LinkStats& stats() const { return stats_; }
@@ -308,6 +355,7 @@ class Link {
   void establish();
   void end_session(ResetReason why);
   void reset_channels();
+  void forget_line();
   bool build_next_frame();
   bool build_hello();
   bool emit(const FrameHeader& h, const uint8_t* payload, size_t n);
@@ -322,8 +370,14 @@ class Link {
   void rtt_sample(uint32_t ms);
   void note_outcome(uint16_t len, bool lost);
   void update_frame_size();
-  void segment_acked(detail::TxReliable& t, detail::Segment& s, uint32_t* max_order);
+  void segment_acked(detail::Segment& s);
   void frame_left();
+  void on_line_report(const uint8_t* p);
+  void resolve_to(uint32_t wire);
+  void declare_taken_lost(uint8_t ch);
+  bool line_has_room(size_t wire_bytes, bool probe) const;
+  bool build_probe();
+  bool send_segment(uint8_t ch, detail::Segment& seg, bool probe);
 
   LinkConfig cfg_{};
   bool ready_ = false;
@@ -338,13 +392,14 @@ class Link {
   FrameType txf_type_ = FrameType::hello;
   uint8_t txf_channel_ = 0;
   uint32_t txf_order_ = 0;
-  uint32_t hello_sent_ms_ = 0;
-  bool hello_sent_ = false;
+  uint16_t txf_seq_ = 0;
+  bool txf_probe_ = false;
   detail::Channel ch_[kChannels];
   uint8_t rr_ = 0;  // round-robin start among sending channels
   uint32_t now_ = 0;
 
   bool established_ = false;
+  bool peer_est_ = false;  // the peer is established too (it said so, or tagged a frame): data may go
   bool hello_due_ = true;
   uint32_t hello_next_ms_ = 0;
   uint32_t my_nonce_ = 0;
@@ -364,10 +419,40 @@ class Link {
   uint8_t backoff_ = 0;
   uint32_t order_ = 0;  // transmission counter of data frames
   uint32_t oldest_sent_ms_ = 0;  // no in-flight frame was sent before this
+  bool probe_due_ = false;       // the RTO fired: send one small retransmission
+
+  // The line, as the receiver reports it (flow control and loss detection).
+  // Receiving: wire bytes taken, and the last data frame taken intact.
+  uint32_t rx_wire_ = 0;
+  uint32_t echo_end_ = 0;  // rx_wire_ just after that frame's delimiter
+  uint16_t echo_seq_ = 0;
+  uint8_t echo_ch_ = 0;
+  bool echo_valid_ = false;
+  bool echo_dup_ = false;  // it carried nothing new (a retransmission that was not needed)
+  bool damaged_ = false;   // a damaged frame was taken: report the line at once
+  // Sending: wire bytes sent, how far the peer is known to have taken them,
+  // the data frames beyond that (a ring in transmission order), and the
+  // last frame the peer echoed, so later reports of it still count.
+  uint32_t tx_wire_ = 0;
+  uint32_t resolved_wire_ = 0;
+  detail::Sent* log_ = nullptr;
+  uint16_t log_cap_ = 0;
+  uint16_t log_head_ = 0;
+  uint16_t log_count_ = 0;
+  bool last_echo_valid_ = false;
+  uint8_t last_echo_ch_ = 0;
+  uint16_t last_echo_seq_ = 0;
+  uint32_t last_echo_end_ = 0;
+  uint16_t peer_line_bytes_ = 0;
+  uint32_t report_ms_ = 0;    // when the last line report arrived
+  uint32_t progress_ms_ = 0;  // when a report or an ack last moved the transfer on
+  uint32_t rto_from_ms_ = 0;  // the RTO counts from here (or the oldest frame's send)
+  bool lost_on_line_ = false;  // the peer reports but has taken nothing for an RTO
   // Loss estimate for frame-size adaptation: wire bytes of frames whose
   // fate is known, and how many of them were lost (Q8: 256 per frame).
   uint32_t est_bytes_ = 0;
   uint32_t est_lost_q8_ = 0;
+  uint32_t est_frames_q8_ = 0;  // frames whose fate is known (Q8)
   uint16_t frame_payload_ = 0;
 
   LinkStats stats_{};

@@ -16,13 +16,16 @@
 #include "vds/link/link.h"
 #include "vds/link/loopback.h"
 #include "vds/link/messages.h"
+#include "vds/link/sim.h"
 
 namespace vds::link {
 
 struct ServeOptions {
   std::string link = "loopback";  // loopback | pty:PATH | tcp:HOST:PORT | tcp-listen:PORT | usb:VID:PID
   uint32_t baud = 115200;
+  bool paced = true;         // pty and TCP: pace writes at baud (false: only the client's flow control)
   FaultConfig faults;        // loopback only: faults on both directions (seeds differ per direction)
+  DrainProfile drain;        // loopback only: a client that takes bytes off its line slowly
   uint32_t timeout_s = 0;    // real links: give up after this many seconds (0: wait forever)
   uint32_t nonce_seed = 0;   // 0: from the clock
 };
@@ -60,6 +63,7 @@ struct ServeReport {
   uint32_t client_chunks = 0;  // loopback: chunks the client's parser verified
   LinkStats host;
   LinkStats client;  // loopback only
+  DrainStats drain;  // loopback with a DrainProfile: the client's UART ring
   uint16_t final_frame_payload = 0;
 };
 
