@@ -438,6 +438,7 @@ void read_control() {
       continue;
     }
     g.goodbye = true;
+    g.link.flush_acks();  // its acknowledgement goes out before the client stops
     Line l;
     l.str("client: the host said goodbye: report ").str(bye.verified ? "verified" : "NOT verified").str(", ");
     l.dec(bye.frame_records).str(" frame records received\n");

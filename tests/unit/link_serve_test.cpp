@@ -108,6 +108,7 @@ ServeReport serve_to_pty_client(const std::vector<uint8_t>& s, bool lie, PtyClie
         while (!out->goodbye && ctl.next(dev, channel::kControl))
           out->goodbye = decode(ctl.bytes, kGoodbyeBytes, &out->bye) == Status::ok;
       }
+      dev.flush_acks();
       pump.step(monotonic_ms(), 1);  // the Goodbye's acknowledgement
     } catch (const BackendError&) {
       // the host closed the pty

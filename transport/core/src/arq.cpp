@@ -41,6 +41,7 @@ constexpr uint8_t kMaxBackoff = 16;
 constexpr uint8_t kEchoChannelMask = 0x0F;
 constexpr uint8_t kEchoValid = 0x10;      // a data frame was taken intact this session
 constexpr uint8_t kEchoDuplicate = 0x20;  // it carried nothing new
+constexpr uint8_t kAnchored = 0x40;       // no data frame yet: `after` counts from the session's first frame
 // A probe resends at most this many bytes: the tail of the oldest frame.
 constexpr uint16_t kProbePayload = 16;
 
@@ -163,9 +164,11 @@ bool Link::build_ack(uint8_t c) {
   p[1] = static_cast<uint8_t>(wnd >> 8);
   // The line report: the last data frame taken intact (any channel) and
   // the wire bytes taken after its delimiter (saturating).
-  const uint32_t after = rx_wire_ - echo_end_;
+  const uint32_t after = rx_wire_ - (echo_valid_ ? echo_end_ : anchor_end_);
   const uint16_t after16 = after > 0xFFFF ? 0xFFFF : static_cast<uint16_t>(after);
-  p[2] = echo_valid_ ? static_cast<uint8_t>(kEchoValid | (echo_dup_ ? kEchoDuplicate : 0) | echo_ch_) : 0;
+  p[2] = echo_valid_     ? static_cast<uint8_t>(kEchoValid | (echo_dup_ ? kEchoDuplicate : 0) | echo_ch_)
+         : anchor_valid_ ? kAnchored
+                         : 0;
   p[3] = static_cast<uint8_t>(echo_seq_);
   p[4] = static_cast<uint8_t>(echo_seq_ >> 8);
   p[5] = static_cast<uint8_t>(after16);
@@ -325,6 +328,13 @@ void Link::note_outcome(uint16_t len, bool lost) {
 void Link::update_frame_size() {
   uint32_t cap = cfg_.max_tx_payload;
   if (peer_max_payload_ != 0 && peer_max_payload_ < cap) cap = peer_max_payload_;
+  if (peer_line_bytes_ != 0) {
+    // A whole frame (and a leading delimiter) must fit the peer's line
+    // buffer less the reserve, or it would wait forever.
+    const uint32_t limit = peer_line_bytes_ - line_reserve(peer_line_bytes_);
+    const uint32_t fit = limit - 14 - limit / 254;
+    if (fit < cap) cap = fit;
+  }
   uint32_t fp = cap;
   if (cfg_.adaptive && est_lost_q8_ != 0 && est_frames_q8_ != 0) {
     const uint64_t h = kWireOverhead;
@@ -375,10 +385,16 @@ void Link::resolve_to(uint32_t wire) {
 // arrived, and bytes lost on the line are never counted as taken.
 void Link::on_line_report(const uint8_t* p) {
   report_ms_ = now_;
-  if ((p[0] & kEchoValid) == 0) return;
+  const uint32_t after = static_cast<uint32_t>(p[3] | p[4] << 8);
+  if ((p[0] & kEchoValid) == 0) {
+    // No data frame taken yet: the peer counts from the end of the first
+    // frame of ours it took, which lies at or after where our first one
+    // started.
+    if ((p[0] & kAnchored) != 0 && first_tagged_sent_) resolve_to(first_tagged_wire_ + after);
+    return;
+  }
   const uint8_t ch = p[0] & kEchoChannelMask;
   const uint16_t seq = static_cast<uint16_t>(p[1] | p[2] << 8);
-  const uint32_t after = static_cast<uint32_t>(p[3] | p[4] << 8);
   uint32_t base = 0;
   if (last_echo_valid_ && last_echo_ch_ == ch && last_echo_seq_ == seq) {
     base = last_echo_end_;
@@ -418,7 +434,7 @@ void Link::declare_taken_lost(uint8_t c) {
 void Link::rx_ack(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
   TxReliable& t = *ch_[c].txr;
   if (n < kAckFixedBytes || (n - kAckFixedBytes) % 4 != 0 || (n - kAckFixedBytes) / 4 > kSackBlocks ||
-      (p[2] & ~(kEchoValid | kEchoDuplicate | kEchoChannelMask)) != 0) {
+      (p[2] & ~(kEchoValid | kEchoDuplicate | kAnchored | kEchoChannelMask)) != 0) {
     ++stats_.bad_ack;
     return;
   }
@@ -507,11 +523,11 @@ void Link::check_timeouts() {
 }
 
 // Whether a frame of `wire` bytes may go now without the peer's line
-// buffer holding more than it declared. New data leaves kLineReserve for
+// buffer holding more than it declared. New data leaves line_reserve() for
 // the small frames that are never held back, and probes.
 bool Link::line_has_room(size_t wire, bool probe) const {
   if (peer_line_bytes_ == 0) return true;
-  const uint32_t limit = probe ? peer_line_bytes_ : peer_line_bytes_ - kLineReserve;
+  const uint32_t limit = probe ? peer_line_bytes_ : peer_line_bytes_ - line_reserve(peer_line_bytes_);
   return line_in_flight() + wire <= limit;
 }
 

@@ -48,7 +48,7 @@ Status Link::init(const LinkConfig& c, Arena& arena) {
       c.max_tx_payload < kMinFramePayload || c.max_tx_payload > kMaxFramePayload ||
       c.min_tx_payload < kMinFramePayload || c.min_tx_payload > c.max_tx_payload || c.rto_min_ms == 0 ||
       c.rto_initial_ms < c.rto_min_ms || c.rto_max_ms < c.rto_initial_ms || c.hello_interval_ms == 0 ||
-      c.keepalive_ms == 0 || (c.rx_line_bytes != 0 && c.rx_line_bytes < 2 * kLineReserve))
+      c.keepalive_ms == 0 || (c.rx_line_bytes != 0 && c.rx_line_bytes < kMinLineBytes))
     return Status::invalid_argument;
   for (const ChannelConfig& ch : c.channels) {
     if (ch.tx == Mode::reliable && (ch.tx_bytes == 0 || ch.tx_segments == 0)) return Status::invalid_argument;
@@ -91,6 +91,8 @@ Status Link::init(const LinkConfig& c, Arena& arena) {
   echo_seq_ = 0;
   echo_ch_ = 0;
   echo_valid_ = echo_dup_ = damaged_ = false;
+  anchor_valid_ = first_tagged_sent_ = false;
+  anchor_end_ = first_tagged_wire_ = 0;
   tx_wire_ = resolved_wire_ = 0;
   log_ = nullptr;
   log_cap_ = log_head_ = log_count_ = 0;
@@ -207,6 +209,11 @@ void Link::reset_channels() {
   }
 }
 
+void Link::flush_acks() {
+  for (Channel& ch : ch_)
+    if (ch.rxr != nullptr && ch.rxr->held != 0) ch.rxr->ack_due = true;
+}
+
 void Link::restart() {
   if (!ready_) return;
   end_session(ResetReason::local);
@@ -249,6 +256,8 @@ void Link::forget_line() {
   log_head_ = log_count_ = 0;
   last_echo_valid_ = false;
   echo_valid_ = echo_dup_ = damaged_ = false;
+  anchor_valid_ = false;
+  first_tagged_sent_ = false;
   probe_due_ = false;
 }
 
@@ -314,7 +323,7 @@ void Link::on_hello(const uint8_t* p, size_t n) {
   const bool peer_device = (flags & kHelloFlagDevice) != 0;
   if (nonce == 0 || count > kMaxChannelId + 1 || n != kHelloFixedBytes + kHelloChannelBytes * count ||
       peer_device == (cfg_.role == Role::device) || max_payload < kMinFramePayload ||
-      (line_bytes != 0 && line_bytes < 2 * kLineReserve)) {
+      (line_bytes != 0 && line_bytes < kMinLineBytes)) {
     ++stats_.bad_hello;
     return;
   }
@@ -375,6 +384,10 @@ void Link::on_frame(const RxFrame& f) {
     return;
   }
   peer_est_ = true;  // only an established peer tags its frames
+  if (!anchor_valid_) {
+    anchor_valid_ = true;
+    anchor_end_ = rx_wire_;
+  }
   Channel& ch = ch_[c];
   switch (f.header.type) {
     case FrameType::data:
@@ -488,6 +501,10 @@ bool Link::emit_parts(const FrameHeader& h, const uint8_t* a, size_t na, const u
   }
   size_t len = 0;
   if (frame_encode_parts(h, a, na, b, nb, txf_ + at, txf_cap_ - at, &len) != Status::ok) return false;
+  if (h.type != FrameType::hello && !first_tagged_sent_) {
+    first_tagged_sent_ = true;
+    first_tagged_wire_ = tx_wire_;  // the transmit buffer was empty: this frame starts here
+  }
   txf_len_ = at + len;
   txf_pos_ = 0;
   txf_type_ = h.type;

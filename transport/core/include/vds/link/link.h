@@ -39,8 +39,11 @@ constexpr uint8_t kSackBlocks = 3;
 constexpr size_t kAckFixedBytes = 7;
 constexpr size_t kAckMaxPayload = kAckFixedBytes + 4 * kSackBlocks;
 // Of a peer's line buffer, what new data leaves free for frames the sender
-// does not hold back (acks, datagrams, a hello) and for retransmission probes.
-constexpr uint16_t kLineReserve = 128;
+// does not hold back (acks, datagrams, a hello) and for retransmission
+// probes: a quarter of it, at most 128 bytes. The smallest line buffer a
+// HELLO may declare is kMinLineBytes.
+constexpr uint16_t kMinLineBytes = 256;
+constexpr uint32_t line_reserve(uint32_t line_bytes) { return line_bytes / 4 < 128 ? line_bytes / 4 : 128; }
 // Delayed acknowledgement: in-order data is acknowledged every second frame
 // or this long after the first unacknowledged one; anything else at once.
 constexpr uint8_t kAckEveryFrames = 2;
@@ -325,6 +328,11 @@ class Link {
   Status send_datagram(uint8_t ch, const uint8_t* data, size_t n);
   Status read_datagram(uint8_t ch, uint8_t* out, size_t max, size_t* got);
 
+  // Makes every acknowledgement this endpoint holds back (delayed acks) due
+  // now: for an application about to stop, whose last received message
+  // must still be acknowledged by the next transmit().
+  void flush_acks();
+
   // Ends the session (discarding unsent and undelivered data) and starts a
   // new handshake with a fresh nonce.
   void restart();
@@ -429,6 +437,10 @@ class Link {
   uint8_t echo_ch_ = 0;
   bool echo_valid_ = false;
   bool echo_dup_ = false;  // it carried nothing new (a retransmission that was not needed)
+  // Before any data frame: the end of the first frame of this session taken
+  // intact, so keepalives and acks taken before any data are reported too.
+  bool anchor_valid_ = false;
+  uint32_t anchor_end_ = 0;
   bool damaged_ = false;   // a damaged frame was taken: report the line at once
   // Sending: wire bytes sent, how far the peer is known to have taken them,
   // the data frames beyond that (a ring in transmission order), and the
@@ -444,6 +456,10 @@ class Link {
   uint16_t last_echo_seq_ = 0;
   uint32_t last_echo_end_ = 0;
   uint16_t peer_line_bytes_ = 0;
+  // Where this session's first tagged frame started on our line: the peer's
+  // anchor lies at or after its end.
+  bool first_tagged_sent_ = false;
+  uint32_t first_tagged_wire_ = 0;
   uint32_t report_ms_ = 0;    // when the last line report arrived
   uint32_t progress_ms_ = 0;  // when a report or an ack last moved the transfer on
   uint32_t rto_from_ms_ = 0;  // the RTO counts from here (or the oldest frame's send)
