@@ -1,0 +1,213 @@
+// vds::Player: the client's one path from stream bytes to display bands.
+// The firmware, the host replay (`vds frames`, `vds decode-image`), the
+// benchmarks and the tests all drive it with the same configuration.
+//
+// CONTRACT
+// - init(arena, config, callbacks) carves the stream parser (its chunk
+//   buffer, config.max_chunk_bytes) from the arena. Everything a stream
+//   needs later is carved from what the arena has left, when the stream's
+//   header (and, for a model, its mesh header) says how much: the plan
+//   (plan()) is known before any payload is decoded. To play another
+//   stream, rewind the arena to where it was and call init again.
+// - feed(bytes, n) takes any piece size (one byte at a time included). It
+//   returns more_input while the stream goes on; ok once the stream's END
+//   is read, or as soon as a model client knows its workspace holds no
+//   more levels (workspace_full(): the rest of the stream is not needed);
+//   otherwise the first error, latched (error_offset(), error_detail()).
+// - Every displayed frame is: begin_frame(width, height), then band() for
+//   each band top to bottom (at most config.band_rows rows: a model's are
+//   band_rows high but the last, an image's one MCU row, 16 rows of 4:2:0,
+//   8 of 4:4:4 or grey), full width, RGB565 little-endian (bit 15..11 red,
+//   10..5 green, 4..0 blue), never outside the frame, then end_frame(crc) and
+//   frame_shown(record). The record's CRC-32C covers the frame's rows as
+//   displayed, top to bottom; its instruction counts come from the clock
+//   callback (0 without one): parse (chunk framing and CRCs), decode
+//   (entropy decoding + inverse transform + colour, or mesh decoding),
+//   display (bands, end_frame and, for a model, the drawing), with the
+//   image decoder's entropy and transform split out.
+// - A callback returning false aborts: feed returns Status::aborted.
+// - service() is called after every band and every
+//   config.mesh_service_items mesh items, to keep I/O moving while a frame
+//   is decoded or drawn; its time counts in no stage. It must not call the
+//   player.
+// - notice() tells the caller what the player decided about a model that
+//   does not fit (vertices held of the stream's, the level after which the
+//   workspace is full, the bytes a base mesh needs); the caller words it.
+// - send_up() is the back-channel for what the client sends upstream
+//   (poses, reports); modes that talk back use it.
+// Bit-exact: the same stream and configuration give the same bands on
+// every platform. No heap, no float, no exceptions.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include "vds/arena.h"
+#include "vds/container.h"
+#include "vds/image.h"
+#include "vds/mesh.h"
+#include "vds/model_view.h"
+#include "vds/status.h"
+
+namespace vds {
+
+struct PlayerConfig {
+  // Rows per display band: a multiple of 16 (one 4:2:0 MCU row), 16..256.
+  // The band buffer costs width x band_rows x 2 bytes.
+  uint16_t band_rows = 16;
+  // Largest chunk payload accepted: the parser's buffer, carved at init.
+  uint32_t max_chunk_bytes = 4096;
+  // Model streams: service() every this many mesh items (0: never).
+  uint32_t mesh_service_items = 64;
+};
+
+// What the client boards use. The host replay of a client uses it too, with
+// max_chunk_bytes sized to the stream (the chunk buffer changes no pixel).
+constexpr PlayerConfig kClientPlayerConfig{};
+
+// One displayed frame.
+struct PlayedFrame {
+  uint32_t index = 0;  // 0, 1, 2, ... in display order
+  uint32_t crc = 0;    // CRC-32C of its RGB565 rows, top to bottom
+  uint64_t parse = 0, decode = 0, display = 0;
+  uint64_t entropy = 0, transform = 0;  // of decode (images)
+};
+
+// What a notice reports; the values a, b, c are listed per kind.
+enum class PlayerNotice : uint8_t {
+  model_partial = 1,       // the workspace holds a (vertices) of the model's b: later levels are skipped
+  model_full = 2,          // the workspace is full after level a of b (c vertices): the rest is not needed
+  model_base_too_big = 3,  // the base mesh needs a bytes of workspace, b are left: the stream is refused
+};
+
+struct PlayerCallbacks {
+  void* ctx = nullptr;
+  bool (*begin_frame)(void* ctx, uint16_t width, uint16_t height) = nullptr;
+  bool (*band)(void* ctx, const PixelRect& rows) = nullptr;
+  bool (*end_frame)(void* ctx, uint32_t crc) = nullptr;
+  void (*frame_shown)(void* ctx, const PlayedFrame& frame) = nullptr;
+  void (*service)(void* ctx) = nullptr;
+  uint64_t (*clock)(void* ctx) = nullptr;
+  void (*notice)(void* ctx, PlayerNotice what, uint32_t a, uint32_t b, uint32_t c) = nullptr;
+  bool (*send_up)(void* ctx, uint8_t kind, const uint8_t* data, size_t n) = nullptr;
+};
+
+// The workspace plan of the stream being played.
+struct PlayerPlan {
+  bool known = false;        // the header (and a model's mesh header) has been read
+  size_t needs = 0;          // bytes the whole stream needs beyond the parser
+  size_t available = 0;      // bytes the arena had left for it
+  uint32_t vertices = 0;     // model: vertices the workspace holds ...
+  uint32_t of_vertices = 0;  // ... of the stream's
+};
+
+class Player;
+
+namespace detail {
+// One mode of play (decoder/src/player/): what the stream header's mode
+// selects. A new mode is a new file defining one of these and a line in
+// the mode table (player.cpp).
+struct PlayerMode {
+  StreamMode mode;
+  // At HEAD: set up what the mode needs from the arena. false refuses.
+  bool (*start)(Player& p, const StreamHeader& h);
+  // Every verified chunk after HEAD.
+  ChunkResult (*chunk)(Player& p, uint32_t type, const uint8_t* payload, uint32_t size);
+  // Most stream bytes to feed at once when `frames_room` more frames may
+  // complete (0: no limit of the mode's own).
+  size_t (*feed_limit)(const Player& p, uint32_t frames_room);
+};
+}  // namespace detail
+
+class Player {
+ public:
+  // Workspace an image stream of frames `width` pixels wide needs beyond the
+  // parser: the image decoder and the band buffer (what its HEAD declares).
+  static size_t image_workspace_bytes(uint16_t width, const PlayerConfig& config);
+
+  Status init(Arena& arena, const PlayerConfig& config, const PlayerCallbacks& callbacks);
+  Status feed(const uint8_t* data, size_t n);
+  // The caller has no more bytes: ok if the stream ended (or was full).
+  Status finish();
+
+  // The most bytes feed() should take next so that no more than
+  // `frames_room` frames complete (a caller with a bounded queue of frame
+  // records); SIZE_MAX when the mode puts no limit.
+  size_t feed_limit(uint32_t frames_room) const;
+
+  bool have_header() const { return parser_.have_header(); }
+  const StreamHeader& header() const { return parser_.header(); }
+  const PlayerPlan& plan() const { return plan_; }
+  bool workspace_full() const { return full_; }
+  uint32_t frames_shown() const { return frames_; }
+  uint64_t error_offset() const { return parser_.error_offset(); }
+  const char* error_detail() const { return error_detail_ != nullptr ? error_detail_ : parser_.error_detail(); }
+  uint32_t chunks() const { return parser_.chunks(); }
+
+  // --- For the modes (decoder/src/player/) ---------------------------------
+  Arena& arena() { return *arena_; }
+  const PlayerConfig& config() const { return config_; }
+  const PlayerCallbacks& callbacks() const { return cb_; }
+  // The clock less the time in service(): what every stage count reads.
+  uint64_t work_clock() const;
+  // Chunk bookkeeping: a mode calls enter_chunk() first (parse time up to
+  // here is counted) and leave_chunk() last. A frame's counts run from the
+  // end of the previous frame unless the mode calls restart_counts() (an
+  // image's counts start at its header chunk: `parse_from` is the parse
+  // total to charge it from); begin_frame() opens a frame, band() shows one
+  // band, end_frame() closes the frame and reports it.
+  uint64_t enter_chunk();
+  void leave_chunk();
+  void restart_counts(uint64_t parse_from);
+  bool begin_frame();
+  bool band(const PixelRect& r);
+  bool end_frame();
+  void add_decode(uint64_t n) { decode_total_ += n; }
+  void add_display(uint64_t n) { display_total_ += n; }
+  uint64_t display_total() const { return display_total_; }
+  uint64_t parse_total() const { return parse_total_; }
+  void set_full() { full_ = true; }
+  void set_plan(const PlayerPlan& p) { plan_ = p; }
+  // A mode's own failure: feed() returns `s` (not the parser's "aborted").
+  void fail(Status s, const char* detail) {
+    mode_status_ = s;
+    error_detail_ = detail;
+  }
+  void notice(PlayerNotice what, uint32_t a, uint32_t b, uint32_t c) const {
+    if (cb_.notice != nullptr) cb_.notice(cb_.ctx, what, a, b, c);
+  }
+  void service();
+  StageClock& stages() { return stages_; }
+  bool counting() const { return cb_.clock != nullptr; }
+
+  // Mode state. Only the mode the header selects is used.
+  ImageDecoder image;
+  uint8_t* band_buffer = nullptr;
+  MeshDecoder mesh;
+  ModelView view;
+  ModelFrames model_frames;
+  bool model_started = false;
+
+ private:
+  static bool on_header(void* ctx, const StreamHeader& h);
+  static ChunkResult on_chunk(void* ctx, uint32_t type, const uint8_t* payload, uint32_t size);
+
+  Arena* arena_ = nullptr;
+  PlayerConfig config_{};
+  PlayerCallbacks cb_{};
+  StreamParser parser_;
+  const detail::PlayerMode* mode_ = nullptr;
+  PlayerPlan plan_{};
+  bool full_ = false;
+  const char* error_detail_ = nullptr;
+  Status mode_status_ = Status::ok;
+  StageClock stages_{};
+  uint64_t service_total_ = 0;
+  uint64_t parse_total_ = 0, decode_total_ = 0, display_total_ = 0;
+  uint64_t feed_mark_ = 0;
+  PlayedFrame at_start_{};  // the totals a frame's counts start from
+  uint32_t frame_crc_ = 0;
+  bool in_frame_ = false;
+  uint32_t frames_ = 0;
+};
+
+}  // namespace vds
