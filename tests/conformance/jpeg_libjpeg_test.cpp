@@ -25,7 +25,7 @@
 #include <vector>
 
 #include <dlfcn.h>
-#include <stb/stb_image.h>
+#include <zip.h>
 
 #include "vds/enc/image_codec.h"
 #include "vds/enc/image_io.h"
@@ -88,38 +88,23 @@ Image crop_rgb(const Image& src, int w, int h) {
 }
 
 // A member of a zip archive (stored or deflated), for the OpenArena pk3.
+// One member of a zip archive (a .pk3), read with libzip; empty if absent.
 std::vector<uint8_t> zip_member(const std::string& zip, const std::string& name) {
-  std::vector<uint8_t> z;
-  try {
-    z = vds::enc::read_file(zip);
-  } catch (const std::exception&) {
-    return {};
+  int err = 0;
+  zip_t* z = zip_open(zip.c_str(), ZIP_RDONLY, &err);
+  if (z == nullptr) return {};
+  std::vector<uint8_t> v;
+  zip_stat_t st;
+  zip_stat_init(&st);
+  if (zip_stat(z, name.c_str(), 0, &st) == 0 && (st.valid & ZIP_STAT_SIZE) != 0 && st.size < (64u << 20)) {
+    if (zip_file_t* f = zip_fopen(z, name.c_str(), 0)) {
+      v.resize(st.size);
+      if (zip_fread(f, v.data(), v.size()) != static_cast<zip_int64_t>(v.size())) v.clear();
+      zip_fclose(f);
+    }
   }
-  const auto u16 = [&](size_t i) { return static_cast<uint32_t>(z[i] | (z[i + 1] << 8)); };
-  const auto u32 = [&](size_t i) { return u16(i) | (u16(i + 2) << 16); };
-  // End of central directory: the last "PK\5\6".
-  size_t eocd = z.size() >= 22 ? z.size() - 22 : 0;
-  while (eocd > 0 && u32(eocd) != 0x06054b50u) --eocd;
-  if (u32(eocd) != 0x06054b50u) return {};
-  size_t at = u32(eocd + 16);
-  for (uint32_t i = 0, n = u16(eocd + 10); i < n && at + 46 <= z.size(); ++i) {
-    const uint32_t method = u16(at + 10), csize = u32(at + 20), usize = u32(at + 24);
-    const uint32_t nlen = u16(at + 28), elen = u16(at + 30), clen = u16(at + 32), local = u32(at + 42);
-    const std::string member(reinterpret_cast<const char*>(&z[at + 46]), nlen);
-    at += 46 + nlen + elen + clen;
-    if (member != name) continue;
-    const size_t data = local + 30 + u16(local + 26) + u16(local + 28);
-    if (data + csize > z.size()) return {};
-    if (method == 0) return std::vector<uint8_t>(z.begin() + data, z.begin() + data + csize);
-    if (method != 8) return {};
-    int len = 0;
-    char* out = stbi_zlib_decode_noheader_malloc(reinterpret_cast<const char*>(&z[data]), static_cast<int>(csize), &len);
-    if (out == nullptr || static_cast<uint32_t>(len) != usize) return {};
-    std::vector<uint8_t> v(out, out + len);
-    std::free(out);
-    return v;
-  }
-  return {};
+  zip_close(z);
+  return v;
 }
 
 struct Source {
@@ -132,18 +117,21 @@ std::vector<Source> sources() {
   s.push_back({"synth61x47", synth(61, 47, 1)});
   s.push_back({"synth240x180", synth(240, 180, 2)});
   s.push_back({"synth17x130", synth(17, 130, 3)});
+  // Real textures: make test installs them (scripts/fetch-data.sh); a
+  // missing one fails the test rather than quietly shrinking it.
   const std::string glmark = "/usr/share/glmark2/textures/";
   for (const char* f : {"crate-base.png", "nasa1.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(glmark + f)) << glmark << f << " not installed (glmark2-data)";
     if (!std::filesystem::exists(glmark + f)) continue;
     s.push_back({f, crop_rgb(vds::enc::load_image(glmark + f), 160, 120)});
   }
   const std::string pk3 = "/usr/share/games/openarena/baseoa/pak4-textures.pk3";
   for (const char* m : {"textures/base_wall/concrete_ow.tga", "textures/czest3ctf/grass_lush.tga"}) {
     const std::vector<uint8_t> bytes = zip_member(pk3, m);
+    EXPECT_FALSE(bytes.empty()) << m << " not found in " << pk3 << " (openarena-081-textures)";
     if (bytes.empty()) continue;
     s.push_back({m, crop_rgb(vds::enc::decode_image(bytes.data(), bytes.size(), m), 128, 160)});
   }
-  if (s.size() < 5) std::printf("note: glmark2/OpenArena textures not installed; synthetic images only\n");
   return s;
 }
 
@@ -250,8 +238,8 @@ Compare compare(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
 class JpegConformance : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!have_tool("cjpeg") || !have_tool("djpeg"))
-      GTEST_SKIP() << "cjpeg/djpeg (libjpeg-turbo-progs) not installed: run scripts/setup.sh";
+    ASSERT_TRUE(have_tool("cjpeg") && have_tool("djpeg"))
+        << "cjpeg/djpeg (libjpeg-turbo-progs) not installed: run scripts/setup.sh";
     std::filesystem::create_directories(kTmp);
   }
 };
@@ -267,7 +255,7 @@ TEST_F(JpegConformance, MatchesLibjpegTurbo) {
                               {"2x1", "-restart 2B", false}, {"1x1", "", true}};
   const int qualities[] = {5, 50, 75, 100};
   const TurboJpeg turbo;
-  if (!turbo.ok()) std::printf("note: libturbojpeg.so.0 not loadable; chroma planes compared through RGB only\n");
+  ASSERT_TRUE(turbo.ok()) << "libturbojpeg.so.0 not loadable (libturbojpeg0-dev): the chroma planes cannot be compared";
   int files = 0, worst = 0, worst_y = 0, worst_planes = 0;
   double worst_psnr = 99;
   for (const Source& src : sources()) {

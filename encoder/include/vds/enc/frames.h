@@ -33,9 +33,9 @@ Image fit_image(const Image& img, int w, int h);
 // header's max_chunk_payload and workspace_bytes are what the frames need.
 FrameSequenceResult encode_frames(const std::vector<Image>& frames, const FrameSequenceOptions& o);
 
-// What a client shows: decodes every frame of an images-mode stream through
-// the client library into RGB565 bands, as firmware_sim/app/client.cpp does,
-// and returns each frame's CRC-32C (and its pixels if `frames` is given).
+// What a client shows: plays the stream (any mode the client plays) through
+// the client's player (vds/player.h) with the boards' configuration, and
+// returns each frame's CRC-32C (and its pixels if `frames` is given).
 // Throws std::runtime_error naming the client status on a bad stream.
 std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames = nullptr);
 

@@ -1,0 +1,169 @@
+// vds::Player (vds/player.h), the client's one path from stream bytes to
+// display bands: the same frames whatever the piece size; bands inside the
+// frame and no taller than configured; a callback's false aborts; a mode
+// the client does not play is refused at the header; a model larger than
+// the workspace plays the levels that fit, says so, and ends early.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "mesh_test_meshes.h"
+#include "vds/enc/frames.h"
+#include "vds/enc/mesh_encoder.h"
+#include "vds/enc/stream_writer.h"
+#include "vds/player.h"
+#include "xorshift.h"
+
+namespace {
+
+using vds::Status;
+
+std::vector<uint8_t> image_stream() {
+  std::vector<vds::enc::Image> frames;
+  for (int f = 0; f < 3; ++f) {
+    vds::enc::Image im(64, 48, 3);
+    for (int y = 0; y < im.height; ++y)
+      for (int x = 0; x < im.width; ++x)
+        for (int c = 0; c < 3; ++c) im.at(x, y, c) = static_cast<uint8_t>((x * (c + 1) * 5 + y * 3 + f * 40) & 0xFF);
+    frames.push_back(im);
+  }
+  vds::enc::FrameSequenceOptions o;
+  o.width = 64;
+  o.height = 48;
+  return vds::enc::encode_frames(frames, o).stream;
+}
+
+// What a caller sees of a play.
+struct Seen {
+  std::vector<uint32_t> crcs;
+  uint32_t begun = 0, ended = 0, bands = 0;
+  bool band_outside = false, band_too_tall = false, band_in_no_frame = false;
+  uint16_t width = 0, height = 0;
+  uint16_t band_rows = 16;
+  int abort_at_band = -1;
+  std::vector<std::pair<vds::PlayerNotice, uint32_t>> notices;
+};
+
+vds::PlayerCallbacks callbacks(Seen& s) {
+  vds::PlayerCallbacks cb;
+  cb.ctx = &s;
+  cb.begin_frame = [](void* ctx, uint16_t w, uint16_t h) {
+    auto& v = *static_cast<Seen*>(ctx);
+    ++v.begun;
+    v.width = w;
+    v.height = h;
+    return true;
+  };
+  cb.band = [](void* ctx, const vds::PixelRect& r) {
+    auto& v = *static_cast<Seen*>(ctx);
+    if (v.begun == v.ended) v.band_in_no_frame = true;
+    if (r.x != 0 || r.w != v.width || r.y + r.h > v.height) v.band_outside = true;
+    if (r.h > v.band_rows) v.band_too_tall = true;
+    return static_cast<int>(v.bands++) != v.abort_at_band;
+  };
+  cb.end_frame = [](void* ctx, uint32_t) {
+    ++static_cast<Seen*>(ctx)->ended;
+    return true;
+  };
+  cb.frame_shown = [](void* ctx, const vds::PlayedFrame& f) { static_cast<Seen*>(ctx)->crcs.push_back(f.crc); };
+  cb.notice = [](void* ctx, vds::PlayerNotice n, uint32_t a, uint32_t, uint32_t) {
+    static_cast<Seen*>(ctx)->notices.emplace_back(n, a);
+  };
+  return cb;
+}
+
+// Plays `s` fed in pieces of `piece` bytes (0: random 1..300) through an
+// arena of `bytes`.
+Status play(const std::vector<uint8_t>& s, Seen& seen, size_t piece, size_t bytes = 1u << 20,
+            vds::Player* out = nullptr) {
+  std::vector<uint8_t> ws(bytes);
+  vds::Arena arena(ws.data(), ws.size());
+  static vds::Player player;
+  vds::Player& p = out != nullptr ? *out : player;
+  if (p.init(arena, vds::kClientPlayerConfig, callbacks(seen)) != Status::ok) return Status::invalid_argument;
+  vds::test::Xorshift32 rng;
+  Status st = Status::more_input;
+  for (size_t at = 0; at < s.size() && st == Status::more_input;) {
+    const size_t n = std::min(s.size() - at, piece != 0 ? piece : 1 + rng.next() % 300);
+    st = p.feed(s.data() + at, n);
+    at += n;
+  }
+  if (st == Status::more_input) st = p.finish();
+  return st;
+}
+
+TEST(Player, SameFramesWhateverThePieceSize) {
+  const std::vector<uint8_t> s = image_stream();
+  const std::vector<uint32_t> want = vds::enc::client_frame_crcs(s);
+  ASSERT_EQ(want.size(), 3u);
+  for (size_t piece : {size_t{0}, size_t{1}, size_t{7}, size_t{256}, s.size()}) {
+    Seen seen;
+    ASSERT_EQ(play(s, seen, piece), Status::ok) << piece;
+    EXPECT_EQ(seen.crcs, want) << piece;
+    EXPECT_EQ(seen.begun, 3u);
+    EXPECT_EQ(seen.ended, 3u);
+    EXPECT_EQ(seen.bands, 3u * 3u) << "48 rows of 4:2:0: three bands of 16 per frame";
+    EXPECT_FALSE(seen.band_outside);
+    EXPECT_FALSE(seen.band_too_tall);
+    EXPECT_FALSE(seen.band_in_no_frame);
+  }
+}
+
+TEST(Player, ACallbackReturningFalseAborts) {
+  const std::vector<uint8_t> s = image_stream();
+  for (int at : {0, 4, 8}) {
+    Seen seen;
+    seen.abort_at_band = at;
+    EXPECT_EQ(play(s, seen, 100), Status::aborted) << at;
+    EXPECT_EQ(seen.bands, static_cast<uint32_t>(at + 1)) << "nothing drawn after the refusal";
+  }
+}
+
+TEST(Player, EveryPrefixFailsCleanlyOnlyTheWholeSucceeds) {
+  const std::vector<uint8_t> s = image_stream();
+  for (size_t n = 0; n < s.size(); n += 37) {
+    Seen seen;
+    const std::vector<uint8_t> cut(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(n));
+    EXPECT_EQ(play(cut, seen, 64), Status::truncated) << n;
+  }
+}
+
+TEST(Player, AModeTheClientDoesNotPlayIsRefusedAtTheHeader) {
+  vds::StreamHeader h = vds::enc::default_header(vds::StreamMode::terrain, 64, 48);
+  vds::enc::StreamWriter w(h);
+  const std::vector<uint8_t> s = w.finish();
+  Seen seen;
+  vds::Player p;
+  EXPECT_EQ(play(s, seen, 16, 1u << 20, &p), Status::unsupported_feature);
+  EXPECT_EQ(seen.begun, 0u);
+}
+
+TEST(Player, AModelLargerThanTheWorkspacePlaysWhatFitsAndEndsEarly) {
+  vds::enc::MeshEncodeOptions o;
+  const vds::enc::MeshEncodeResult r = vds::enc::encode_mesh(vds::test::torus_mesh(40, 20), o);
+  const std::vector<uint32_t> want = vds::enc::client_frame_crcs(r.stream);
+  ASSERT_GT(want.size(), 3u);
+  Seen whole;
+  ASSERT_EQ(play(r.stream, whole, 0, 8u << 20), Status::ok);
+  ASSERT_EQ(whole.crcs, want);
+  // Find a workspace that holds the base but not the whole model.
+  bool partial_seen = false;
+  for (size_t bytes = 24u << 10; bytes < (4u << 20) && !partial_seen; bytes += bytes / 4) {
+    Seen seen;
+    vds::Player p;
+    const Status st = play(r.stream, seen, 0, bytes, &p);
+    if (st != Status::ok) continue;  // not even the base
+    if (seen.crcs.size() == want.size()) break;
+    partial_seen = true;
+    EXPECT_TRUE(p.workspace_full());
+    EXPECT_TRUE(p.plan().known);
+    EXPECT_LT(p.plan().vertices, p.plan().of_vertices);
+    EXPECT_EQ(seen.crcs, std::vector<uint32_t>(want.begin(), want.begin() + static_cast<std::ptrdiff_t>(seen.crcs.size())));
+    ASSERT_EQ(seen.notices.size(), 2u);
+    EXPECT_EQ(seen.notices[0].first, vds::PlayerNotice::model_partial);
+    EXPECT_EQ(seen.notices[1].first, vds::PlayerNotice::model_full);
+  }
+  EXPECT_TRUE(partial_seen) << "some workspace holds part of the model";
+}
+
+}  // namespace
