@@ -6,6 +6,7 @@
 
 #include "vds/config.h"
 #include "vds/crc32c.h"
+#include "vds/bytes.h"
 
 namespace vds {
 namespace {
@@ -13,39 +14,27 @@ namespace {
 constexpr uint32_t kMaxFrameSide = 16384;
 constexpr uint32_t kMaxChunkPayloadLimit = 1u << 24;  // 16 MiB: far beyond any client
 
-uint16_t get_u16(const uint8_t* p) { return static_cast<uint16_t>(p[0] | (p[1] << 8)); }
-uint32_t get_u32(const uint8_t* p) {
-  return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 | static_cast<uint32_t>(p[2]) << 16 |
-         static_cast<uint32_t>(p[3]) << 24;
-}
-int32_t get_s32(const uint8_t* p) { return static_cast<int32_t>(get_u32(p)); }
-void put_u16(uint8_t* p, uint16_t v) {
-  p[0] = static_cast<uint8_t>(v);
-  p[1] = static_cast<uint8_t>(v >> 8);
-}
-void put_u32(uint8_t* p, uint32_t v) {
-  for (int i = 0; i < 4; ++i) p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
+int32_t get_s32(const uint8_t* p) { return static_cast<int32_t>(load_le32(p)); }
 
 }  // namespace
 
 void header_to_bytes(const StreamHeader& h, uint8_t out[kHeaderPayloadV1]) {
   out[0] = static_cast<uint8_t>(h.mode);
   out[1] = h.flags;
-  put_u16(out + 2, h.width);
-  put_u16(out + 4, h.height);
-  put_u32(out + 6, h.frame_period_us);
-  put_u32(out + 10, h.frame_count);
-  put_u32(out + 14, static_cast<uint32_t>(h.focal_x_q16));
-  put_u32(out + 18, static_cast<uint32_t>(h.focal_y_q16));
-  put_u32(out + 22, static_cast<uint32_t>(h.center_x_q16));
-  put_u32(out + 26, static_cast<uint32_t>(h.center_y_q16));
-  put_u32(out + 30, static_cast<uint32_t>(h.near_q16));
-  put_u32(out + 34, static_cast<uint32_t>(h.far_q16));
-  put_u32(out + 38, h.max_chunk_payload);
-  put_u32(out + 42, h.workspace_bytes);
-  put_u32(out + 46, h.max_vertices);
-  put_u32(out + 50, h.max_triangles);
+  store_le16(out + 2, h.width);
+  store_le16(out + 4, h.height);
+  store_le32(out + 6, h.frame_period_us);
+  store_le32(out + 10, h.frame_count);
+  store_le32(out + 14, static_cast<uint32_t>(h.focal_x_q16));
+  store_le32(out + 18, static_cast<uint32_t>(h.focal_y_q16));
+  store_le32(out + 22, static_cast<uint32_t>(h.center_x_q16));
+  store_le32(out + 26, static_cast<uint32_t>(h.center_y_q16));
+  store_le32(out + 30, static_cast<uint32_t>(h.near_q16));
+  store_le32(out + 34, static_cast<uint32_t>(h.far_q16));
+  store_le32(out + 38, h.max_chunk_payload);
+  store_le32(out + 42, h.workspace_bytes);
+  store_le32(out + 46, h.max_vertices);
+  store_le32(out + 50, h.max_triangles);
 }
 
 Status header_from_bytes(const uint8_t* p, uint32_t size, uint8_t version_major, uint8_t version_minor,
@@ -59,20 +48,20 @@ Status header_from_bytes(const uint8_t* p, uint32_t size, uint8_t version_major,
   h.mode = static_cast<StreamMode>(p[0]);
   h.flags = p[1];
   if ((h.flags & ~kHeaderFlagInteractive) != 0 && version_minor <= kStreamVersionMinor) return Status::malformed;
-  h.width = get_u16(p + 2);
-  h.height = get_u16(p + 4);
-  h.frame_period_us = get_u32(p + 6);
-  h.frame_count = get_u32(p + 10);
+  h.width = load_le16(p + 2);
+  h.height = load_le16(p + 4);
+  h.frame_period_us = load_le32(p + 6);
+  h.frame_count = load_le32(p + 10);
   h.focal_x_q16 = get_s32(p + 14);
   h.focal_y_q16 = get_s32(p + 18);
   h.center_x_q16 = get_s32(p + 22);
   h.center_y_q16 = get_s32(p + 26);
   h.near_q16 = get_s32(p + 30);
   h.far_q16 = get_s32(p + 34);
-  h.max_chunk_payload = get_u32(p + 38);
-  h.workspace_bytes = get_u32(p + 42);
-  h.max_vertices = get_u32(p + 46);
-  h.max_triangles = get_u32(p + 50);
+  h.max_chunk_payload = load_le32(p + 38);
+  h.workspace_bytes = load_le32(p + 42);
+  h.max_vertices = load_le32(p + 46);
+  h.max_triangles = load_le32(p + 50);
   if (h.width == 0 || h.height == 0 || h.width > kMaxFrameSide || h.height > kMaxFrameSide) return Status::malformed;
   if (h.max_chunk_payload > kMaxChunkPayloadLimit) return Status::malformed;
   if (h.focal_x_q16 < 0 || h.focal_y_q16 < 0) return Status::malformed;
@@ -104,8 +93,8 @@ Status StreamParser::fail(Status s, uint64_t at, const char* detail) {
 }
 
 Status StreamParser::on_chunk_head() {
-  type_ = get_u32(small_);
-  length_ = get_u32(small_ + 4);
+  type_ = load_le32(small_);
+  length_ = load_le32(small_ + 4);
   if (!have_header_ && type_ != chunk::kHeader)
     return fail(Status::malformed, item_offset_, VDS_DETAIL("first chunk is not HEAD"));
   if (have_header_ && type_ == chunk::kHeader)
@@ -119,7 +108,7 @@ Status StreamParser::on_chunk_head() {
 }
 
 Status StreamParser::on_chunk_complete() {
-  const uint32_t stored = get_u32(small_);
+  const uint32_t stored = load_le32(small_);
   if (stored != crc_) return fail(Status::bad_crc, item_offset_, VDS_DETAIL("chunk CRC-32C mismatch"));
   ++chunks_;
   if (type_ == chunk::kHeader) {
@@ -135,7 +124,7 @@ Status StreamParser::on_chunk_complete() {
     if (sink_.on_header != nullptr && !sink_.on_header(sink_.ctx, header_))
       return fail(Status::aborted, item_offset_, VDS_DETAIL("header callback stopped the stream"));
   } else if (type_ == chunk::kEnd) {
-    if (length_ != 4 || get_u32(buf_) != chunks_ - 1)
+    if (length_ != 4 || load_le32(buf_) != chunks_ - 1)
       return fail(Status::malformed, item_offset_, VDS_DETAIL("END chunk count does not match the chunks read"));
     state_ = State::done;
     status_ = Status::ok;

@@ -8,6 +8,7 @@
 #include "image_output.h"
 #include "vds/idct.h"
 #include "vds/image.h"
+#include "vds/bytes.h"
 
 namespace vds {
 
@@ -30,10 +31,6 @@ using Info = ImageDecoder::BlockInfo;
 constexpr size_t kAlwaysOneOffset = offsetof(m::PackedClassContexts, nz_suffix);
 constexpr m::PackedContext kAlwaysOne = 0;
 
-uint32_t rd32(const uint8_t* p) {
-  return static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 | static_cast<uint32_t>(p[2]) << 16 |
-         static_cast<uint32_t>(p[3]) << 24;
-}
 
 // Blocks per MCU of component c, across and down.
 inline int blocks_w(const ImageHeader& h, int c) { return (c == 0 && h.chroma == ChromaFormat::yuv420) ? 2 : 1; }
@@ -107,7 +104,7 @@ Status ImageDecoder::feed(const uint8_t* imgd, uint32_t size) {
   if (imgd == nullptr) return status_ = Status::invalid_argument;
   const uint32_t total = header_.mcu_count();
   if (size < kImageDataPrefixBytes) return status_ = Status::malformed;
-  const uint32_t first = rd32(imgd);
+  const uint32_t first = load_le32(imgd);
   const uint32_t count = static_cast<uint32_t>(imgd[4] | (imgd[5] << 8));
   if (next_mcu_ == total || first != next_mcu_ || count == 0 || count > total - first)
     return status_ = Status::malformed;

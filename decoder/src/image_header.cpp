@@ -1,6 +1,7 @@
 // vds image codec: the IMGH header and the quantisation tables (perceptual
 // shapes from ITU-T T.81 Annex K, scaled by a quantiser index and a slope).
 #include "vds/image.h"
+#include "vds/bytes.h"
 
 namespace vds {
 
@@ -48,7 +49,6 @@ constexpr int kStepShift = kBaseFracBits + kWeightFracBits;
 constexpr uint32_t kStepRound = uint32_t{1} << (kStepShift - 1);
 constexpr int kMaxStep = 2047;
 
-uint16_t rd16(const uint8_t* p) { return static_cast<uint16_t>(p[0] | (p[1] << 8)); }
 
 }  // namespace
 
@@ -86,9 +86,9 @@ Status image_header_from_bytes(const uint8_t* p, uint32_t size, ImageHeader* out
   h.quant_chroma = p[4];
   h.slope = p[5];
   if (h.slope > kQuantSlopeMax) return Status::malformed;
-  h.width = rd16(p + 6);
-  h.height = rd16(p + 8);
-  h.reserved = rd16(p + 10);
+  h.width = load_le16(p + 6);
+  h.height = load_le16(p + 8);
+  h.reserved = load_le16(p + 10);
   if (h.width == 0 || h.height == 0 || h.width > kImageMaxSide || h.height > kImageMaxSide) return Status::malformed;
   if (h.reserved != 0) return Status::malformed;
   *out = h;

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "image_output.h"
+#include "colour.h"
 
 #if defined(__ARM_FEATURE_SIMD32)
 #include <arm_acle.h>  // __uqadd8, __uqsub8, __uxtb16 (Cortex-M4 DSP extension)
@@ -12,16 +13,14 @@ namespace vds {
 
 namespace {
 
-// T.871 / JFIF coefficients in Q16, each round(c * 2^16):
-// R = Y + 1.402 Cr', G = Y - 0.34414 Cb' - 0.71414 Cr', B = Y + 1.772 Cb'
-// with Cb' = Cb - 128, Cr' = Cr - 128.
-constexpr int kColourFracBits = 16;
-constexpr int32_t kCrToR = 91881;
-constexpr int32_t kCbToG = 22554;
-constexpr int32_t kCrToG = 46802;
-constexpr int32_t kCbToB = 116130;
-constexpr int32_t kColourHalf = int32_t{1} << (kColourFracBits - 1);
-constexpr int kChromaCentre = 128;
+// T.871 / JFIF coefficients in Q16 (colour.h).
+using colour::kCbToB;
+using colour::kCbToG;
+using colour::kChromaCentre;
+using colour::kCrToG;
+using colour::kCrToR;
+constexpr int kColourFracBits = colour::kFracBits;
+constexpr int32_t kColourHalf = colour::kHalf;
 
 // The three chroma terms of a chroma sample, rounded to integers (T.871
 // in Q16, round to nearest).

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "vds/mesh.h"
+#include "vds/bytes.h"
 
 namespace vds {
 namespace {
@@ -24,17 +25,6 @@ constexpr int kBaseRefEgK = kMeshBaseRefEgK;
 // values are malformed (and keep the sums far from overflow).
 constexpr int32_t kMaxStep = 1 << 16;
 
-uint32_t rd_u16(const uint8_t* p) { return uint32_t{p[0]} | uint32_t{p[1]} << 8; }
-uint32_t rd_u32(const uint8_t* p) {
-  return uint32_t{p[0]} | uint32_t{p[1]} << 8 | uint32_t{p[2]} << 16 | uint32_t{p[3]} << 24;
-}
-void wr_u16(uint8_t* p, uint32_t v) {
-  p[0] = static_cast<uint8_t>(v);
-  p[1] = static_cast<uint8_t>(v >> 8);
-}
-void wr_u32(uint8_t* p, uint32_t v) {
-  for (int i = 0; i < 4; ++i) p[i] = static_cast<uint8_t>(v >> (8 * i));
-}
 
 // Index of the candidate holding `rank` in the order (score, index).
 uint32_t select_rank(const int64_t* score, uint32_t n, uint32_t rank) {
@@ -58,22 +48,22 @@ void mesh_header_to_bytes(const MeshHeader& h, uint8_t out[kMeshHeaderTailBytes]
   out[1] = static_cast<uint8_t>(h.coder);
   out[2] = static_cast<uint8_t>(h.predictor);
   out[3] = h.bits;
-  wr_u16(out + 4, h.levels);
-  wr_u16(out + 6, h.max_degree);
-  wr_u32(out + 8, h.base_vertices);
-  wr_u32(out + 12, h.base_triangles);
-  wr_u32(out + 16, h.vertices);
-  wr_u32(out + 20, h.triangles);
-  for (int k = 0; k < 3; ++k) wr_u32(out + 24 + 4 * k, h.origin_f32[k]);
-  wr_u32(out + 36, h.step_f32);
+  store_le16(out + 4, h.levels);
+  store_le16(out + 6, h.max_degree);
+  store_le32(out + 8, h.base_vertices);
+  store_le32(out + 12, h.base_triangles);
+  store_le32(out + 16, h.vertices);
+  store_le32(out + 20, h.triangles);
+  for (int k = 0; k < 3; ++k) store_le32(out + 24 + 4 * k, h.origin_f32[k]);
+  store_le32(out + 36, h.step_f32);
   if (h.up != MeshUp::y_plus || h.tail()) {
     out[40] = static_cast<uint8_t>(h.up);
     out[41] = out[42] = out[43] = 0;
   }
   if (h.tail()) {
-    wr_u32(out + 44, h.tail_dummy_vertices);
-    wr_u32(out + 48, h.tail_dummy_triangles);
-    wr_u32(out + 52, h.tail_max_border);
+    store_le32(out + 44, h.tail_dummy_vertices);
+    store_le32(out + 48, h.tail_dummy_triangles);
+    store_le32(out + 52, h.tail_max_border);
   }
 }
 
@@ -88,14 +78,14 @@ Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out) 
   h.coder = static_cast<MeshCoder>(p[1]);
   h.predictor = static_cast<MeshPredictor>(p[2]);
   h.bits = p[3];
-  h.levels = static_cast<uint16_t>(rd_u16(p + 4));
-  h.max_degree = static_cast<uint16_t>(rd_u16(p + 6));
-  h.base_vertices = rd_u32(p + 8);
-  h.base_triangles = rd_u32(p + 12);
-  h.vertices = rd_u32(p + 16);
-  h.triangles = rd_u32(p + 20);
-  for (int k = 0; k < 3; ++k) h.origin_f32[k] = rd_u32(p + 24 + 4 * k);
-  h.step_f32 = rd_u32(p + 36);
+  h.levels = static_cast<uint16_t>(load_le16(p + 4));
+  h.max_degree = static_cast<uint16_t>(load_le16(p + 6));
+  h.base_vertices = load_le32(p + 8);
+  h.base_triangles = load_le32(p + 12);
+  h.vertices = load_le32(p + 16);
+  h.triangles = load_le32(p + 20);
+  for (int k = 0; k < 3; ++k) h.origin_f32[k] = load_le32(p + 24 + 4 * k);
+  h.step_f32 = load_le32(p + 36);
   // The view block: absent (+y up), or the up axis and three zero bytes.
   if (size != kMeshHeaderBytes) {
     if (size < kMeshHeaderViewBytes || p[41] != 0 || p[42] != 0 || p[43] != 0) return Status::malformed;
@@ -113,9 +103,9 @@ Status mesh_header_from_bytes(const uint8_t* p, uint32_t size, MeshHeader* out) 
     // The tail block; the tail is a level, coded arithmetically only. Each
     // dummy closes a hole of three edges or more with as many triangles.
     if (size < kMeshHeaderTailBytes) return Status::malformed;
-    h.tail_dummy_vertices = rd_u32(p + 44);
-    h.tail_dummy_triangles = rd_u32(p + 48);
-    h.tail_max_border = rd_u32(p + 52);
+    h.tail_dummy_vertices = load_le32(p + 44);
+    h.tail_dummy_triangles = load_le32(p + 48);
+    h.tail_max_border = load_le32(p + 52);
     if (h.levels == 0 || h.tail_dummy_triangles < 3 * uint64_t{h.tail_dummy_vertices} || h.tail_max_border < 3 ||
         uint64_t{h.vertices} + h.tail_dummy_vertices > 0x0FFFFFFFu ||
         uint64_t{h.triangles} + h.tail_dummy_triangles > 0x07FFFFFFu ||

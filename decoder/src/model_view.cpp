@@ -22,9 +22,11 @@ constexpr int32_t kLightCam[3] = {-14746, -18022, -22938};
 constexpr uint32_t kAmbientQ8 = 56;   // intensity without light, of 256
 constexpr uint32_t kDiffuseQ8 = 200;  // added at normal incidence
 
-int32_t mul_q30(int32_t a, int32_t b) {
-  return static_cast<int32_t>((int64_t{a} * b + (int64_t{1} << 29)) >> 30);
-}
+// Q2.30 (rotations, unit vectors): the product of two, rounded to nearest.
+constexpr int kQ30 = Q2_30::kFracBits;
+constexpr int64_t kQ30Half = int64_t{1} << (kQ30 - 1);
+
+int32_t mul_q30(int32_t a, int32_t b) { return static_cast<int32_t>((int64_t{a} * b + kQ30Half) >> kQ30); }
 
 int32_t abs32(int32_t v) { return v < 0 ? -v : v; }
 
@@ -128,9 +130,10 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) cam.rotation.m[i][j] = Q2_30::from_raw(rows[i][j]);
   // The centre of projection: D units back along the forward axis.
-  cam.position.x = Q16_16::from_raw(static_cast<int32_t>((-rows[2][0] * kCameraDistanceQ16) >> 30));
-  cam.position.y = Q16_16::from_raw(static_cast<int32_t>((-rows[2][1] * kCameraDistanceQ16) >> 30));
-  cam.position.z = Q16_16::from_raw(static_cast<int32_t>((-rows[2][2] * kCameraDistanceQ16) >> 30));
+  // (Q2.30 x Q16.16 -> Q16.16: drop the rotation's fraction bits.)
+  cam.position.x = Q16_16::from_raw(static_cast<int32_t>((-rows[2][0] * kCameraDistanceQ16) >> kQ30));
+  cam.position.y = Q16_16::from_raw(static_cast<int32_t>((-rows[2][1] * kCameraDistanceQ16) >> kQ30));
+  cam.position.z = Q16_16::from_raw(static_cast<int32_t>((-rows[2][2] * kCameraDistanceQ16) >> kQ30));
   // Focal length one frame height: a point 1 unit from the centre, on the
   // near side, lands within 0.46 frame heights of the middle.
   const int32_t focal = int32_t{cfg_.height} * 65536;

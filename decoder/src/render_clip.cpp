@@ -26,10 +26,13 @@ int64_t plane_distance(const FrameCamera& fc, uint8_t bit, const ClipVertex& v) 
   }
 }
 
+// The clip parameter t is Q2.30.
+constexpr int kQ30 = Q2_30::kFracBits;
+
 int32_t lerp_q30(int32_t a, int32_t b, int64_t t30) {
   // a + (b - a) t with t in [0, 1] (Q2.30); |b - a| < 2^32, product < 2^62.
   const int64_t d = int64_t{b} - a;
-  return sat_s32(int64_t{a} + shr_round(d * t30, 30));
+  return sat_s32(int64_t{a} + shr_round(d * t30, kQ30));
 }
 
 // The point where edge (in -> out) crosses the plane: din >= 0 > dout.
@@ -44,8 +47,8 @@ ClipVertex intersect(const ClipVertex& in, const ClipVertex& out, int64_t din, i
     num >>= (len - 32);
     den >>= (len - 32);
   }
-  int64_t t30 = den > 0 ? (num << 30) / den : 0;
-  if (t30 > (int64_t{1} << 30)) t30 = int64_t{1} << 30;
+  int64_t t30 = den > 0 ? (num << kQ30) / den : 0;
+  if (t30 > (int64_t{1} << kQ30)) t30 = int64_t{1} << kQ30;
   ClipVertex r;
   r.x = lerp_q30(in.x, out.x, t30);
   r.y = lerp_q30(in.y, out.y, t30);

@@ -10,6 +10,7 @@
 #include "render_internal.h"
 #include "vds/config.h"
 #include "vds/render_raster.h"
+#include "colour.h"
 
 namespace vds::detail {
 
@@ -165,13 +166,14 @@ inline uint16_t pack565(uint32_t c) {
                                ((b * 249 + 1014) >> 11));
 }
 
-// JFIF full-range Y'CbCr -> R'G'B' with Q16 constants (1.402, 0.344136,
-// 0.714136, 1.772), each channel rounded and clamped.
+// JFIF full-range Y'CbCr -> R'G'B' (colour.h, the image output's
+// constants), each channel rounded and clamped.
 inline uint32_t ycbcr_to_rgb(int32_t y, int32_t cb, int32_t cr) {
-  const int32_t cbd = cb - 128, crd = cr - 128;
-  const int32_t r = y + ((91881 * crd + 32768) >> 16);
-  const int32_t g = y + ((-22554 * cbd - 46802 * crd + 32768) >> 16);
-  const int32_t b = y + ((116130 * cbd + 32768) >> 16);
+  using namespace colour;
+  const int32_t cbd = cb - kChromaCentre, crd = cr - kChromaCentre;
+  const int32_t r = y + ((kCrToR * crd + kHalf) >> kFracBits);
+  const int32_t g = y + ((-kCbToG * cbd - kCrToG * crd + kHalf) >> kFracBits);
+  const int32_t b = y + ((kCbToB * cbd + kHalf) >> kFracBits);
   return (static_cast<uint32_t>(sat_u8(r)) << 16) | (static_cast<uint32_t>(sat_u8(g)) << 8) | sat_u8(b);
 }
 

@@ -19,6 +19,7 @@
 #include "vds/crc32c.h"
 #include "vds/image.h"
 #include "vds/jpeg.h"
+#include "vds/bytes.h"
 
 #ifndef VDS_WORKSPACE_BYTES
 #error "VDS_WORKSPACE_BYTES (the client's workspace budget) must be set by the build"
@@ -48,8 +49,6 @@ struct Case {
   uint32_t size;
 };
 
-uint32_t rd16(const uint8_t* p) { return static_cast<uint32_t>(p[0] | p[1] << 8); }
-uint32_t rd32(const uint8_t* p) { return rd16(p) | rd16(p + 2) << 16; }
 
 vds::ImageTarget target_for(const Case& c) {
   uint8_t* const base = reinterpret_cast<uint8_t*>(g_frame);
@@ -124,16 +123,16 @@ int run_case(uint32_t index) {
   const int32_t got = vds::board::host_file_read(name.c_str(), 0, head, sizeof head);
   if (got < 0) return 2;
   Case c{};
-  if (got != static_cast<int32_t>(sizeof head) || rd32(head) != kCaseMagic) {
+  if (got != static_cast<int32_t>(sizeof head) || vds::load_le32(head) != kCaseMagic) {
     vds::board::log(Line().str("m4 error: bad case file ").str(name.c_str()).str("\n").c_str());
     return 1;
   }
   c.kind = head[4];
   c.reps = head[5];
-  c.width = static_cast<uint16_t>(rd16(head + 6));
-  c.height = static_cast<uint16_t>(rd16(head + 8));
-  c.planar = rd16(head + 10) == 1;
-  c.size = rd32(head + 12);
+  c.width = static_cast<uint16_t>(vds::load_le16(head + 6));
+  c.height = static_cast<uint16_t>(vds::load_le16(head + 8));
+  c.planar = vds::load_le16(head + 10) == 1;
+  c.size = vds::load_le32(head + 12);
   vds::Arena arena(g_workspace, sizeof g_workspace);
   uint8_t* const data = c.size > 0 ? static_cast<uint8_t*>(arena.alloc(c.size)) : nullptr;
   if (data == nullptr || c.kind > 1 || c.reps == 0 || c.width == 0 || c.height == 0 ||

@@ -8,6 +8,7 @@
 // only sends a small probe; and a frame size chosen from the loss rate.
 #include <cstring>
 
+#include "vds/bytes.h"
 #include "vds/link/link.h"
 
 namespace vds::link {
@@ -160,8 +161,7 @@ bool Link::build_ack(uint8_t c) {
   RxReliable& r = *ch_[c].rxr;
   uint8_t p[kAckMaxPayload];
   const uint32_t wnd = r.rd + r.cap - r.nxt;
-  p[0] = static_cast<uint8_t>(wnd);
-  p[1] = static_cast<uint8_t>(wnd >> 8);
+  store_le16(p, wnd);
   // The line report: the last data frame taken intact (any channel) and
   // the wire bytes taken after its delimiter (saturating).
   const uint32_t after = rx_wire_ - (echo_valid_ ? echo_end_ : anchor_end_);
@@ -169,10 +169,8 @@ bool Link::build_ack(uint8_t c) {
   p[2] = echo_valid_     ? static_cast<uint8_t>(kEchoValid | (echo_dup_ ? kEchoDuplicate : 0) | echo_ch_)
          : anchor_valid_ ? kAnchored
                          : 0;
-  p[3] = static_cast<uint8_t>(echo_seq_);
-  p[4] = static_cast<uint8_t>(echo_seq_ >> 8);
-  p[5] = static_cast<uint8_t>(after16);
-  p[6] = static_cast<uint8_t>(after16 >> 8);
+  store_le16(p + 3, echo_seq_);
+  store_le16(p + 5, after16);
   size_t n = kAckFixedBytes;
   // The block with the newest arrival first (the sender's loss detection
   // needs it), then the highest others.
@@ -184,10 +182,9 @@ bool Link::build_ack(uint8_t c) {
   }
   for (uint8_t b = 0; b < blocks; ++b) {
     const Range& g = r.ranges[order[b]];
-    p[n++] = static_cast<uint8_t>(g.start);
-    p[n++] = static_cast<uint8_t>(g.start >> 8);
-    p[n++] = static_cast<uint8_t>(g.end);
-    p[n++] = static_cast<uint8_t>(g.end >> 8);
+    store_le16(p + n, g.start);
+    store_le16(p + n + 2, g.end);
+    n += 4;
   }
   FrameHeader h;
   h.type = FrameType::ack;
@@ -385,7 +382,7 @@ void Link::resolve_to(uint32_t wire) {
 // arrived, and bytes lost on the line are never counted as taken.
 void Link::on_line_report(const uint8_t* p) {
   report_ms_ = now_;
-  const uint32_t after = static_cast<uint32_t>(p[3] | p[4] << 8);
+  const uint32_t after = load_le16(p + 3);
   if ((p[0] & kEchoValid) == 0) {
     // No data frame taken yet: the peer counts from the end of the first
     // frame of ours it took, which lies at or after where our first one
@@ -394,7 +391,7 @@ void Link::on_line_report(const uint8_t* p) {
     return;
   }
   const uint8_t ch = p[0] & kEchoChannelMask;
-  const uint16_t seq = static_cast<uint16_t>(p[1] | p[2] << 8);
+  const uint16_t seq = load_le16(p + 1);
   uint32_t base = 0;
   if (last_echo_valid_ && last_echo_ch_ == ch && last_echo_seq_ == seq) {
     base = last_echo_end_;
@@ -441,7 +438,7 @@ void Link::rx_ack(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
   // Acks never go backwards on a FIFO pipe; anything outside [base, nxt] is
   // stale or bogus.
   const uint32_t ack = t.base + static_cast<uint16_t>(seq - static_cast<uint16_t>(t.base));
-  const uint32_t wnd = static_cast<uint32_t>(p[0] | p[1] << 8);
+  const uint32_t wnd = load_le16(p);
   if (diff(ack, t.nxt) > 0 || wnd > kMaxWindow) {
     ++stats_.bad_ack;
     return;
@@ -468,8 +465,8 @@ void Link::rx_ack(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
     progress_ms_ = rto_from_ms_ = now_;
   }
   for (size_t b = kAckFixedBytes; b < n; b += 4) {
-    const uint32_t s = widen(static_cast<uint16_t>(p[b] | p[b + 1] << 8), ack);
-    const uint32_t e = widen(static_cast<uint16_t>(p[b + 2] | p[b + 3] << 8), ack);
+    const uint32_t s = widen(load_le16(p + b), ack);
+    const uint32_t e = widen(load_le16(p + b + 2), ack);
     if (diff(s, ack) <= 0 || diff(e, s) <= 0 || diff(e, t.nxt) > 0) {
       ++stats_.bad_ack;
       continue;

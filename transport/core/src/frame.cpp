@@ -4,6 +4,7 @@
 
 #include <cstring>
 
+#include "vds/bytes.h"
 #include "vds/crc32c.h"
 
 namespace vds::link {
@@ -123,7 +124,7 @@ size_t FrameReceiver::push(const uint8_t* data, size_t n, RxEvent* event, RxFram
     frame->header.type = static_cast<FrameType>(buf_[0] >> 4);
     frame->header.channel = static_cast<uint8_t>(buf_[0] & 0x0F);
     frame->header.tag = buf_[1];
-    frame->header.seq = static_cast<uint16_t>(buf_[2] | buf_[3] << 8);
+    frame->header.seq = load_le16(buf_ + 2);
     frame->payload = buf_ + kHeaderBytes;
     frame->size = body - kHeaderBytes;
     *event = RxEvent::frame;

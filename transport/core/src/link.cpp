@@ -5,6 +5,7 @@
 
 #include "vds/crc32c.h"
 #include "vds/link/link.h"
+#include "vds/bytes.h"
 
 namespace vds::link {
 
@@ -20,16 +21,6 @@ constexpr uint8_t kHelloFlagEstablished = 0x01;
 constexpr uint8_t kHelloFlagDevice = 0x02;
 constexpr uint8_t kCapabilities = kCapSelectiveAck | kCapDatagram | kCapAdaptiveFrames;
 
-void put16(uint8_t* p, uint32_t v) {
-  p[0] = static_cast<uint8_t>(v);
-  p[1] = static_cast<uint8_t>(v >> 8);
-}
-void put32(uint8_t* p, uint32_t v) {
-  put16(p, v);
-  put16(p + 2, v >> 16);
-}
-uint16_t get16(const uint8_t* p) { return static_cast<uint16_t>(p[0] | p[1] << 8); }
-uint32_t get32(const uint8_t* p) { return get16(p) | static_cast<uint32_t>(get16(p + 2)) << 16; }
 
 template <typename T>
 T* carve(Arena& a, size_t count = 1) {
@@ -270,8 +261,8 @@ void Link::establish() {
   // nonces so each side computes it alone.
   uint8_t ids[8];
   const bool host = cfg_.role == Role::host;
-  put32(ids, host ? my_nonce_ : peer_nonce_);
-  put32(ids + 4, host ? peer_nonce_ : my_nonce_);
+  store_le32(ids, host ? my_nonce_ : peer_nonce_);
+  store_le32(ids + 4, host ? peer_nonce_ : my_nonce_);
   tag_ = static_cast<uint8_t>(crc32c(ids, sizeof ids));
   have_rtt_ = false;
   oldest_sent_ms_ = now_;
@@ -315,11 +306,11 @@ void Link::on_hello(const uint8_t* p, size_t n) {
     return;
   }
   const uint8_t flags = p[2];
-  const uint32_t nonce = get32(p + 4);
-  const uint32_t echo = get32(p + 8);
-  const uint16_t max_payload = get16(p + 12);
+  const uint32_t nonce = load_le32(p + 4);
+  const uint32_t echo = load_le32(p + 8);
+  const uint16_t max_payload = load_le16(p + 12);
   const uint8_t count = p[14];
-  const uint16_t line_bytes = get16(p + 16);
+  const uint16_t line_bytes = load_le16(p + 16);
   const bool peer_device = (flags & kHelloFlagDevice) != 0;
   if (nonce == 0 || count > kMaxChannelId + 1 || n != kHelloFixedBytes + kHelloChannelBytes * count ||
       peer_device == (cfg_.role == Role::device) || max_payload < kMinFramePayload ||
@@ -350,7 +341,7 @@ void Link::on_hello(const uint8_t* p, size_t n) {
     const Mode m = e[1] == static_cast<uint8_t>(Mode::reliable)   ? Mode::reliable
                    : e[1] == static_cast<uint8_t>(Mode::datagram) ? Mode::datagram
                                                                   : Mode::none;
-    uint16_t w = get16(e + 2);
+    uint16_t w = load_le16(e + 2);
     if (w > kMaxWindow) w = static_cast<uint16_t>(kMaxWindow);
     ch_[e[0]].peer_rx = m;
     ch_[e[0]].peer_window = w;
@@ -520,9 +511,9 @@ bool Link::build_hello() {
   p[2] = static_cast<uint8_t>((established_ ? kHelloFlagEstablished : 0) |
                               (cfg_.role == Role::device ? kHelloFlagDevice : 0));
   p[3] = kCapabilities;
-  put32(p + 4, my_nonce_);
-  put32(p + 8, peer_nonce_);
-  put16(p + 12, cfg_.max_rx_payload);
+  store_le32(p + 4, my_nonce_);
+  store_le32(p + 8, peer_nonce_);
+  store_le16(p + 12, cfg_.max_rx_payload);
   uint8_t count = 0;
   for (uint8_t i = 0; i < kChannels; ++i) {
     const ChannelConfig& cc = cfg_.channels[i];
@@ -530,12 +521,12 @@ bool Link::build_hello() {
     uint8_t* e = p + kHelloFixedBytes + kHelloChannelBytes * count;
     e[0] = i;
     e[1] = static_cast<uint8_t>(cc.rx);
-    put16(e + 2, cc.rx_bytes);
+    store_le16(e + 2, cc.rx_bytes);
     ++count;
   }
   p[14] = count;
   p[15] = 0;
-  put16(p + 16, cfg_.rx_line_bytes);
+  store_le16(p + 16, cfg_.rx_line_bytes);
   FrameHeader h;
   h.type = FrameType::hello;
   return emit(h, p, kHelloFixedBytes + kHelloChannelBytes * count);

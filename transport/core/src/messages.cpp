@@ -1,15 +1,18 @@
 // Encoding of the link's application messages (vds/link/messages.h).
 #include "vds/link/messages.h"
 
+#include "vds/bytes.h"
+
 namespace vds::link {
 namespace {
 
+// Field by field, the cursor moving on.
 void put32(uint8_t*& p, uint32_t v) {
-  for (int i = 0; i < 4; ++i) *p++ = static_cast<uint8_t>(v >> (8 * i));
+  store_le32(p, v);
+  p += 4;
 }
 uint32_t get32(const uint8_t*& p) {
-  const uint32_t v = static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 |
-                     static_cast<uint32_t>(p[2]) << 16 | static_cast<uint32_t>(p[3]) << 24;
+  const uint32_t v = load_le32(p);
   p += 4;
   return v;
 }
