@@ -16,6 +16,7 @@
 #include "vds/enc/stream_writer.h"
 #include "vds/mesh.h"
 #include "vds/model_view.h"
+#include "vds/player.h"
 
 namespace {
 
@@ -69,57 +70,44 @@ TEST(ModelView, GoldenStreamOneFramePerLevel) {
 }
 
 // A client with `bytes` of workspace for the model (the chunk buffer apart),
-// as the firmware plays a stream: set up at MSHH, a frame per level.
+// playing the stream through the client's player as the firmware does.
 struct SmallClient {
-  std::vector<uint8_t> chunk_ws = std::vector<uint8_t>(1u << 16);
-  std::vector<uint8_t> model_ws;
-  vds::Arena model_arena;
-  vds::MeshDecoder mesh;
-  vds::ModelView view;
-  vds::ModelFrames shown;
-  vds::ModelCapacity cap;
-  Status start = Status::more_input;
-  uint32_t crc = 0;
+  std::vector<uint8_t> ws;
+  size_t parser_bytes = 0;  // what the player's parser carves first
+  vds::Arena arena;
+  vds::Player player;
+  vds::PlayerPlan cap;  // the plan made at MSHH
   std::vector<uint32_t> crcs, vertices;
+  uint32_t base_needs = 0;  // from a model_base_too_big notice
 
-  explicit SmallClient(size_t bytes) : model_ws(bytes), model_arena(model_ws.data(), model_ws.size()) {}
+  explicit SmallClient(size_t bytes) : ws(bytes + (1u << 16)), arena(ws.data(), ws.size()) {
+    vds::Arena probe(ws.data(), ws.size());
+    vds::Player p;
+    if (p.init(probe, config(), {}) == Status::ok) parser_bytes = probe.used();
+    arena = vds::Arena(ws.data(), parser_bytes + bytes);
+  }
+  static vds::PlayerConfig config() {
+    vds::PlayerConfig c = vds::kClientPlayerConfig;
+    c.max_chunk_bytes = 1u << 15;
+    return c;
+  }
+  size_t model_high_water() const { return arena.high_water() - parser_bytes; }
 
   Status play(const std::vector<uint8_t>& s) {
-    vds::Arena chunk_arena(chunk_ws.data(), chunk_ws.size());
-    vds::StreamParser parser;
-    vds::ChunkSink sink;
-    sink.ctx = this;
-    sink.model_prefix = true;
-    sink.on_chunk = [](void* ctx, uint32_t type, const uint8_t* p, uint32_t n) {
+    vds::PlayerCallbacks cb;
+    cb.ctx = this;
+    cb.frame_shown = [](void* ctx, const vds::PlayedFrame& f) {
       auto* c = static_cast<SmallClient*>(ctx);
-      if (!vds::MeshDecoder::handles(type)) return vds::ChunkResult::unknown;
-      if (type == vds::chunk::kMeshHeader) {
-        vds::ModelViewConfig vc;
-        vc.width = 240;
-        vc.height = 180;
-        c->start = vds::start_model(c->model_arena, p, n, vc, c->mesh, c->view, &c->cap);
-        if (c->start != Status::ok) return vds::ChunkResult::abort;
-      }
-      if (c->mesh.consume(type, p, n) != Status::ok) return vds::ChunkResult::abort;
-      if (c->shown.due(c->mesh)) {
-        c->crc = 0;
-        auto band = [](void* ctx, const vds::Band& b) {
-          auto* cc = static_cast<SmallClient*>(ctx);
-          for (uint16_t y = 0; y < b.height; ++y)
-            cc->crc = vds::crc32c_update(cc->crc, reinterpret_cast<const uint8_t*>(b.pixels) + y * b.stride,
-                                         size_t{b.width} * 2);
-          return true;
-        };
-        if (c->view.draw(c->mesh.mesh(), c->shown.angle(), band, c) != Status::ok) return vds::ChunkResult::abort;
-        c->shown.mark_drawn(c->mesh);
-        c->crcs.push_back(c->crc);
-        c->vertices.push_back(c->mesh.mesh().vertex_count());
-      }
-      return vds::ChunkResult::consumed;
+      c->crcs.push_back(f.crc);
+      c->vertices.push_back(c->player.mesh.mesh().vertex_count());
     };
-    if (parser.init(chunk_arena, 1u << 15, sink) != Status::ok) return Status::invalid_argument;
-    Status st = parser.feed(s.data(), s.size());
-    if (st == Status::more_input) st = parser.finish();
+    cb.notice = [](void* ctx, vds::PlayerNotice n, uint32_t a, uint32_t, uint32_t) {
+      if (n == vds::PlayerNotice::model_base_too_big) static_cast<SmallClient*>(ctx)->base_needs = a;
+    };
+    if (player.init(arena, config(), cb) != Status::ok) return Status::invalid_argument;
+    Status st = player.feed(s.data(), s.size());
+    if (st == Status::more_input) st = player.finish();
+    cap = player.plan();
     return st;
   }
 };
@@ -130,8 +118,8 @@ TEST(ModelView, ASmallClientShowsTheLevelsThatFit) {
   SmallClient full(8u << 20);
   ASSERT_EQ(full.play(s), Status::ok);
   ASSERT_EQ(full.crcs, full_crcs) << "the same frames as the host replay";
-  ASSERT_TRUE(full.mesh.complete());
-  const vds::MeshHeader h = full.mesh.header();
+  ASSERT_TRUE(full.player.mesh.complete());
+  const vds::MeshHeader h = full.player.mesh.header();
   ASSERT_EQ(full.cap.vertices, h.vertices);
   const size_t base_bytes = [&] {
     vds::ModelCapacity c;
@@ -152,11 +140,12 @@ TEST(ModelView, ASmallClientShowsTheLevelsThatFit) {
     SmallClient c(bytes);
     ASSERT_EQ(c.play(s), Status::ok) << bytes << " bytes";
     EXPECT_LE(c.cap.bytes, bytes);
-    EXPECT_LE(c.model_arena.high_water(), bytes);
-    const uint32_t levels = c.mesh.levels_done();
+    EXPECT_LE(c.model_high_water(), bytes);
+    const uint32_t levels = c.player.mesh.levels_done();
     ASSERT_EQ(c.crcs.size(), levels + 1u) << bytes << " bytes";
     for (size_t i = 0; i < c.crcs.size(); ++i) EXPECT_EQ(c.crcs[i], full_crcs[i]) << bytes << " bytes, frame " << i;
-    EXPECT_EQ(c.mesh.capacity_reached(), levels < h.levels);
+    EXPECT_EQ(c.player.mesh.capacity_reached(), levels < h.levels);
+    EXPECT_EQ(c.player.workspace_full(), levels < h.levels);
     if (levels < h.levels) EXPECT_GT(full.vertices[levels + 1], c.cap.vertices) << bytes << " bytes";
     if (c.crcs.size() != full_crcs.size()) ++sizes_seen;
   }
@@ -164,9 +153,9 @@ TEST(ModelView, ASmallClientShowsTheLevelsThatFit) {
 
   // Below the base: refused at MSHH with what the base needs.
   SmallClient none(base_bytes - 1);
-  EXPECT_EQ(none.play(s), Status::aborted);
-  EXPECT_EQ(none.start, Status::workspace_too_small);
+  EXPECT_EQ(none.play(s), Status::workspace_too_small);
   EXPECT_EQ(none.cap.bytes, base_bytes);
+  EXPECT_EQ(none.base_needs, base_bytes);
   EXPECT_TRUE(none.crcs.empty());
 }
 
@@ -187,15 +176,15 @@ TEST(ModelView, ATailStreamPlaysWholeOrStopsBeforeTheTail) {
   SmallClient full(8u << 20);
   ASSERT_EQ(full.play(r.stream), Status::ok);
   EXPECT_EQ(full.crcs, want);
-  ASSERT_TRUE(full.mesh.complete());
+  ASSERT_TRUE(full.player.mesh.complete());
   EXPECT_EQ(full.cap.vertices, r.mesh_header.vertices + r.tail_counts.dummy_vertices);
   EXPECT_EQ(full.cap.triangles, r.mesh_header.triangles + r.tail_counts.dummy_triangles);
   for (size_t less : {size_t{1}, size_t{64}, size_t{2048}}) {
     SmallClient part(full.cap.bytes - less);
     ASSERT_EQ(part.play(r.stream), Status::ok) << less;
-    EXPECT_LE(part.model_arena.high_water(), full.cap.bytes - less);
-    EXPECT_TRUE(part.mesh.capacity_reached()) << less;
-    EXPECT_EQ(part.mesh.levels_done(), r.levels.size() - 2) << less;
+    EXPECT_LE(part.model_high_water(), full.cap.bytes - less);
+    EXPECT_TRUE(part.player.mesh.capacity_reached()) << less;
+    EXPECT_EQ(part.player.mesh.levels_done(), r.levels.size() - 2) << less;
     EXPECT_EQ(part.crcs, std::vector<uint32_t>(want.begin(), want.end() - 1)) << less;
   }
 }
@@ -212,7 +201,7 @@ struct TurnedMeshes {
 void build_turned(TurnedMeshes& t) {
   SmallClient c(4u << 20);
   ASSERT_EQ(c.play(golden_mesh_stream()), Status::ok);
-  const vds::MeshState& m = c.mesh.mesh();
+  const vds::MeshState& m = c.player.mesh.mesh();
   const int k = (1 << m.bits()) - 1;
   for (vds::MeshState* s : {&t.upright, &t.turned}) {
     ASSERT_EQ(s->init(t.arena, m.vertex_count(), m.triangle_count()), Status::ok);
@@ -358,7 +347,7 @@ TEST(ModelView, RefusesWhatItCannotDraw) {
 void build_copy(vds::MeshState& s, vds::Arena& arena, int extra, bool hole) {
   SmallClient c(4u << 20);
   ASSERT_EQ(c.play(golden_mesh_stream()), Status::ok);
-  const vds::MeshState& m = c.mesh.mesh();
+  const vds::MeshState& m = c.player.mesh.mesh();
   ASSERT_LE(m.bits() + extra, 16);
   ASSERT_EQ(s.init(arena, m.vertex_count(), m.triangle_count()), Status::ok);
   s.clear(m.bits() + extra);

@@ -98,6 +98,8 @@ struct PlayerPlan {
   size_t available = 0;      // bytes the arena had left for it
   uint32_t vertices = 0;     // model: vertices the workspace holds ...
   uint32_t of_vertices = 0;  // ... of the stream's
+  uint32_t triangles = 0;    // model: the most triangles it holds with them
+  size_t bytes = 0;          // model: what the mesh decoder and the view carve for that (or a base needs)
 };
 
 class Player;

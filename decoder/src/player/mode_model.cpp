@@ -32,6 +32,8 @@ bool start_mesh(Player& p, const uint8_t* mshh, uint32_t size) {
   plan.available = left;
   plan.vertices = cap.vertices;
   plan.of_vertices = p.header().max_vertices;
+  plan.triangles = cap.triangles;
+  plan.bytes = cap.bytes;
   p.set_plan(plan);
   if (s == Status::workspace_too_small && cap.bytes > 0) {
     p.notice(PlayerNotice::model_base_too_big, static_cast<uint32_t>(cap.bytes), static_cast<uint32_t>(left), 0);
