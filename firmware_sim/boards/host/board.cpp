@@ -19,7 +19,8 @@
 #include <vector>
 
 #include "vds/board.h"
-#include "vds/enc/image_io.h"
+#include "vds/io/image.h"
+#include "vds/io/y4m.h"
 #include "vds/link/backend.h"
 #include "vds/link/fd_backends.h"
 #include "window.h"
@@ -74,8 +75,8 @@ void refill_credit() {
 uint16_t g_width = 0, g_height = 0;
 std::vector<uint8_t> g_rgb;  // RGB888 of the frame being drawn
 uint32_t g_frame_index = 0;
-std::vector<enc::Image> g_thumbs;
-std::ofstream g_y4m;
+std::vector<io::Image> g_thumbs;
+std::unique_ptr<io::Y4mWriter> g_y4m;
 
 void to_rgb888(uint16_t p, uint8_t* out) {
   // Replicate the high bits into the low ones so white stays 255.
@@ -85,28 +86,8 @@ void to_rgb888(uint16_t p, uint8_t* out) {
   out[2] = static_cast<uint8_t>((b << 3) | (b >> 2));
 }
 
-void write_y4m_frame(const enc::Image& img) {
-  if (!g_y4m.is_open()) {
-    g_y4m.open(g_opt.y4m, std::ios::binary | std::ios::trunc);
-    if (!g_y4m) throw std::runtime_error(g_opt.y4m + ": cannot open for writing");
-    g_y4m << "YUV4MPEG2 W" << img.width << " H" << img.height << " F20:1 Ip A1:1 C444\n";
-  }
-  // Full-range BT.601 (JFIF) Y'CbCr 4:4:4, the inverse of the client's conversion.
-  const size_t n = static_cast<size_t>(img.width) * img.height;
-  std::vector<uint8_t> planes(3 * n);
-  for (size_t i = 0; i < n; ++i) {
-    const double r = img.pixels[3 * i], g = img.pixels[3 * i + 1], b = img.pixels[3 * i + 2];
-    const auto clamp = [](double v) { return static_cast<uint8_t>(std::clamp(v + 0.5, 0.0, 255.0)); };
-    planes[i] = clamp(0.299 * r + 0.587 * g + 0.114 * b);
-    planes[n + i] = clamp(128 - 0.168736 * r - 0.331264 * g + 0.5 * b);
-    planes[2 * n + i] = clamp(128 + 0.5 * r - 0.418688 * g - 0.081312 * b);
-  }
-  g_y4m << "FRAME\n";
-  g_y4m.write(reinterpret_cast<const char*>(planes.data()), static_cast<std::streamsize>(planes.size()));
-}
-
-enc::Image thumbnail(const enc::Image& img, int scale) {
-  enc::Image t(std::max(1, img.width / scale), std::max(1, img.height / scale), 3);
+io::Image thumbnail(const io::Image& img, int scale) {
+  io::Image t(std::max(1, img.width / scale), std::max(1, img.height / scale), 3);
   for (int y = 0; y < t.height; ++y)
     for (int x = 0; x < t.width; ++x)
       for (int c = 0; c < 3; ++c) {
@@ -123,16 +104,16 @@ void write_contact_sheet() {
   const int cols = std::min<int>(g_opt.contact_columns, static_cast<int>(g_thumbs.size()));
   const int rows = (static_cast<int>(g_thumbs.size()) + cols - 1) / cols;
   const int tw = g_thumbs[0].width, th = g_thumbs[0].height, gap = 4;
-  enc::Image sheet(cols * tw + (cols + 1) * gap, rows * th + (rows + 1) * gap, 3);
+  io::Image sheet(cols * tw + (cols + 1) * gap, rows * th + (rows + 1) * gap, 3);
   std::fill(sheet.pixels.begin(), sheet.pixels.end(), 40);
   for (size_t i = 0; i < g_thumbs.size(); ++i) {
     const int cx = gap + static_cast<int>(i % cols) * (tw + gap), cy = gap + static_cast<int>(i / cols) * (th + gap);
-    const enc::Image& t = g_thumbs[i];
+    const io::Image& t = g_thumbs[i];
     for (int y = 0; y < std::min(th, t.height); ++y)
       for (int x = 0; x < std::min(tw, t.width); ++x)
         for (int c = 0; c < 3; ++c) sheet.at(cx + x, cy + y, c) = t.at(x, y, c);
   }
-  enc::save_png(g_opt.contact_sheet, sheet);
+  io::save_png(g_opt.contact_sheet, sheet);
 }
 
 }  // namespace
@@ -225,14 +206,17 @@ void display_band(uint16_t y0, uint16_t rows, const uint16_t* rgb565, size_t str
 
 void display_end_frame(uint32_t frame_crc) {
   (void)frame_crc;
-  enc::Image img(g_width, g_height, 3);
+  io::Image img(g_width, g_height, 3);
   img.pixels = g_rgb;
   if (!g_opt.frames_dir.empty()) {
     char name[32];
     std::snprintf(name, sizeof name, "/frame%04u.png", g_frame_index);
-    enc::save_png(g_opt.frames_dir + name, img);
+    io::save_png(g_opt.frames_dir + name, img);
   }
-  if (!g_opt.y4m.empty()) write_y4m_frame(img);
+  if (!g_opt.y4m.empty()) {
+    if (!g_y4m) g_y4m = std::make_unique<io::Y4mWriter>(g_opt.y4m);
+    g_y4m->write(img);
+  }
   if (!g_opt.contact_sheet.empty()) g_thumbs.push_back(thumbnail(img, 2));
   if (g_opt.window) {
     std::string error;

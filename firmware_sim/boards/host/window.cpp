@@ -51,7 +51,7 @@ bool Window::open(int width, int height, int scale, std::string* error) {
   return true;
 }
 
-bool Window::show(const enc::Image& rgb, uint32_t index) {
+bool Window::show(const io::Image& rgb, uint32_t index) {
   if (!impl_) return false;
   SDL_Event e;
   while (SDL_PollEvent(&e))
@@ -78,7 +78,7 @@ bool Window::open(int, int, int, std::string* error) {
   return false;
 }
 
-bool Window::show(const enc::Image&, uint32_t) { return false; }
+bool Window::show(const io::Image&, uint32_t) { return false; }
 
 #endif
 

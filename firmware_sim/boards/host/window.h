@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "vds/enc/image_io.h"
+#include "vds/io/image.h"
 
 namespace vds::board {
 
@@ -20,7 +20,7 @@ class Window {
   bool open(int width, int height, int scale, std::string* error);
   bool is_open() const { return impl_ != nullptr; }
   // Shows a frame; false once the user has closed the window.
-  bool show(const enc::Image& rgb, uint32_t index);
+  bool show(const io::Image& rgb, uint32_t index);
 
   struct Impl;
 

@@ -1,41 +1,16 @@
-// Host image files: load PNG/JPEG/TGA/BMP (stb_image), write PNG (libpng),
-// and the measures every benchmark uses (PSNR).
+// Host image files for the encoder: the image I/O library (vds/io/image.h)
+// under the encoder's names.
 #pragma once
-#include <cstdint>
-#include <string>
-#include <vector>
+#include "vds/io/image.h"
 
 namespace vds::enc {
 
-// 8-bit interleaved pixels, rows top to bottom, no padding.
-struct Image {
-  int width = 0;
-  int height = 0;
-  int channels = 0;  // 1 grey, 3 RGB, 4 RGBA
-  std::vector<uint8_t> pixels;
-
-  Image() = default;
-  Image(int w, int h, int c) : width(w), height(h), channels(c), pixels(static_cast<size_t>(w) * h * c) {}
-  uint8_t* row(int y) { return pixels.data() + static_cast<size_t>(y) * width * channels; }
-  const uint8_t* row(int y) const { return pixels.data() + static_cast<size_t>(y) * width * channels; }
-  uint8_t& at(int x, int y, int c) { return pixels[(static_cast<size_t>(y) * width + x) * channels + c]; }
-  uint8_t at(int x, int y, int c) const { return pixels[(static_cast<size_t>(y) * width + x) * channels + c]; }
-};
-
-// Loads an image file; `want_channels` 0 keeps the file's own, 1/3/4 converts.
-// Throws std::runtime_error naming the file and the reason.
-Image load_image(const std::string& path, int want_channels = 0);
-// Decodes an in-memory image file (PNG, JPEG, TGA, BMP).
-Image decode_image(const uint8_t* data, size_t size, const std::string& what, int want_channels = 0);
-// Writes a PNG (1, 3 or 4 channels). Throws std::runtime_error on failure.
-void save_png(const std::string& path, const Image& img);
-
-// Same size and channels, else throws std::invalid_argument.
-double mse(const Image& a, const Image& b);
-// 10·log10(255² / MSE); identical images give +infinity.
-double psnr(const Image& a, const Image& b);
-
-// Places images side by side in one row with a gap of `gap` pixels (grey).
-Image side_by_side(const std::vector<const Image*>& images, int gap = 4);
+using io::decode_image;
+using io::Image;
+using io::load_image;
+using io::mse;
+using io::psnr;
+using io::save_png;
+using io::side_by_side;
 
 }  // namespace vds::enc

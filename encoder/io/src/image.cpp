@@ -1,18 +1,19 @@
 // Host image files through stb_image (read) and libpng (write).
-#include "vds/enc/image_io.h"
+#include "vds/io/image.h"
 
 #include <png.h>
 #include <stb_image.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <stdexcept>
 
-#include "vds/enc/stream_writer.h"
-
-namespace vds::enc {
+namespace vds::io {
 
 Image decode_image(const uint8_t* data, size_t size, const std::string& what, int want_channels) {
   if (want_channels < 0 || want_channels > 4 || want_channels == 2)
@@ -34,7 +35,10 @@ Image decode_image(const uint8_t* data, size_t size, const std::string& what, in
 }
 
 Image load_image(const std::string& path, int want_channels) {
-  const std::vector<uint8_t> bytes = read_file(path);
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw std::runtime_error(path + ": cannot open");
+  const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  if (f.bad()) throw std::runtime_error(path + ": read error");
   return decode_image(bytes.data(), bytes.size(), path, want_channels);
 }
 
@@ -111,4 +115,4 @@ Image side_by_side(const std::vector<const Image*>& images, int gap) {
   return out;
 }
 
-}  // namespace vds::enc
+}  // namespace vds::io
