@@ -1,5 +1,5 @@
 // Benchmark driver for the client renderer (vds/render.h) against the host
-// reference renderer (vds/enc/ref_render.h). bench/run_render.sh runs it and
+// reference renderer (vds/ref/render.h). bench/run_render.sh runs it and
 // writes bench/results/render.md.
 //
 //   bench_render accuracy OUTDIR     PSNR of every shared scene, texture format,
@@ -38,12 +38,13 @@
 
 #include "vds/crc32c.h"
 #include "vds/enc/image_io.h"
-#include "vds/enc/ref_render.h"
-#include "vds/enc/scene.h"
+#include "vds/ref/render.h"
+#include "vds/ref/scene.h"
 #include "vds/render.h"
 
 using namespace vds;
 using namespace vds::enc;
+using namespace vds::ref;
 
 namespace {
 

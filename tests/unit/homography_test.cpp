@@ -12,14 +12,14 @@
 #include <random>
 #include <vector>
 
-#include "vds/enc/ref_render.h"
-#include "vds/enc/scene.h"
+#include "vds/ref/render.h"
+#include "vds/ref/scene.h"
 
 namespace vds {
 namespace {
 
-using enc::CameraD;
-using enc::Vec3d;
+using ref::CameraD;
+using ref::Vec3d;
 
 Vec3<Q16_16> fixed(Vec3d p) {
   return {Q16_16::from_raw(static_cast<int32_t>(std::llround(p.x * 65536))),
@@ -57,11 +57,11 @@ PlaneCase random_setup(std::mt19937& rng) {
   const Vec3d view_eye = eye + Vec3d{2 * u(rng), 0.5 * u(rng), 2 * u(rng)};
   const double fov = 45 + 20 * u(rng);
   PlaneCase s;
-  s.screen = enc::to_client(CameraD::look_at(eye, target, {0, 1, 0}, 240, 180, fov, 0.1, 100));
-  s.view = enc::to_client(CameraD::look_at(view_eye, target + Vec3d{u(rng), u(rng), u(rng)}, {0, 1, 0}, 240, 180,
+  s.screen = ref::to_client(CameraD::look_at(eye, target, {0, 1, 0}, 240, 180, fov, 0.1, 100));
+  s.view = ref::to_client(CameraD::look_at(view_eye, target + Vec3d{u(rng), u(rng), u(rng)}, {0, 1, 0}, 240, 180,
                                            fov + 10 * u(rng), 0.1, 100));
-  const Vec3d n = enc::normalize({u(rng), 1 + u(rng), u(rng)});
-  const Vec3d a = enc::normalize(enc::cross(n, {0.3, 0.1, 1})), b = enc::cross(n, a);
+  const Vec3d n = ref::normalize({u(rng), 1 + u(rng), u(rng)});
+  const Vec3d a = ref::normalize(ref::cross(n, {0.3, 0.1, 1})), b = ref::cross(n, a);
   const double size = 1 + 3 * (u(rng) + 1);
   s.plane[0] = fixed(target);
   s.plane[1] = fixed(target + a * size);
@@ -79,7 +79,7 @@ TEST(Homography, MapsScreenPointsLikeTheDoubleVersion) {
     ASSERT_EQ(plane_homography(s.screen, s.view, s.plane, &h), Status::ok);
     const CameraD sd = as_double(s.screen), vd = as_double(s.view);
     const Vec3d pl[3] = {as_double(s.plane[0]), as_double(s.plane[1]), as_double(s.plane[2])};
-    const enc::Mat3d hd = enc::plane_homography(sd, vd, pl);
+    const ref::Mat3d hd = ref::plane_homography(sd, vd, pl);
     // The normalised largest entry lies in [2^29, 2^30).
     int32_t mx = 0;
     for (auto& row : h.m)
@@ -90,13 +90,13 @@ TEST(Homography, MapsScreenPointsLikeTheDoubleVersion) {
       const double x = std::uniform_real_distribution<double>(0, 240)(rng);
       const double y = std::uniform_real_distribution<double>(0, 180)(rng);
       double ox, oy;
-      if (!enc::homography_apply(hd, x, y, &ox, &oy) || std::fabs(ox) > 2000 || std::fabs(oy) > 2000) continue;
+      if (!ref::homography_apply(hd, x, y, &ox, &oy) || std::fabs(ox) > 2000 || std::fabs(oy) > 2000) continue;
       int32_t fx, fy;
       const int32_t xq = static_cast<int32_t>(std::lround(x * 256)), yq = static_cast<int32_t>(std::lround(y * 256));
       ASSERT_TRUE(homography_apply(h, xq, yq, &fx, &fy)) << trial;
       // Compare at the same (rounded) input point.
       double rx, ry;
-      enc::homography_apply(hd, xq / 256.0, yq / 256.0, &rx, &ry);
+      ref::homography_apply(hd, xq / 256.0, yq / 256.0, &rx, &ry);
       const double err = std::hypot(fx / 256.0 - rx, fy / 256.0 - ry);
       worst = std::max(worst, err);
       ASSERT_LT(err, 1.0 / 64) << "trial " << trial << " at " << x << "," << y;
@@ -120,15 +120,15 @@ TEST(Homography, ScreenPointsOfThePlaneLandOnTheirViewProjection) {
     const CameraD sd = as_double(s.screen), vd = as_double(s.view);
     const Vec3d p0 = as_double(s.plane[0]), p1 = as_double(s.plane[1]), p2 = as_double(s.plane[2]);
     const Vec3d pl[3] = {p0, p1, p2};
-    const enc::Mat3d hd = enc::plane_homography(sd, vd, pl);
+    const ref::Mat3d hd = ref::plane_homography(sd, vd, pl);
     for (double a : {0.1, 0.4, 0.7})
       for (double b : {0.2, 0.5}) {
         const Vec3d p = p0 + (p1 - p0) * a + (p2 - p0) * (b * (1 - a));
         double sx, sy, vx, vy;
-        if (!enc::project(sd, p, &sx, &sy) || !enc::project(vd, p, &vx, &vy)) continue;
+        if (!ref::project(sd, p, &sx, &sy) || !ref::project(vd, p, &vx, &vy)) continue;
         int32_t hx, hy;
         ASSERT_TRUE(homography_apply(h, static_cast<int32_t>(std::lround(sx * 256)), static_cast<int32_t>(std::lround(sy * 256)), &hx, &hy));
-        const double tol = 0.01 + enc::homography_scale(hd, sx, sy) * (1.5 / 512);
+        const double tol = 0.01 + ref::homography_scale(hd, sx, sy) * (1.5 / 512);
         EXPECT_NEAR(hx / 256.0, vx, tol) << trial;
         EXPECT_NEAR(hy / 256.0, vy, tol) << trial;
       }
@@ -144,10 +144,10 @@ TEST(Homography, ScaleFactorMatchesTheDoubleClosedForm) {
     Homography vs;
     ASSERT_EQ(plane_homography(s.view, s.screen, s.plane, &vs), Status::ok);
     const Vec3d pl[3] = {as_double(s.plane[0]), as_double(s.plane[1]), as_double(s.plane[2])};
-    const enc::Mat3d hd = enc::plane_homography(as_double(s.view), as_double(s.screen), pl);
+    const ref::Mat3d hd = ref::plane_homography(as_double(s.view), as_double(s.screen), pl);
     for (int k = 0; k < 10; ++k) {
       const int32_t xq = static_cast<int32_t>(rng() % (240 * 256)), yq = static_cast<int32_t>(rng() % (180 * 256));
-      const double want = enc::homography_scale(hd, xq / 256.0, yq / 256.0);
+      const double want = ref::homography_scale(hd, xq / 256.0, yq / 256.0);
       if (!(want > 1.0 / 64 && want < 64)) continue;
       const double got = homography_scale(vs, xq, yq).raw() / 65536.0;
       const double err = std::fabs(got - want);
@@ -165,7 +165,7 @@ TEST(Homography, ExactCases) {
   const CameraD base = CameraD::look_at({0, 2, -6}, {0, 0, 0}, {0, 1, 0}, 240, 180, 60, 0.1, 100);
   const Vec3<Q16_16> plane[3] = {fixed({-1, 0, -1}), fixed({1, 0, -1}), fixed({0, 0, 1})};
   // Same camera: the identity (up to scale), scale factor 1.
-  const Camera c = enc::to_client(base);
+  const Camera c = ref::to_client(base);
   Homography h;
   ASSERT_EQ(plane_homography(c, c, plane, &h), Status::ok);
   for (int32_t x : {0, 1000, 30000, 61439})
@@ -182,7 +182,7 @@ TEST(Homography, ExactCases) {
   CameraD zoom = base;
   zoom.fx *= 2;
   zoom.fy *= 2;
-  const Camera cz = enc::to_client(zoom);
+  const Camera cz = ref::to_client(zoom);
   Homography vs, sv;
   ASSERT_EQ(plane_homography(cz, c, plane, &vs), Status::ok);
   ASSERT_EQ(plane_homography(c, cz, plane, &sv), Status::ok);
@@ -211,7 +211,7 @@ TEST(Homography, TextureQualityAgreesWithTheHostAndDecidesTheSame) {
     Q16_16 q;
     ASSERT_EQ(texture_quality(s.screen, s.view, poly, 3, &q), Status::ok);
     const Vec3d pl[3] = {as_double(poly[0]), as_double(poly[1]), as_double(poly[2])};
-    const enc::Mat3d vs = enc::plane_homography(as_double(s.view), as_double(s.screen), pl);
+    const ref::Mat3d vs = ref::plane_homography(as_double(s.view), as_double(s.screen), pl);
     double want = 0;
     bool behind = false;
     for (const Vec3<Q16_16>& p : poly) {
@@ -220,7 +220,7 @@ TEST(Homography, TextureQualityAgreesWithTheHostAndDecidesTheSame) {
         behind = true;
         break;
       }
-      want = std::max(want, enc::homography_scale(vs, x / 256.0, y / 256.0));
+      want = std::max(want, ref::homography_scale(vs, x / 256.0, y / 256.0));
     }
     if (behind) {
       EXPECT_EQ(q, Q16_16::max());
@@ -242,7 +242,7 @@ TEST(Homography, TextureQualityAgreesWithTheHostAndDecidesTheSame) {
 }
 
 TEST(Homography, RejectsDegenerateInput) {
-  const Camera c = enc::to_client(CameraD::look_at({0, 2, -6}, {0, 0, 0}, {0, 1, 0}, 240, 180, 60, 0.1, 100));
+  const Camera c = ref::to_client(CameraD::look_at({0, 2, -6}, {0, 0, 0}, {0, 1, 0}, 240, 180, 60, 0.1, 100));
   Homography h;
   const Vec3<Q16_16> line[3] = {fixed({0, 0, 0}), fixed({1, 0, 0}), fixed({2, 0, 0})};
   EXPECT_EQ(plane_homography(c, c, line, &h), Status::invalid_argument);

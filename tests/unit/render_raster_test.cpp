@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "vds/enc/scene.h"
+#include "vds/ref/scene.h"
 #include "vds/render.h"
 
 namespace vds {
@@ -158,18 +158,18 @@ TEST(RenderRaster, DegenerateTrianglesDrawNothing) {
 // the screen edges. Its front faces must tile exactly the region its back
 // faces tile (no gap), and no pixel may be rasterised twice (pixels
 // rasterised == pixels covered).
-enc::Scene convex_mesh_scene(std::mt19937& rng) {
-  enc::Scene s;
+ref::Scene convex_mesh_scene(std::mt19937& rng) {
+  ref::Scene s;
   s.width = kW;
   s.height = kH;
-  enc::MeshD m;
+  ref::MeshD m;
   m.shading = Shading::flat;
   m.color = 0xFFFFFF;
   // An icosphere subdivided twice, squashed and rotated randomly.
   const double t = (1 + std::sqrt(5.0)) / 2;
-  std::vector<enc::Vec3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
+  std::vector<ref::Vec3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
                                {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  for (enc::Vec3d& p : v) p = enc::normalize(p);  // all on the unit sphere: convex
+  for (ref::Vec3d& p : v) p = ref::normalize(p);  // all on the unit sphere: convex
   std::vector<int> f = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8,
                         3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
   for (int level = 0; level < 2; ++level) {
@@ -177,7 +177,7 @@ enc::Scene convex_mesh_scene(std::mt19937& rng) {
     for (size_t i = 0; i < f.size(); i += 3) {
       int mid[3];
       for (int k = 0; k < 3; ++k) {
-        v.push_back(enc::normalize(v[static_cast<size_t>(f[i + k])] + v[static_cast<size_t>(f[i + (k + 1) % 3])]));
+        v.push_back(ref::normalize(v[static_cast<size_t>(f[i + k])] + v[static_cast<size_t>(f[i + (k + 1) % 3])]));
         mid[k] = static_cast<int>(v.size() - 1);
       }
       g.insert(g.end(), {f[i], mid[0], mid[2], mid[0], f[i + 1], mid[1], mid[2], mid[1], f[i + 2], mid[0], mid[1], mid[2]});
@@ -185,28 +185,28 @@ enc::Scene convex_mesh_scene(std::mt19937& rng) {
     f = g;
   }
   std::uniform_real_distribution<double> u(-1, 1);
-  const enc::Vec3d axis = enc::normalize({u(rng), u(rng), u(rng)});
+  const ref::Vec3d axis = ref::normalize({u(rng), u(rng), u(rng)});
   const double ang = 3.14159 * u(rng);
-  const enc::Vec3d scale{1.0 + 0.5 * u(rng), 0.7 + 0.3 * u(rng), 1.0 + 0.4 * u(rng)};
-  const enc::Vec3d centre{4.0 * u(rng), 3.0 * u(rng), 6 + 2 * u(rng)};  // often partly off screen
+  const ref::Vec3d scale{1.0 + 0.5 * u(rng), 0.7 + 0.3 * u(rng), 1.0 + 0.4 * u(rng)};
+  const ref::Vec3d centre{4.0 * u(rng), 3.0 * u(rng), 6 + 2 * u(rng)};  // often partly off screen
   for (int idx : f) {
     // Midpoints are duplicated per face: identical positions give identical
     // projections, so shared edges still match exactly.
-    enc::Vec3d p = v[static_cast<size_t>(idx)];
+    ref::Vec3d p = v[static_cast<size_t>(idx)];
     p = {p.x * scale.x, p.y * scale.y, p.z * scale.z};
     // Rodrigues rotation.
-    const enc::Vec3d k = axis;
-    p = p * std::cos(ang) + enc::cross(k, p) * std::sin(ang) + k * (enc::dot(k, p) * (1 - std::cos(ang)));
+    const ref::Vec3d k = axis;
+    p = p * std::cos(ang) + ref::cross(k, p) * std::sin(ang) + k * (ref::dot(k, p) * (1 - std::cos(ang)));
     m.indices.push_back(s.add_vertex(p + centre));
   }
   // Outward winding: flip triangles whose normal points at the centre.
   for (size_t i = 0; i < m.indices.size(); i += 3) {
-    const enc::Vec3d a = s.positions[m.indices[i]], b = s.positions[m.indices[i + 1]], c = s.positions[m.indices[i + 2]];
-    if (enc::dot(enc::cross(b - a, c - a), a - centre) < 0) std::swap(m.indices[i + 1], m.indices[i + 2]);
+    const ref::Vec3d a = s.positions[m.indices[i]], b = s.positions[m.indices[i + 1]], c = s.positions[m.indices[i + 2]];
+    if (ref::dot(ref::cross(b - a, c - a), a - centre) < 0) std::swap(m.indices[i + 1], m.indices[i + 2]);
   }
   s.meshes.push_back(m);
   // Camera with a random sub-pixel principal point.
-  s.camera = enc::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, kW, kH, 60, 0.5, 50);
+  s.camera = ref::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, kW, kH, 60, 0.5, 50);
   s.camera.cx += u(rng) * 0.5;
   s.camera.cy += u(rng) * 0.5;
   s.clear_color = 0;
@@ -216,15 +216,15 @@ enc::Scene convex_mesh_scene(std::mt19937& rng) {
 TEST(RenderRaster, ClosedMeshFrontAndBackTileTheSameRegionOnce) {
   std::mt19937 rng(777);
   for (int trial = 0; trial < 25; ++trial) {
-    enc::Scene s = convex_mesh_scene(rng);
-    enc::ClientRenderSettings st;
+    ref::Scene s = convex_mesh_scene(rng);
+    ref::ClientRenderSettings st;
     st.format = PixelFormat::rgb888;
     st.band_height = 1 + trial % 17;
-    enc::Scene back = s;
+    ref::Scene back = s;
     back.meshes[0].cull = Cull::front;  // draw only the back faces
-    const enc::ClientScene cf(s, TexFormat::rgb565), cb(back, TexFormat::rgb565);
-    const enc::ClientFrame ff = enc::render_client(cf, kW, kH, st);
-    const enc::ClientFrame fb = enc::render_client(cb, kW, kH, st);
+    const ref::ClientScene cf(s, TexFormat::rgb565), cb(back, TexFormat::rgb565);
+    const ref::ClientFrame ff = ref::render_client(cf, kW, kH, st);
+    const ref::ClientFrame fb = ref::render_client(cb, kW, kH, st);
     ASSERT_EQ(ff.status, Status::ok);
     ASSERT_EQ(fb.status, Status::ok);
     uint32_t covered_front = 0, covered_back = 0, mismatch = 0;

@@ -1,5 +1,5 @@
 // The client renderer (vds/render.h) against the double-precision reference
-// (vds/enc/ref_render.h) on the shared scenes, and its contract: band height
+// (vds/ref/render.h) on the shared scenes, and its contract: band height
 // never changes the picture and nothing is written outside the band,
 // clipping, degenerate and hostile input, validation, and golden checksums
 // for comparing builds.
@@ -17,32 +17,32 @@
 #include "../../decoder/src/render_internal.h"
 #include "vds/crc32c.h"
 #include "vds/enc/image_io.h"
-#include "vds/enc/ref_render.h"
-#include "vds/enc/scene.h"
+#include "vds/ref/render.h"
+#include "vds/ref/scene.h"
 
 namespace vds {
 namespace {
 
-using enc::ClientFrame;
-using enc::ClientRenderSettings;
-using enc::ClientScene;
-using enc::Scene;
+using ref::ClientFrame;
+using ref::ClientRenderSettings;
+using ref::ClientScene;
+using ref::Scene;
 
 const char* tex_name(TexFormat f) {
   return f == TexFormat::rgb565 ? "rgb565" : f == TexFormat::xrgb8888 ? "xrgb8888" : "ycbcr420";
 }
 
 Scene view_mapped_cube() {
-  const Scene base = enc::make_cube_scene();
-  const enc::CameraD view_cam = enc::CameraD::look_at({2.8, 2.9, -4.8}, {0.2, 0.9, 0.3}, {0, 1, 0}, 240, 180, 55, 0.5, 60);
-  const enc::RefFrame view = enc::ref_render(base, view_cam, 240, 180);
+  const Scene base = ref::make_cube_scene();
+  const ref::CameraD view_cam = ref::CameraD::look_at({2.8, 2.9, -4.8}, {0.2, 0.9, 0.3}, {0, 1, 0}, 240, 180, 55, 0.5, 60);
+  const ref::RefFrame view = ref::ref_render(base, view_cam, 240, 180);
   std::vector<int> faces;
   for (int i = 0; i < static_cast<int>(base.meshes.size()); ++i) faces.push_back(i);
-  return enc::make_view_mapped_scene(base, faces, view.image, view_cam);
+  return ref::make_view_mapped_scene(base, faces, view.image, view_cam);
 }
 
 std::vector<Scene> all_scenes() {
-  std::vector<Scene> v = enc::shared_scenes();
+  std::vector<Scene> v = ref::shared_scenes();
   v.push_back(view_mapped_cube());
   return v;
 }
@@ -53,14 +53,14 @@ std::vector<Scene> all_scenes() {
 TEST(RenderAccuracy, SharedScenesReach45dBAgainstTheFloatReference) {
   for (const Scene& base : all_scenes()) {
     for (TexFormat tf : {TexFormat::xrgb8888, TexFormat::rgb565, TexFormat::ycbcr420}) {
-      const Scene sc = enc::client_textures(base, tf);
-      const enc::RefFrame ref = enc::ref_render(sc);
+      const Scene sc = ref::client_textures(base, tf);
+      const ref::RefFrame ref = ref::ref_render(sc);
       const ClientScene cs(sc, tf);
       for (DepthFormat df : {DepthFormat::d32, DepthFormat::d16}) {
         ClientRenderSettings st;
         st.format = PixelFormat::rgb888;
         st.depth = df;
-        const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, st);
+        const ClientFrame fr = ref::render_client(cs, sc.width, sc.height, st);
         ASSERT_EQ(fr.status, Status::ok);
         const double p = enc::psnr(ref.image, fr.image);
         EXPECT_GE(p, 45.0) << sc.name << " " << tex_name(tf) << (df == DepthFormat::d16 ? " d16" : " d32");
@@ -74,9 +74,9 @@ TEST(RenderAccuracy, Rgb565OutputMatchesTheRoundedReference) {
   // With rgb565 output the client rounds once more (5-bit bilinear weights,
   // 5/6/5 channels), so a 1-step difference in 5 bits costs 8 levels: the
   // bound is lower than for rgb888.
-  for (const Scene& base : enc::shared_scenes()) {
-    const Scene sc = enc::client_textures(base, TexFormat::rgb565);
-    enc::Image ref = enc::ref_render(sc).image;
+  for (const Scene& base : ref::shared_scenes()) {
+    const Scene sc = ref::client_textures(base, TexFormat::rgb565);
+    enc::Image ref = ref::ref_render(sc).image;
     for (size_t i = 0; i < ref.pixels.size(); ++i) {
       const uint32_t v = ref.pixels[i];
       const bool green = i % 3 == 1;
@@ -86,7 +86,7 @@ TEST(RenderAccuracy, Rgb565OutputMatchesTheRoundedReference) {
     const ClientScene cs(sc, TexFormat::rgb565);
     ClientRenderSettings st;
     st.format = PixelFormat::rgb565;
-    const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, st);
+    const ClientFrame fr = ref::render_client(cs, sc.width, sc.height, st);
     ASSERT_EQ(fr.status, Status::ok);
     EXPECT_GE(enc::psnr(ref, fr.image), 40.0) << sc.name;
   }
@@ -113,7 +113,7 @@ TEST(RenderAccuracy, PerPixelReciprocalWithinStatedBound) {
 // Bands
 // ---------------------------------------------------------------------------
 TEST(RenderBands, AnyBandHeightAndCacheSizesGiveTheSameFrame) {
-  for (const Scene& base : {enc::make_cube_scene(), enc::make_room_scene(), enc::make_golden_scene()}) {
+  for (const Scene& base : {ref::make_cube_scene(), ref::make_room_scene(), ref::make_golden_scene()}) {
     const ClientScene cs(base, TexFormat::rgb565);
     for (PixelFormat of : {PixelFormat::rgb565, PixelFormat::rgb888}) {
       std::vector<uint8_t> first;
@@ -127,7 +127,7 @@ TEST(RenderBands, AnyBandHeightAndCacheSizesGiveTheSameFrame) {
           // Set-ups kept across bands: none, a few slots shared by many
           // triangles (evictions), or one per triangle.
           st.setup_cache = cache == 0u ? 0u : (cache == 5u ? 3u : 4096u);
-          const ClientFrame fr = enc::render_client(cs, 240, 180, st);
+          const ClientFrame fr = ref::render_client(cs, 240, 180, st);
           ASSERT_EQ(fr.status, Status::ok);
           if (first.empty()) {
             first = fr.bytes;
@@ -144,7 +144,7 @@ TEST(RenderBands, AnyBandHeightAndCacheSizesGiveTheSameFrame) {
 // checks at every band that rows not yet drawn still hold the sentinel and
 // rows of finished bands have not changed since.
 TEST(RenderBands, NothingIsWrittenOutsideTheCurrentBand) {
-  const Scene sc = enc::make_room_scene(120, 90);
+  const Scene sc = ref::make_room_scene(120, 90);
   const ClientScene cs(sc, TexFormat::xrgb8888);
   for (PixelFormat of : {PixelFormat::rgb565, PixelFormat::rgb888}) {
     for (uint16_t band : {1, 7, 16, 90}) {
@@ -207,7 +207,7 @@ TEST(RenderBands, NothingIsWrittenOutsideTheCurrentBand) {
 }
 
 TEST(RenderBands, SinkReturningFalseAborts) {
-  const ClientScene cs(enc::make_cube_scene(), TexFormat::rgb565);
+  const ClientScene cs(ref::make_cube_scene(), TexFormat::rgb565);
   RenderConfig cfg;
   cfg.width = 240;
   cfg.height = 180;
@@ -227,31 +227,31 @@ TEST(RenderBands, SinkReturningFalseAborts) {
 // ---------------------------------------------------------------------------
 // Texture coordinates are 24 texels per unit, or `uv_scale`: they must stay
 // within the Q16.16 range (+-32768 texels).
-Scene single_triangle(enc::Vec3d a, enc::Vec3d b, enc::Vec3d c, double uv_scale = 24, Cull cull = Cull::none) {
+Scene single_triangle(ref::Vec3d a, ref::Vec3d b, ref::Vec3d c, double uv_scale = 24, Cull cull = Cull::none) {
   Scene s;
   s.width = 160;
   s.height = 120;
   s.clear_color = 0x000000;
   s.textures.push_back({});
-  s.textures[0].image = enc::make_checker_texture(64, 8, 0xF0E0D0, 0x304050);
-  enc::MeshD m;
+  s.textures[0].image = ref::make_checker_texture(64, 8, 0xF0E0D0, 0x304050);
+  ref::MeshD m;
   m.shading = Shading::texture;
   m.texture = 0;
   m.cull = cull;
-  for (const enc::Vec3d& p : {a, b, c}) m.indices.push_back(s.add_vertex(p, {p.x * uv_scale + 7, p.z * uv_scale - 3}));
+  for (const ref::Vec3d& p : {a, b, c}) m.indices.push_back(s.add_vertex(p, {p.x * uv_scale + 7, p.z * uv_scale - 3}));
   s.meshes.push_back(m);
-  s.camera = enc::CameraD::look_at({0, 1.5, 0}, {0, 0.5, 4}, {0, 1, 0}, 160, 120, 70, 0.25, 50);
+  s.camera = ref::CameraD::look_at({0, 1.5, 0}, {0, 0.5, 4}, {0, 1, 0}, 160, 120, 70, 0.25, 50);
   return s;
 }
 
 void expect_matches_reference(const Scene& sc, double min_psnr) {
-  const Scene q = enc::client_textures(sc, TexFormat::xrgb8888);
-  const enc::RefFrame ref = enc::ref_render(q);
+  const Scene q = ref::client_textures(sc, TexFormat::xrgb8888);
+  const ref::RefFrame ref = ref::ref_render(q);
   const ClientScene cs(q, TexFormat::xrgb8888);
   ClientRenderSettings st;
   for (int band : {1, 16, sc.height}) {
     st.band_height = band;
-    const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, st);
+    const ClientFrame fr = ref::render_client(cs, sc.width, sc.height, st);
     ASSERT_EQ(fr.status, Status::ok);
     EXPECT_GE(enc::psnr(ref.image, fr.image), min_psnr) << "band " << band;
   }
@@ -260,7 +260,7 @@ void expect_matches_reference(const Scene& sc, double min_psnr) {
 TEST(RenderClip, TriangleBehindTheCameraDrawsNothing) {
   const Scene sc = single_triangle({-1, 0, -3}, {1, 0, -3}, {0, 2, -2});
   const ClientScene cs(sc, TexFormat::rgb565);
-  const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, {});
+  const ClientFrame fr = ref::render_client(cs, sc.width, sc.height, {});
   ASSERT_EQ(fr.status, Status::ok);
   EXPECT_EQ(fr.stats.pixels, 0u);
   for (uint8_t v : fr.image.pixels) ASSERT_EQ(v, 0);
@@ -277,8 +277,8 @@ TEST(RenderClip, NearPlaneAndGuardBandClippingMatchTheReference) {
 }
 
 TEST(RenderClip, RoomWithTheCameraAgainstAWall) {
-  Scene sc = enc::make_room_scene(160, 120);
-  sc.camera = enc::CameraD::look_at({-3.93, 1.2, 0.3}, {3.0, 0.9, 0.9}, {0, 1, 0}, 160, 120, 80, 0.05, 20);
+  Scene sc = ref::make_room_scene(160, 120);
+  sc.camera = ref::CameraD::look_at({-3.93, 1.2, 0.3}, {3.0, 0.9, 0.9}, {0, 1, 0}, 160, 120, 80, 0.05, 20);
   expect_matches_reference(sc, 45);
 }
 
@@ -289,12 +289,12 @@ TEST(RenderDegenerate, ZeroAreaAndTinyTrianglesDrawNothing) {
   Scene s;
   s.width = 64;
   s.height = 48;
-  enc::MeshD m;
+  ref::MeshD m;
   m.shading = Shading::flat;
   m.color = 0xFFFFFF;
   m.cull = Cull::none;
-  auto tri = [&](enc::Vec3d a, enc::Vec3d b, enc::Vec3d c) {
-    for (const enc::Vec3d& p : {a, b, c}) m.indices.push_back(s.add_vertex(p));
+  auto tri = [&](ref::Vec3d a, ref::Vec3d b, ref::Vec3d c) {
+    for (const ref::Vec3d& p : {a, b, c}) m.indices.push_back(s.add_vertex(p));
   };
   tri({0, 0, 5}, {0, 0, 5}, {0, 0, 5});          // a point
   tri({-1, -1, 5}, {0, 0, 5}, {1, 1, 5});        // collinear
@@ -303,11 +303,11 @@ TEST(RenderDegenerate, ZeroAreaAndTinyTrianglesDrawNothing) {
   // A sliver between pixel centres: covers no centre.
   tri({0.001, 0.001, 5}, {0.004, 0.001, 5}, {0.001, 0.004, 5});
   s.meshes.push_back(m);
-  s.camera = enc::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 64, 48, 60, 0.5, 50);
+  s.camera = ref::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 64, 48, 60, 0.5, 50);
   s.camera.cx = 32.25;  // pixel centres at +-1/4 pixel around the optical axis
   s.camera.cy = 24.25;
   const ClientScene cs(s, TexFormat::rgb565);
-  const ClientFrame fr = enc::render_client(cs, 64, 48, {});
+  const ClientFrame fr = ref::render_client(cs, 64, 48, {});
   ASSERT_EQ(fr.status, Status::ok);
   EXPECT_EQ(fr.stats.pixels, 0u);
 }
@@ -357,7 +357,7 @@ TEST(RenderDegenerate, HostileCoordinatesAreSafe) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) meshes[4].view_map.m[i][j] = static_cast<int32_t>(rng());
   DrawList list{pos.data(), static_cast<uint32_t>(pos.size()), meshes, 5};
-  const Camera cam = enc::to_client(enc::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 80, 60, 60, 0.01, 40));
+  const Camera cam = ref::to_client(ref::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 80, 60, 60, 0.01, 40));
   for (PixelFormat of : {PixelFormat::rgb565, PixelFormat::rgb888}) {
     for (DepthFormat df : {DepthFormat::d16, DepthFormat::d32}) {
       RenderConfig cfg;
@@ -422,7 +422,7 @@ TEST(RenderApi, ValidationStatuses) {
   }
   Arena a(ws.data(), ws.size());
   Renderer r;
-  const Camera cam = enc::to_client(enc::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 64, 48, 60, 0.5, 50));
+  const Camera cam = ref::to_client(ref::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 64, 48, 60, 0.5, 50));
   auto sink = [](void*, const Band&) { return true; };
   DrawList empty{};
   EXPECT_EQ(r.render(cam, empty, 0, sink, nullptr), Status::invalid_argument);  // not initialised
@@ -483,14 +483,14 @@ TEST(RenderApi, ValidationStatuses) {
 }
 
 TEST(RenderApi, ApronAndPlainTexturesGiveTheSameFrame) {
-  for (const Scene& base : {enc::make_cube_scene(), enc::make_golden_scene()}) {
+  for (const Scene& base : {ref::make_cube_scene(), ref::make_golden_scene()}) {
     for (TexFormat tf : {TexFormat::rgb565, TexFormat::xrgb8888}) {
       const ClientScene with(base, tf, true), without(base, tf, false);
       for (PixelFormat of : {PixelFormat::rgb565, PixelFormat::rgb888}) {
         ClientRenderSettings st;
         st.format = of;
-        const ClientFrame a = enc::render_client(with, 240, 180, st);
-        const ClientFrame b = enc::render_client(without, 240, 180, st);
+        const ClientFrame a = ref::render_client(with, 240, 180, st);
+        const ClientFrame b = ref::render_client(without, 240, 180, st);
         ASSERT_EQ(a.status, Status::ok);
         EXPECT_EQ(a.bytes, b.bytes) << base.name << " " << tex_name(tf);
       }
@@ -525,7 +525,7 @@ TEST(RenderApi, GridPositionsDrawWhatTheirWorldPositionsDraw) {
   m.shading = Shading::gouraud;
   m.cull = Cull::none;
   m.colors = colors.data();
-  const Camera cam = enc::to_client(enc::CameraD::look_at({0, 1.6, -1.8}, {0, 0, 0}, {0, 1, 0}, 96, 72, 60, 0.1, 20));
+  const Camera cam = ref::to_client(ref::CameraD::look_at({0, 1.6, -1.8}, {0, 0, 0}, {0, 1, 0}, 96, 72, 60, 0.1, 20));
   for (const uint8_t shift : {uint8_t{5}, uint8_t{6}}) {
     const Vec3<Q16_16> origin{Q16_16::from_raw(-(2048 << shift)), Q16_16::from_raw(-(2048 << shift)),
                               Q16_16::from_raw(-(2048 << shift))};
@@ -590,7 +590,7 @@ TEST(RenderApi, BandRenderingOf240x180In16LineBandsFitsIn16KiB) {
   Arena a(ws.data(), ws.size());
   Renderer r;
   ASSERT_EQ(r.init(cfg, a), Status::ok);
-  const ClientScene cs(enc::make_room_scene(), TexFormat::rgb565);
+  const ClientScene cs(ref::make_room_scene(), TexFormat::rgb565);
   EXPECT_EQ(r.render(cs.camera(), cs.list(), 0, [](void*, const Band&) { return true; }, nullptr), Status::ok);
 }
 
@@ -601,7 +601,7 @@ TEST(RenderApi, BandRenderingOf240x180In16LineBandsFitsIn16KiB) {
 // arithmetic changes them on purpose: update them in the same change.
 // ---------------------------------------------------------------------------
 TEST(RenderGolden, FrameChecksums) {
-  const Scene sc = enc::make_golden_scene();
+  const Scene sc = ref::make_golden_scene();
   struct G {
     TexFormat tex;
     PixelFormat out;
@@ -615,12 +615,12 @@ TEST(RenderGolden, FrameChecksums) {
       {TexFormat::ycbcr420, PixelFormat::rgb888, DepthFormat::d16, 7, 0xb09d0f47u},
   };
   for (const G& g : golden) {
-    const ClientScene cs(enc::client_textures(sc, g.tex), g.tex);
+    const ClientScene cs(ref::client_textures(sc, g.tex), g.tex);
     ClientRenderSettings st;
     st.format = g.out;
     st.depth = g.depth;
     st.band_height = g.band;
-    const ClientFrame fr = enc::render_client(cs, sc.width, sc.height, st);
+    const ClientFrame fr = ref::render_client(cs, sc.width, sc.height, st);
     ASSERT_EQ(fr.status, Status::ok);
     EXPECT_EQ(crc32c(fr.bytes.data(), fr.bytes.size()), g.crc) << tex_name(g.tex) << std::hex;
   }

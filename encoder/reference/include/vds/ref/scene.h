@@ -12,10 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "vds/enc/image_io.h"
+#include "vds/io/image.h"
 #include "vds/render.h"
 
-namespace vds::enc {
+namespace vds::ref {
+
+using io::Image;
 
 struct Vec2d {
   double x = 0, y = 0;
@@ -188,4 +190,4 @@ ClientFrame render_client(const ClientScene& scene, int width, int height, const
 ClientFrame render_client(const ClientScene& scene, const vds::Camera& camera, int width, int height,
                           const ClientRenderSettings& settings);
 
-}  // namespace vds::enc
+}  // namespace vds::ref

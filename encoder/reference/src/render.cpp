@@ -2,7 +2,7 @@
 // client's primitives and fill rule on edge functions, attributes from the
 // exact ray-plane intersection of each pixel centre, plus mip-mapping,
 // lightmaps and supersampling for ground-truth frames.
-#include "vds/enc/ref_render.h"
+#include "vds/ref/render.h"
 
 #include <algorithm>
 #include <array>
@@ -10,7 +10,7 @@
 #include <limits>
 #include <map>
 
-namespace vds::enc {
+namespace vds::ref {
 
 namespace {
 
@@ -391,4 +391,4 @@ RefFrame ref_render(const Scene& scene, const CameraD& camera_in, int width, int
   return out;
 }
 
-}  // namespace vds::enc
+}  // namespace vds::ref

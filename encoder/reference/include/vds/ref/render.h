@@ -17,10 +17,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "vds/enc/image_io.h"
-#include "vds/enc/scene.h"
+#include "vds/io/image.h"
+#include "vds/ref/scene.h"
 
-namespace vds::enc {
+namespace vds::ref {
 
 struct RefOptions {
   bool mipmap = false;          // trilinear mip-mapping of power-of-two RGB textures
@@ -57,4 +57,4 @@ double homography_scale(const Mat3d& h, double x, double y);
 // vertex is behind the view camera.
 double texture_quality(const CameraD& screen, const CameraD& view, const std::vector<Vec3d>& polygon);
 
-}  // namespace vds::enc
+}  // namespace vds::ref

@@ -1,6 +1,6 @@
 // The shared scene description (vds/enc/scene.h): vector helpers, cameras,
 // procedural textures, the standard scenes and their fixed-point client copy.
-#include "vds/enc/scene.h"
+#include "vds/ref/scene.h"
 
 #include <algorithm>
 #include <cmath>
@@ -9,7 +9,7 @@
 
 #include "vds/homography.h"
 
-namespace vds::enc {
+namespace vds::ref {
 
 namespace {
 
@@ -773,4 +773,4 @@ ClientFrame render_client(const ClientScene& scene, const vds::Camera& camera, i
   return out;
 }
 
-}  // namespace vds::enc
+}  // namespace vds::ref
