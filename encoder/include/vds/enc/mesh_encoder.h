@@ -15,6 +15,7 @@
 #include "vds/enc/mesh_import.h"
 #include "vds/enc/mesh_simplify.h"
 #include "vds/mesh.h"
+#include "vds/mesh_model.h"
 
 namespace vds::enc {
 
