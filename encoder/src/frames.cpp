@@ -6,9 +6,11 @@
 #include <memory>
 #include <stdexcept>
 
+#include "vds/bytes.h"
 #include "vds/container.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/image.h"
+#include "vds/io/image.h"
 #include "vds/player.h"
 
 namespace vds::enc {
@@ -86,11 +88,7 @@ bool replay_band(void* ctx, const PixelRect& r) {
   for (uint16_t row = 0; row < r.h; ++row) {
     const uint8_t* line = r.pixels + row * r.stride;
     for (uint16_t x = 0; x < r.w; ++x) {
-      const uint16_t p = static_cast<uint16_t>(line[2 * x] | (line[2 * x + 1] << 8));
-      const uint32_t rr = (p >> 11) & 31, gg = (p >> 5) & 63, bb = p & 31;
-      img.at(r.x + x, r.y + row, 0) = static_cast<uint8_t>((rr << 3) | (rr >> 2));
-      img.at(r.x + x, r.y + row, 1) = static_cast<uint8_t>((gg << 2) | (gg >> 4));
-      img.at(r.x + x, r.y + row, 2) = static_cast<uint8_t>((bb << 3) | (bb >> 2));
+      io::rgb565_to_rgb888(load_le16(line + 2 * x), &img.at(r.x + x, r.y + row, 0));
     }
   }
   return true;

@@ -95,4 +95,21 @@ struct DeviceReader {
   }
 };
 
+// Steps `sim` with `src` writing and `rd` reading until the device
+// application holds the whole stream (and, with `until_acked`, the host has
+// it all acknowledged) or the simulated clock reaches `limit_ms`. Returns
+// when the host was first seen established (where a goodput measurement
+// starts), 0 if never.
+inline uint64_t stream_down(LinkSim& sim, StreamSource& src, DeviceReader& rd, uint64_t limit_ms,
+                            bool until_acked = false) {
+  uint64_t established_ms = 0;
+  while (!(rd.check.got == src.total && (!until_acked || src.done(sim.host()))) && sim.now_ms() < limit_ms) {
+    if (established_ms == 0 && sim.host().established()) established_ms = sim.now_ms();
+    src.pump(sim.host());
+    sim.step();
+    rd.pump(sim.device());
+  }
+  return established_ms;
+}
+
 }  // namespace vds::link::linktest

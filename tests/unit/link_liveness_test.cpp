@@ -76,12 +76,7 @@ TEST(LinkLiveness, SlowDeviceReceivesEverythingAndIsNeverOverrun) {
     // slack for the handshake, the last round trips and timeouts.
     const double drain_bytes_per_ms = kBaud / 10.0 / 1000.0 * c.rate_permille / 1000.0;
     const double efficiency = c.ber != 0 ? 0.75 : 0.90;
-    const uint64_t limit_ms = 600000;
-    while (!(src.done(sim.host()) && rd.check.got == total) && sim.now_ms() < limit_ms) {
-      src.pump(sim.host());
-      sim.step();
-      rd.pump(sim.device());
-    }
+    stream_down(sim, src, rd, 600000, true);
     const DrainStats& d = sim.slow_device()->stats();
     const double bound_ms = static_cast<double>(total) / (drain_bytes_per_ms * efficiency) +
                             static_cast<double>(d.paused_ms) + 5000.0;
@@ -123,13 +118,7 @@ TEST(LinkLiveness, GoodputFollowsTheDrainRate) {
     StreamSource src{5, total};
     DeviceReader rd;
     rd.check.seed = 5;
-    uint64_t start = 0;
-    while (rd.check.got < total && sim.now_ms() < 600000) {
-      if (start == 0 && sim.host().established()) start = sim.now_ms();
-      src.pump(sim.host());
-      sim.step();
-      rd.pump(sim.device());
-    }
+    const uint64_t start = stream_down(sim, src, rd, 600000);
     const double drain = kBaud / 10.0 * rate / 1000.0;
     const double goodput = static_cast<double>(total) / (static_cast<double>(sim.now_ms() - start) / 1000.0);
     SCOPED_TRACE("drain " + std::to_string(rate / 10) + " %");
@@ -185,11 +174,7 @@ TEST(LinkLiveness, SmallLineBufferCapsTheFrameSize) {
   StreamSource src{7, total};
   DeviceReader rd;
   rd.check.seed = 7;
-  while (rd.check.got < total && sim.now_ms() < 120000) {
-    src.pump(sim.host());
-    sim.step();
-    rd.pump(sim.device());
-  }
+  stream_down(sim, src, rd, 120000);
   EXPECT_EQ(rd.check.got, total);
   EXPECT_TRUE(rd.check.intact);
   EXPECT_LE(sim.host().frame_payload(), 256u - line_reserve(256));
@@ -223,11 +208,7 @@ TEST(LinkLiveness, LongIdleSessionThenData) {
   DeviceReader rd;
   rd.check.seed = 9;
   const uint64_t start = sim.now_ms();
-  while (rd.check.got < total && sim.now_ms() < start + 60000) {
-    src.pump(sim.host());
-    sim.step();
-    rd.pump(sim.device());
-  }
+  stream_down(sim, src, rd, start + 60000);
   EXPECT_EQ(rd.check.got, total);
   EXPECT_TRUE(rd.check.intact);
   EXPECT_LT(sim.now_ms() - start, 5000u) << "the stream starts at once";

@@ -208,7 +208,6 @@ class Player {
   uint64_t feed_mark_ = 0;
   PlayedFrame at_start_{};  // the totals a frame's counts start from
   uint32_t frame_crc_ = 0;
-  bool in_frame_ = false;
   uint32_t frames_ = 0;
 };
 

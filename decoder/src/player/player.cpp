@@ -41,7 +41,6 @@ Status Player::init(Arena& arena, const PlayerConfig& config, const PlayerCallba
   feed_mark_ = 0;
   at_start_ = PlayedFrame{};
   frame_crc_ = 0;
-  in_frame_ = false;
   frames_ = 0;
   band_buffer = nullptr;
   model_frames = ModelFrames{};
@@ -98,7 +97,6 @@ void Player::restart_counts(uint64_t parse_from) {
 }
 
 bool Player::begin_frame() {
-  in_frame_ = true;
   frame_crc_ = 0;
   const uint64_t t0 = work_clock();
   const bool go = cb_.begin_frame == nullptr || cb_.begin_frame(cb_.ctx, parser_.header().width, parser_.header().height);
@@ -129,7 +127,6 @@ bool Player::end_frame() {
   f.entropy = stages_.spent[StageClock::entropy] - at_start_.entropy;
   f.transform = stages_.spent[StageClock::transform] - at_start_.transform;
   ++frames_;
-  in_frame_ = false;
   if (cb_.frame_shown != nullptr) cb_.frame_shown(cb_.ctx, f);
   restart_counts(parse_total_);  // the next frame's counts start here
   return go;

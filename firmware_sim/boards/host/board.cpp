@@ -78,14 +78,6 @@ uint32_t g_frame_index = 0;
 std::vector<io::Image> g_thumbs;
 std::unique_ptr<io::Y4mWriter> g_y4m;
 
-void to_rgb888(uint16_t p, uint8_t* out) {
-  // Replicate the high bits into the low ones so white stays 255.
-  const uint32_t r = (p >> 11) & 31, g = (p >> 5) & 63, b = p & 31;
-  out[0] = static_cast<uint8_t>((r << 3) | (r >> 2));
-  out[1] = static_cast<uint8_t>((g << 2) | (g >> 4));
-  out[2] = static_cast<uint8_t>((b << 3) | (b >> 2));
-}
-
 io::Image thumbnail(const io::Image& img, int scale) {
   io::Image t(std::max(1, img.width / scale), std::max(1, img.height / scale), 3);
   for (int y = 0; y < t.height; ++y)
@@ -201,7 +193,7 @@ void display_begin_frame(uint16_t width, uint16_t height) {
 void display_band(uint16_t y0, uint16_t rows, const uint16_t* rgb565, size_t stride_pixels) {
   for (uint16_t r = 0; r < rows && y0 + r < g_height; ++r)
     for (uint16_t x = 0; x < g_width; ++x)
-      to_rgb888(rgb565[r * stride_pixels + x], &g_rgb[(static_cast<size_t>(y0 + r) * g_width + x) * 3]);
+      io::rgb565_to_rgb888(rgb565[r * stride_pixels + x], &g_rgb[(static_cast<size_t>(y0 + r) * g_width + x) * 3]);
 }
 
 void display_end_frame(uint32_t frame_crc) {

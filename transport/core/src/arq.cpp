@@ -487,6 +487,25 @@ void Link::rx_ack(uint8_t c, uint16_t seq, const uint8_t* p, size_t n) {
   declare_taken_lost(c);
 }
 
+// The frame still leaving the transmit buffer has not been sent yet.
+bool Link::leaving(const Segment& g) const {
+  return txf_pos_ < txf_len_ && txf_type_ == FrameType::data && g.order == txf_order_;
+}
+
+// Cuts segment i of `t` after its first `head` bytes: the rest becomes
+// segment i + 1 with the same state (the caller has checked seg_count <
+// seg_cap).
+void Link::split_segment(TxReliable& t, uint16_t i, uint16_t head) {
+  Segment& g = t.segs[i];
+  memmove(&t.segs[i + 2], &t.segs[i + 1], sizeof(Segment) * (t.seg_count - i - 1));
+  Segment tail = g;
+  tail.start = g.start + head;
+  tail.len = static_cast<uint16_t>(g.len - head);
+  t.segs[i + 1] = tail;
+  ++t.seg_count;
+  g.len = head;
+}
+
 // The RTO (with back-off) counts from the later of the oldest frame in
 // flight leaving and the last progress (bytes taken or acknowledged). When
 // it fires nothing is declared lost: the peer may only be slow. One probe
@@ -504,8 +523,7 @@ void Link::check_timeouts() {
     const TxReliable& t = *ch.txr;
     for (uint16_t i = 0; i < t.seg_count; ++i) {
       const Segment& g = t.segs[i];
-      const bool leaving = txf_pos_ < txf_len_ && txf_type_ == FrameType::data && g.order == txf_order_;
-      if (g.state != SegState::in_flight || leaving) continue;
+      if (g.state != SegState::in_flight || leaving(g)) continue;
       if (diff(g.sent_ms, oldest) < 0) oldest = g.sent_ms;
       pending = true;
     }
@@ -544,8 +562,7 @@ bool Link::build_probe() {
     TxReliable& t = *ch.txr;
     for (uint16_t i = 0; i < t.seg_count; ++i) {
       Segment& g = t.segs[i];
-      const bool leaving = txf_pos_ < txf_len_ && txf_type_ == FrameType::data && g.order == txf_order_;
-      if (g.state != SegState::in_flight || leaving) continue;
+      if (g.state != SegState::in_flight || leaving(g)) continue;
       const uint16_t plen = g.len < kProbePayload ? g.len : kProbePayload;
       if (!line_has_room(frame_wire_bound(plen) + 1, true) || log_count_ == log_cap_ ||
           (g.len > plen && t.seg_count == t.seg_cap)) {
@@ -557,13 +574,7 @@ bool Link::build_probe() {
         return false;
       }
       if (g.len > plen) {
-        memmove(&t.segs[i + 2], &t.segs[i + 1], sizeof(Segment) * (t.seg_count - i - 1));
-        Segment tail = g;
-        tail.start = g.start + (g.len - plen);
-        tail.len = plen;
-        t.segs[i + 1] = tail;
-        ++t.seg_count;
-        g.len = static_cast<uint16_t>(g.len - plen);
+        split_segment(t, i, static_cast<uint16_t>(g.len - plen));
         ++i;
       }
       ++stats_.probes;
@@ -587,14 +598,7 @@ bool Link::build_data(uint8_t c) {
     // tail frame pays a whole frame's overhead.
     if (g.len > frame_payload_ + frame_payload_ / 2 && t.seg_count < t.seg_cap) {
       const uint32_t pieces = (g.len + frame_payload_ - 1u) / frame_payload_;
-      const uint16_t head = static_cast<uint16_t>((g.len + pieces - 1u) / pieces);
-      memmove(&t.segs[i + 2], &t.segs[i + 1], sizeof(Segment) * (t.seg_count - i - 1));
-      Segment tail = g;
-      tail.start = g.start + head;
-      tail.len = static_cast<uint16_t>(g.len - head);
-      t.segs[i + 1] = tail;
-      ++t.seg_count;
-      g.len = head;
+      split_segment(t, i, static_cast<uint16_t>((g.len + pieces - 1u) / pieces));
     }
     if (!line_has_room(frame_wire_bound(g.len) + 1, false) || log_count_ == log_cap_) {
       ++stats_.line_waits;

@@ -21,13 +21,7 @@ void Wire::set_faults(const FaultConfig& f) {
   next_drop_byte_ = geometric(f_.byte_drop_rate);
 }
 
-// splitmix64: small, fast and identical on every platform.
-uint64_t Wire::rng() {
-  uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
+uint64_t Wire::rng() { return splitmix64(state_); }
 
 double Wire::uniform() { return static_cast<double>(rng() >> 11) * (1.0 / 9007199254740992.0); }
 

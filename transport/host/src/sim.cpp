@@ -14,13 +14,7 @@ SlowDevice::SlowDevice(Backend& line, uint32_t baud, const DrainProfile& p)
   if (p_.burst_ms == 0) p_.burst_ms = 1;
 }
 
-// splitmix64, as the wire's faults.
-uint64_t SlowDevice::rng() {
-  uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
+uint64_t SlowDevice::rng() { return splitmix64(state_); }
 
 void SlowDevice::advance(uint64_t now_ms) {
   now_ = now_ms;

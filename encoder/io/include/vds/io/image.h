@@ -37,6 +37,16 @@ double mse(const Image& a, const Image& b);
 // 10·log10(255² / MSE); identical images give +infinity.
 double psnr(const Image& a, const Image& b);
 
+// One RGB565 pixel (bits 15..11 red, 10..5 green, 4..0 blue) as 8-bit RGB,
+// the high bits replicated into the low ones so white stays 255: how the
+// host shows what a client displays.
+inline void rgb565_to_rgb888(uint16_t p, uint8_t out[3]) {
+  const uint32_t r = (p >> 11) & 31, g = (p >> 5) & 63, b = p & 31;
+  out[0] = static_cast<uint8_t>((r << 3) | (r >> 2));
+  out[1] = static_cast<uint8_t>((g << 2) | (g >> 4));
+  out[2] = static_cast<uint8_t>((b << 3) | (b >> 2));
+}
+
 // Places images side by side in one row with a gap of `gap` pixels (grey).
 Image side_by_side(const std::vector<const Image*>& images, int gap = 4);
 

@@ -386,6 +386,8 @@ class Link {
   bool line_has_room(size_t wire_bytes, bool probe) const;
   bool build_probe();
   bool send_segment(uint8_t ch, detail::Segment& seg, bool probe);
+  bool leaving(const detail::Segment& g) const;
+  void split_segment(detail::TxReliable& t, uint16_t i, uint16_t head);
 
   LinkConfig cfg_{};
   bool ready_ = false;

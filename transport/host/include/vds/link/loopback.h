@@ -12,6 +12,15 @@
 
 namespace vds::link {
 
+// splitmix64: the seeded generator of every simulated fault and device
+// schedule (small, fast, the same on every platform). Advances `state`.
+inline uint64_t splitmix64(uint64_t& state) {
+  uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
 struct FaultConfig {
   uint64_t seed = 1;
   double bit_error_rate = 0;       // per data bit on the wire
