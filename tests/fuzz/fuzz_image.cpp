@@ -58,6 +58,9 @@ void decode(const std::vector<uint8_t>& imgh, const std::vector<std::vector<uint
   t.predict = grey_prediction;
   Status s = dec.start(imgh.data(), static_cast<uint32_t>(imgh.size()), t);
   if (s != Status::ok) return;
+  // The image is unfinished until a feed says ok (an input may hold a
+  // header and no data at all).
+  s = Status::more_input;
   for (const auto& d : imgd) {
     s = dec.feed(d.data(), static_cast<uint32_t>(d.size()));
     if (vds::is_error(s)) {
