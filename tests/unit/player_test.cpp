@@ -5,9 +5,11 @@
 // the workspace plays the levels that fit, says so, and ends early.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <vector>
 
 #include "mesh_test_meshes.h"
+#include "vds/container.h"
 #include "vds/enc/frames.h"
 #include "vds/enc/mesh_encoder.h"
 #include "vds/enc/stream_writer.h"
@@ -136,6 +138,49 @@ TEST(Player, AModeTheClientDoesNotPlayIsRefusedAtTheHeader) {
   vds::Player p;
   EXPECT_EQ(play(s, seen, 16, 1u << 20, &p), Status::unsupported_feature);
   EXPECT_EQ(seen.begun, 0u);
+}
+
+// The image stream's chunks under a HEAD that declares another frame size.
+std::vector<uint8_t> resized_head(const std::vector<uint8_t>& s, uint16_t w, uint16_t h) {
+  uint32_t head_len = 0;
+  std::memcpy(&head_len, s.data() + vds::kPreambleBytes + 4, 4);
+  vds::StreamHeader hdr{};
+  EXPECT_EQ(vds::header_from_bytes(s.data() + vds::kPreambleBytes + vds::kChunkHeadBytes, head_len, s[4], s[5], &hdr),
+            Status::ok);
+  hdr.width = w;
+  hdr.height = h;
+  vds::enc::StreamWriter out(hdr);
+  for (size_t at = vds::kPreambleBytes + vds::kChunkHeadBytes + head_len + vds::kChunkTailBytes;
+       at + vds::kChunkHeadBytes <= s.size();) {
+    uint32_t type = 0, len = 0;
+    std::memcpy(&type, s.data() + at, 4);
+    std::memcpy(&len, s.data() + at + 4, 4);
+    if (type != vds::chunk::kEnd)
+      out.add_chunk(type, std::vector<uint8_t>(s.begin() + static_cast<std::ptrdiff_t>(at + 8),
+                                               s.begin() + static_cast<std::ptrdiff_t>(at + 8 + len)));
+    at += vds::kChunkHeadBytes + len + vds::kChunkTailBytes;
+  }
+  return out.finish();
+}
+
+// The band buffer and the display are the stream's frame size: an image of
+// another size (wider, taller or smaller) is refused before any pixel.
+TEST(Player, AnImageOfAnotherSizeThanTheStreamIsRefused) {
+  const std::vector<uint8_t> s = image_stream();  // 64x48 images
+  for (const auto& wh : {std::pair<uint16_t, uint16_t>{48, 48}, {64, 32}, {80, 48}, {64, 64}}) {
+    Seen seen;
+    vds::Player p;
+    // Narrower: the image decoder refuses the band target itself
+    // (invalid_argument); otherwise the player's size check (malformed).
+    const Status want = wh.first < 64 ? Status::invalid_argument : Status::malformed;
+    EXPECT_EQ(play(resized_head(s, wh.first, wh.second), seen, 100, 1u << 20, &p), want)
+        << wh.first << "x" << wh.second;
+    EXPECT_EQ(seen.bands, 0u);
+    EXPECT_EQ(seen.begun, 0u);
+  }
+  Seen same;
+  EXPECT_EQ(play(resized_head(s, 64, 48), same, 100), Status::ok) << "the same size still plays";
+  EXPECT_EQ(same.crcs, vds::enc::client_frame_crcs(s));
 }
 
 TEST(Player, AModelLargerThanTheWorkspacePlaysWhatFitsAndEndsEarly) {

@@ -25,7 +25,9 @@
 //   (entropy decoding + inverse transform + colour, or mesh decoding),
 //   display (bands, end_frame and, for a model, the drawing), with the
 //   image decoder's entropy and transform split out.
-// - A callback returning false aborts: feed returns Status::aborted.
+// - A callback returning false aborts: feed returns Status::aborted. An
+//   image whose size is not the stream's frame size is malformed, refused
+//   before any of its pixels is decoded.
 // - service() is called after every band and every
 //   config.mesh_service_items mesh items, to keep I/O moving while a frame
 //   is decoded or drawn; its time counts in no stage. It must not call the

@@ -40,24 +40,27 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
   const uint64_t parse_before = p.parse_total();
   const uint64_t t0 = p.enter_chunk();
   const uint64_t display_before = p.display_total();
-  ChunkResult result = ChunkResult::consumed;
-  // The parser checked this chunk's CRC before the call: that belongs to the new frame.
-  if (type == chunk::kImageHeader) {
-    p.restart_counts(parse_before);
-    if (!p.begin_frame()) result = ChunkResult::abort;
+  const ImageTarget target = ImageTarget::bands(PixelFormat::rgb565, p.band_buffer,
+                                                static_cast<ptrdiff_t>(p.header().width) * 2, image_band, &p);
+  const Status s = p.image.on_chunk(type, payload, size, target);
+  bool ok = !is_error(s);
+  if (!ok) {
+    p.fail(s, "the image decoder refused a chunk");
+  } else if (type == chunk::kImageHeader &&
+             (p.image.header().width != p.header().width || p.image.header().height != p.header().height)) {
+    // The header chunk only sets the decoder up; the band buffer and the
+    // display are the stream's frame size, so an image of another size is
+    // refused before a pixel of it is decoded.
+    p.fail(Status::malformed, "an image's size differs from the stream's frame size");
+    ok = false;
   }
-  if (result == ChunkResult::consumed) {
-    const ImageTarget target = ImageTarget::bands(PixelFormat::rgb565, p.band_buffer,
-                                                  static_cast<ptrdiff_t>(p.header().width) * 2, image_band, &p);
-    const Status s = p.image.on_chunk(type, payload, size, target);
-    p.add_decode((p.work_clock() - t0) - (p.display_total() - display_before));
-    if (is_error(s)) {
-      p.fail(s, "the image decoder refused a chunk");
-      result = ChunkResult::abort;
-    } else if (type == chunk::kImageData && s == Status::ok && !p.end_frame()) {
-      result = ChunkResult::abort;
-    }
-  }
+  // An image's counts start at its header chunk, whose CRC the parser
+  // checked before the call.
+  if (ok && type == chunk::kImageHeader) p.restart_counts(parse_before);
+  p.add_decode((p.work_clock() - t0) - (p.display_total() - display_before));
+  ChunkResult result = ok ? ChunkResult::consumed : ChunkResult::abort;
+  if (ok && type == chunk::kImageHeader && !p.begin_frame()) result = ChunkResult::abort;
+  if (ok && type == chunk::kImageData && s == Status::ok && !p.end_frame()) result = ChunkResult::abort;
   p.leave_chunk();
   return result;
 }

@@ -1,0 +1,162 @@
+// libFuzzer: the client's player (vds/player.h) on hostile streams, fed in
+// pieces of sizes the input chooses. The first byte picks the stream:
+// chunks of the input's bytes in a valid images- or model-mode container
+// (every CRC right, so the modes themselves see the bytes), raw bytes, or
+// a valid image or model stream whose chunk payloads the input's bytes
+// flip (CRCs recomputed, so the decoders meet the damage).
+// Invariants: no crash or sanitizer report; every band lies inside its
+// frame and is at most config.band_rows high; bands come only between a
+// frame's begin and end; the player ends with ok, more_input or an error,
+// never anything else, and never reads past the workspace.
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "vds/container.h"
+#include "vds/enc/frames.h"
+#include "vds/enc/mesh_encoder.h"
+#include "vds/enc/stream_writer.h"
+#include "vds/image.h"
+#include "vds/mesh.h"
+#include "vds/player.h"
+
+namespace {
+
+struct Watch {
+  uint16_t w = 0, h = 0;
+  bool open = false;
+};
+
+std::vector<uint8_t> container(vds::StreamMode mode, const uint8_t* data, size_t size) {
+  vds::StreamHeader h = vds::enc::default_header(mode, 64, 48);
+  h.max_chunk_payload = 4096;
+  h.workspace_bytes = 96 * 1024;
+  if (mode == vds::StreamMode::model) {
+    h.max_vertices = 2048;
+    h.max_triangles = 4096;
+  }
+  vds::enc::StreamWriter w(h);
+  const uint32_t images[] = {vds::chunk::kImageHeader, vds::chunk::kImageData};
+  const uint32_t meshes[] = {vds::chunk::kMeshHeader, vds::chunk::kMeshBase, vds::chunk::kMeshLevel,
+                             vds::chunk::kMeshTail};
+  size_t at = 0;
+  while (at + 2 <= size) {
+    const uint8_t pick = data[at];
+    const size_t len = data[at + 1] * 8u % 600;
+    at += 2;
+    const size_t n = len < size - at ? len : size - at;
+    const uint32_t type = mode == vds::StreamMode::images ? images[pick % 2] : meshes[pick % 4];
+    w.add_chunk(type, std::vector<uint8_t>(data + at, data + at + n));
+    at += n;
+  }
+  return w.finish();
+}
+
+// A valid stream's chunks (after HEAD), rewrapped with the input's bytes
+// XORed over their payloads.
+std::vector<uint8_t> flipped(const std::vector<uint8_t>& valid, const uint8_t* data, size_t size) {
+  vds::StreamHeader h{};
+  uint32_t head_len = 0;
+  std::memcpy(&head_len, valid.data() + vds::kPreambleBytes + 4, 4);
+  const uint8_t* head = valid.data() + vds::kPreambleBytes + vds::kChunkHeadBytes;
+  if (vds::header_from_bytes(head, head_len, valid[4], valid[5], &h) != vds::Status::ok) abort();
+  vds::enc::StreamWriter w(h);
+  size_t at = vds::kPreambleBytes + vds::kChunkHeadBytes + head_len + vds::kChunkTailBytes;
+  size_t k = 0;
+  while (at + vds::kChunkHeadBytes <= valid.size()) {
+    uint32_t type = 0, len = 0;
+    std::memcpy(&type, valid.data() + at, 4);
+    std::memcpy(&len, valid.data() + at + 4, 4);
+    std::vector<uint8_t> p(valid.begin() + static_cast<long>(at + 8), valid.begin() + static_cast<long>(at + 8 + len));
+    for (uint8_t& b : p)
+      if (size != 0) b ^= data[k++ % size];
+    if (type != vds::chunk::kEnd) w.add_chunk(type, p);
+    at += vds::kChunkHeadBytes + len + vds::kChunkTailBytes;
+  }
+  return w.finish();
+}
+
+const std::vector<uint8_t>& valid_images() {
+  static const std::vector<uint8_t> s = [] {
+    std::vector<vds::enc::Image> frames;
+    for (int f = 0; f < 2; ++f) {
+      vds::enc::Image im(48, 32, 3);
+      for (size_t i = 0; i < im.pixels.size(); ++i) im.pixels[i] = static_cast<uint8_t>(i * 7 + f * 50);
+      frames.push_back(im);
+    }
+    vds::enc::FrameSequenceOptions o;
+    o.width = 48;
+    o.height = 32;
+    return vds::enc::encode_frames(frames, o).stream;
+  }();
+  return s;
+}
+
+const std::vector<uint8_t>& valid_model() {
+  static const std::vector<uint8_t> s = [] {
+    vds::enc::Mesh m;
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) m.positions.push_back({double(x), double(y), double((x * y) % 3)});
+    for (uint32_t y = 0; y + 1 < 8; ++y)
+      for (uint32_t x = 0; x + 1 < 8; ++x) {
+        const uint32_t a = y * 8 + x, b = a + 1, c = a + 8, d = c + 1;
+        m.triangles.push_back({a, b, d});
+        m.triangles.push_back({a, d, c});
+      }
+    return vds::enc::encode_mesh(m, vds::enc::MeshEncodeOptions{}).stream;
+  }();
+  return s;
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  if (size < 2) return 0;
+  const uint8_t kind = data[0] % 5;
+  const uint8_t piece = static_cast<uint8_t>(data[1] | 1);
+  data += 2;
+  size -= 2;
+  const std::vector<uint8_t> stream =
+      kind == 0 ? container(vds::StreamMode::images, data, size)
+      : kind == 1 ? container(vds::StreamMode::model, data, size)
+      : kind == 2 ? std::vector<uint8_t>(data, data + size)
+      : kind == 3 ? flipped(valid_images(), data, size)
+                  : flipped(valid_model(), data, size);
+  static std::vector<uint8_t> ws(256 * 1024);
+  vds::Arena arena(ws.data(), ws.size());
+  Watch watch;
+  vds::PlayerCallbacks cb;
+  cb.ctx = &watch;
+  cb.begin_frame = [](void* ctx, uint16_t w, uint16_t h) {
+    auto& v = *static_cast<Watch*>(ctx);
+    if (v.open) abort();
+    v = Watch{w, h, true};
+    return true;
+  };
+  cb.band = [](void* ctx, const vds::PixelRect& r) {
+    const auto& v = *static_cast<Watch*>(ctx);
+    if (!v.open || r.x != 0 || r.w != v.w || r.h == 0 || r.y + r.h > v.h ||
+        r.h > vds::kClientPlayerConfig.band_rows)
+      abort();
+    return true;
+  };
+  cb.end_frame = [](void* ctx, uint32_t) {
+    auto& v = *static_cast<Watch*>(ctx);
+    if (!v.open) abort();
+    v.open = false;
+    return true;
+  };
+  vds::Player player;
+  if (player.init(arena, vds::kClientPlayerConfig, cb) != vds::Status::ok) abort();
+  vds::Status s = vds::Status::more_input;
+  for (size_t at = 0; at < stream.size() && s == vds::Status::more_input; at += piece) {
+    const size_t n = piece < stream.size() - at ? piece : stream.size() - at;
+    s = player.feed(stream.data() + at, n);
+  }
+  if (s == vds::Status::more_input) s = player.finish();
+  if (s != vds::Status::ok && !vds::is_error(s)) abort();
+  if (arena.high_water() > ws.size()) abort();
+  return 0;
+}
