@@ -191,10 +191,10 @@ for v in 0 1 2 3 4; do
   jcrc=$("$BENCH" m4-case "$WORK/v$v.jpg" "$WORK/m4/texture_case$i.bin" 3 | sed -n 's/.*host_crc=//p')
   vcrc=$("$BENCH" m4-case "$WORK/v$v.vds" "$WORK/m4/texture_case$((i + 1)).bin" 3 | sed -n 's/.*host_crc=//p')
   jx=$(valgrind --tool=callgrind --callgrind-out-file="$WORK/cg.j$v" --collect-atstart=no \
-        --toggle-collect='vds::JpegDecoder::decode*' "$BENCH" decode "$WORK/v$v.jpg" 1 2>&1 >/dev/null |
+        --toggle-collect='vds::Player::feed*' "$BENCH" decode "$WORK/v$v.jpg" 1 2>&1 >/dev/null |
        sed -n 's/.*Collected : \([0-9]*\).*/\1/p')
   vx=$(valgrind --tool=callgrind --callgrind-out-file="$WORK/cg.v$v" --collect-atstart=no \
-        --toggle-collect='vds::StreamParser::feed*' "$BENCH" decode "$WORK/v$v.vds" 1 2>&1 >/dev/null |
+        --toggle-collect='vds::Player::feed*' "$BENCH" decode "$WORK/v$v.vds" 1 2>&1 >/dev/null |
        sed -n 's/.*Collected : \([0-9]*\).*/\1/p')
   echo "view0$v $psnr $(stat -c %s "$WORK/v$v.jpg") $jcrc $jx $vpsnr $(stat -c %s "$WORK/v$v.vds") $vcrc $vx" | tee -a "$CASES"
   i=$((i + 2))
@@ -319,12 +319,14 @@ L.append('## Client decode cost (goals: baseline JPEG <= 80, vds <= 100 instruct
 L.append('Each 240x180 view coded by `cjpeg -quality 85` (4:2:0, standard Huffman tables, as the TJpgDec anchor: '
          '12,464 bytes at 155 instructions/pixel, 132 with its lookup tables) and by vds at the smallest size whose '
          'RGB PSNR reaches that of the JPEG as the client decodes it (no fancy upsampling). Both decoded by the client '
-         'library to an RGB565 frame. vds counts include the stream parser (chunk CRC-32C checks). Cortex-M4: '
+         'library to an RGB565 frame, each as an images stream played by `vds::Player` as the client plays it (the JPEG '
+         'in 4096-byte JPEG chunks): counts are the parse and decode of the player\'s frame record (chunk framing and '
+         'CRC-32C checks, entropy decoding, IDCT, colour conversion into the band), the band copies excluded. Cortex-M4: '
          'executed instructions of the board firmware `vds_fw_bench_texture` (`firmware_sim/app/bench_texture.cpp`, '
          'the Cortex-M4 build: arm-none-eabi-g++ -O2) on the QEMU board mps2-an386 with `-icount shift=0` '
-         '(`board::instructions()`, 40 instructions per tick), mean of 3 decodes; input, chunk buffer and decoder '
-         'workspace inside the board\'s 128 KiB workspace budget; x86-64: callgrind Ir inside the decode call '
-         '(clang -O3).\n')
+         '(`board::instructions()`, 40 instructions per tick), mean of 3 plays; input, chunk buffer and decoder '
+         'workspace inside the board\'s 128 KiB workspace budget; x86-64: callgrind Ir '
+         '(clang -O3) inside `vds::Player::feed`, band copies included.\n')
 L.append('| view | JPEG bytes | JPEG PSNR | M4 instr/px | x86 instr/px | vds bytes | vds PSNR | M4 instr/px | x86 instr/px | M4 = host output |')
 L.append('|---|---:|---:|---:|---:|---:|---:|---:|---:|---|')
 px = 240 * 180
@@ -346,7 +348,8 @@ if m4sizes:
     L.append('| decoder | workspace bytes | object bytes (Cortex-M4) |\n|---|---:|---:|')
     L.append(f'| vds image (`vds::ImageDecoder`) | {m4sizes["image_workspace"]} | {m4sizes["image_object"]} |')
     L.append(f'| baseline JPEG (`vds::JpegDecoder`) | {m4sizes["jpeg_workspace"]} | {m4sizes["jpeg_object"]} |')
-    L.append(f'| stream parser (`vds::StreamParser`) | chunk buffer | {m4sizes["parser_object"]} |\n')
+    L.append(f'| stream parser (`vds::StreamParser`) | chunk buffer | {m4sizes["parser_object"]} |')
+    L.append(f'| the player (`vds::Player`, both decoders and the parser inside) | chunk buffer + band buffer + a decoder\'s | {m4sizes.get("player_object", "n/a")} |\n')
 L.append('Host view (`bench_texture workspace`):\n\n```\n' + ws + '\n```\n')
 if sizes:
     L.append('Cortex-M4 `.text` of a program that uses only one decoder (`arm-none-eabi-g++ -O2 -ffunction-sections`, '

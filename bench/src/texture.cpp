@@ -7,16 +7,17 @@
 //                                           decodes), one CSV line per point
 //   bench_texture bd CSV MD PLOTCSV         BD-rates (Bjontegaard, PCHIP over
 //                                           0.25..2 bpp) as markdown
-//   bench_texture decode FILE N             decodes FILE (a .vds image stream or a
-//                                           .jpg) N times through the client decoders
-//                                           to an RGB565 frame (for callgrind)
+//   bench_texture decode FILE N             plays FILE (a .vds image stream, or a .jpg
+//                                           wrapped in JPEG chunks) N times through
+//                                           vds::Player to an RGB565 frame (for callgrind)
 //   bench_texture make-vds IN OUT.vds PSNR [SLOPE]
 //                                           encodes IN at the smallest size reaching
 //                                           PSNR (RGB dB); prints bytes and PSNR
 //   bench_texture m4-case FILE OUT REPS     wraps a .vds stream or .jpg as a case file
 //                                           for the board firmware vds_fw_bench_texture
-//                                           (firmware_sim/app/bench_texture.cpp); prints the
-//                                           host's CRC-32C of the decoded RGB565 frame
+//                                           (firmware_sim/app/bench_texture.cpp), a .jpg
+//                                           wrapped in JPEG chunks; prints the host's
+//                                           CRC-32C of the played RGB565 frame
 //   bench_texture psnr A B                  RGB PSNR of two image files
 //   bench_texture workspace                 the decoders' workspace and object sizes
 //
@@ -45,6 +46,7 @@
 #include "vds/enc/stream_writer.h"
 #include "vds/image.h"
 #include "vds/jpeg.h"
+#include "vds/player.h"
 
 namespace {
 
@@ -278,7 +280,8 @@ int cmd_rd(const std::string& list, const std::string& csv, const RdOptions& ro)
       const vds::enc::EncodedImage e = vds::enc::encode_planes_at(planes, qi, std::clamp(qi + delta, 0, 255), o);
       const std::vector<uint8_t> stream = vds::enc::image_stream(e);
       const vds::enc::DecodedImage d = vds::enc::decode_stream_image(stream);
-      if (!(d.planes == e.recon)) throw std::runtime_error("client decode differs from the encoder's reconstruction");
+      if (d.rgb.pixels != vds::enc::planes_to_rgb(e.recon).pixels)
+        throw std::runtime_error("the client shows other pixels than the encoder's reconstruction");
       emit("vds", qi, e.coded_bytes(), d.rgb);
     }
     const auto t2 = std::chrono::steady_clock::now();
@@ -478,116 +481,81 @@ int cmd_bd(const std::string& csv, const std::string& md, const std::string& plo
 
 // --- client decode cost ---------------------------------------------------------------
 
-int cmd_decode(const std::string& path, int n) {
-  const std::vector<uint8_t> bytes = vds::enc::read_file(path);
-  const bool is_jpeg = bytes.size() > 2 && bytes[0] == 0xFF && bytes[1] == 0xD8;
-  static uint8_t workspace[32768];
-  uint32_t checksum = 2166136261u;
-  if (is_jpeg) {
-    vds::Arena arena(workspace, sizeof workspace);
-    vds::JpegDecoder dec;
-    if (dec.init(arena) != vds::Status::ok) return 1;
-    vds::JpegInfo info;
-    if (vds::jpeg_peek_info(bytes.data(), bytes.size(), &info) != vds::Status::ok) return 1;
-    std::vector<uint16_t> frame(static_cast<size_t>(info.width) * info.height);
-    for (int i = 0; i < n; ++i) {
-      const vds::ImageTarget t = vds::ImageTarget::frame(vds::PixelFormat::rgb565,
-                                                         reinterpret_cast<uint8_t*>(frame.data()), info.width * 2);
-      const vds::Status s = dec.decode(bytes.data(), bytes.size(), t);
-      if (s != vds::Status::ok) {
-        std::fprintf(stderr, "jpeg decode: %s (%s)\n", vds::status_name(s), dec.error_detail());
-        return 1;
-      }
-    }
-    for (uint16_t v : frame) checksum = (checksum ^ v) * 16777619u;
-    std::printf("jpeg %dx%d %zu bytes, checksum %08x, workspace %zu + object %zu bytes\n", info.width, info.height,
-                bytes.size(), checksum, vds::JpegDecoder::kWorkspaceBytes, sizeof(vds::JpegDecoder));
-    return 0;
-  }
-  // A vds stream: the client parser with the image decoder, chunk by chunk,
-  // in one workspace (chunk buffer, then the decoder carved at the header).
-  struct Ctx {
-    vds::ImageDecoder* dec;
-    vds::Arena* arena;
-    vds::ImageTarget target;
-    std::vector<uint16_t>* frame;
-    vds::Status status = vds::Status::ok;
+// A .jpg as the client receives it: an images stream of JPEG chunks
+// (4096 bytes each, as `vds encode-image --jpeg` writes them); a .vds
+// stream as it is.
+std::vector<uint8_t> client_stream(const std::vector<uint8_t>& bytes, bool* is_jpeg) {
+  *is_jpeg = bytes.size() > 2 && bytes[0] == 0xFF && bytes[1] == 0xD8;
+  if (!*is_jpeg) return bytes;
+  vds::JpegInfo info;
+  if (vds::jpeg_peek_info(bytes.data(), bytes.size(), &info) != vds::Status::ok) throw std::runtime_error("not a JPEG the client decodes");
+  vds::StreamHeader h = vds::enc::default_header(vds::StreamMode::images, info.width, info.height);
+  h.frame_count = 1;
+  h.max_chunk_payload = 4096;
+  h.workspace_bytes = static_cast<uint32_t>(vds::Player::jpeg_workspace_bytes(info.width, vds::kClientPlayerConfig));
+  vds::enc::StreamWriter w(h);
+  for (size_t at = 0; at < bytes.size(); at += 4096)
+    w.add_chunk(vds::chunk::kJpeg, std::span(bytes).subspan(at, std::min<size_t>(4096, bytes.size() - at)));
+  return w.finish();
+}
+
+// Plays a stream through vds::Player (the client's configuration) into an
+// RGB565 frame, as the board firmware (firmware_sim/app/bench_texture.cpp)
+// does, `n` times.
+std::vector<uint16_t> client_rgb565(const std::vector<uint8_t>& stream, int* w, int* h, int n = 1) {
+  struct Out {
+    std::vector<uint16_t> frame;
+    int w = 0, h = 0;
+  } out;
+  std::vector<uint8_t> ws((1 << 16) + 65536);
+  vds::PlayerConfig config = vds::kClientPlayerConfig;
+  config.max_chunk_bytes = 1 << 16;
+  vds::PlayerCallbacks cb;
+  cb.ctx = &out;
+  cb.begin_frame = [](void* ctx, uint16_t fw, uint16_t fh) {
+    Out& o = *static_cast<Out*>(ctx);
+    o.w = fw;
+    o.h = fh;
+    o.frame.assign(static_cast<size_t>(fw) * fh, 0);
+    return true;
   };
-  vds::ImageDecoder dec;
-  std::vector<uint16_t> frame;
-  static uint8_t stream_ws[(1 << 16) + vds::ImageDecoder::kWorkspaceBytes + 64];
+  cb.band = [](void* ctx, const vds::PixelRect& r) {
+    Out& o = *static_cast<Out*>(ctx);
+    for (int row = 0; row < r.h; ++row)
+      std::memcpy(&o.frame[static_cast<size_t>(r.y + row) * r.w], r.pixels + row * r.stride, static_cast<size_t>(r.w) * 2);
+    return true;
+  };
   for (int i = 0; i < n; ++i) {
-    vds::Arena arena(stream_ws, sizeof stream_ws);
-    Ctx ctx{&dec, &arena, {}, &frame};
-    vds::ChunkSink sink;
-    sink.ctx = &ctx;
-    sink.on_header = [](void* c, const vds::StreamHeader&) {
-      Ctx& x = *static_cast<Ctx*>(c);
-      return x.dec->init(*x.arena) == vds::Status::ok;
-    };
-    sink.on_chunk = [](void* c, uint32_t type, const uint8_t* p, uint32_t size) {
-      Ctx& x = *static_cast<Ctx*>(c);
-      if (type == vds::chunk::kImageHeader) {
-        vds::ImageHeader h;
-        if (vds::image_header_from_bytes(p, size, &h) != vds::Status::ok) return vds::ChunkResult::abort;
-        x.frame->assign(static_cast<size_t>(h.width) * h.height, 0);
-        x.target = vds::ImageTarget::frame(vds::PixelFormat::rgb565, reinterpret_cast<uint8_t*>(x.frame->data()),
-                                           h.width * 2);
-      }
-      const vds::Status s = x.dec->on_chunk(type, p, size, x.target);
-      if (vds::is_error(s)) {
-        x.status = s;
-        return vds::ChunkResult::abort;
-      }
-      return vds::ChunkResult::consumed;
-    };
-    vds::StreamParser parser;
-    if (parser.init(arena, 1 << 16, sink) != vds::Status::ok) return 1;
-    vds::Status s = parser.feed(bytes.data(), bytes.size());
-    if (s != vds::Status::ok || ctx.status != vds::Status::ok || !dec.done()) {
-      std::fprintf(stderr, "vds decode: %s / %s\n", vds::status_name(s), vds::status_name(ctx.status));
-      return 1;
-    }
+    vds::Arena arena(ws.data(), ws.size());
+    vds::Player player;
+    if (player.init(arena, config, cb) != vds::Status::ok) throw std::logic_error("player init");
+    vds::Status s = player.feed(stream.data(), stream.size());
+    if (s == vds::Status::more_input) s = player.finish();
+    if (s != vds::Status::ok || player.frames_shown() != 1)
+      throw std::runtime_error(std::string("the client player: ") + vds::status_name(s) + " (" + player.error_detail() + ")");
   }
+  *w = out.w;
+  *h = out.h;
+  return out.frame;
+}
+
+int cmd_decode(const std::string& path, int n) {
+  bool is_jpeg = false;
+  const std::vector<uint8_t> stream = client_stream(vds::enc::read_file(path), &is_jpeg);
+  int w = 0, h = 0;
+  const std::vector<uint16_t> frame = client_rgb565(stream, &w, &h, n);
+  uint32_t checksum = 2166136261u;
   for (uint16_t v : frame) checksum = (checksum ^ v) * 16777619u;
-  std::printf("vds %dx%d %zu bytes, checksum %08x, workspace %zu + object %zu bytes\n", dec.header().width,
-              dec.header().height, bytes.size(), checksum, vds::ImageDecoder::kWorkspaceBytes, sizeof(vds::ImageDecoder));
+  std::printf("%s %dx%d %zu stream bytes, checksum %08x, player object %zu bytes\n", is_jpeg ? "jpeg" : "vds", w, h,
+              stream.size(), checksum, sizeof(vds::Player));
   return 0;
 }
 
-// The frame the client decodes to (RGB565) for a .vds stream or a JPEG, as
-// the board firmware (firmware_sim/app/bench_texture.cpp) does it, for the cross-target CRC.
-std::vector<uint16_t> client_rgb565(const std::vector<uint8_t>& bytes, int* w, int* h) {
-  const bool is_jpeg = bytes.size() > 2 && bytes[0] == 0xFF && bytes[1] == 0xD8;
-  std::vector<uint8_t> ws(vds::JpegDecoder::kWorkspaceBytes + vds::ImageDecoder::kWorkspaceBytes + 64);
-  vds::Arena arena(ws.data(), ws.size());
-  std::vector<uint16_t> frame;
-  if (is_jpeg) {
-    vds::JpegInfo info;
-    if (vds::jpeg_peek_info(bytes.data(), bytes.size(), &info) != vds::Status::ok) throw std::runtime_error("not a JPEG");
-    *w = info.width;
-    *h = info.height;
-    frame.assign(static_cast<size_t>(*w) * *h, 0);
-    vds::JpegDecoder dec;
-    dec.init(arena);
-    const vds::Status s = dec.decode(bytes.data(), bytes.size(),
-                                     vds::ImageTarget::frame(vds::PixelFormat::rgb565, reinterpret_cast<uint8_t*>(frame.data()), *w * 2));
-    if (s != vds::Status::ok) throw std::runtime_error(std::string("jpeg: ") + vds::status_name(s));
-    return frame;
-  }
-  const vds::enc::DecodedImage d = vds::enc::decode_stream_image(bytes);
-  *w = d.rgb.width;
-  *h = d.rgb.height;
-  for (int y = 0; y < *h; ++y)
-    for (int x = 0; x < *w; ++x) frame.push_back(vds::pack_rgb565(d.rgb.at(x, y, 0), d.rgb.at(x, y, 1), d.rgb.at(x, y, 2)));
-  return frame;
-}
-
 int cmd_m4_case(const std::string& in, const std::string& out, int reps) {
-  const std::vector<uint8_t> bytes = vds::enc::read_file(in);
+  bool is_jpeg = false;
+  const std::vector<uint8_t> bytes = client_stream(vds::enc::read_file(in), &is_jpeg);
   int w = 0, h = 0;
   const std::vector<uint16_t> frame = client_rgb565(bytes, &w, &h);
-  const bool is_jpeg = bytes[0] == 0xFF;
   std::vector<uint8_t> f = {'V', 'T', 'X', '1', static_cast<uint8_t>(is_jpeg ? 1 : 0), static_cast<uint8_t>(reps)};
   const auto u16 = [&](uint32_t v) {
     f.push_back(static_cast<uint8_t>(v));

@@ -337,7 +337,12 @@ Status ImageDecoder::decode_mcu(uint32_t mcu) {
     if (!coded) {
       std::memset(left_, 0, sizeof left_);
       if (mx == 0) std::memset(row_start_, 0, sizeof row_start_);
-      return row_end ? detail::emit_band(target_, geometry(h), y0) : Status::ok;
+      // A packed target with a prediction shows the prediction where
+      // nothing is coded: a band buffer holds no earlier frame.
+      if (target_.planar || target_.predict == nullptr)
+        return row_end ? detail::emit_band(target_, geometry(h), y0) : Status::ok;
+      if (!fetch_prediction(x0, y0)) return Status::aborted;
+      return deliver_mcu(x0, y0, row_end);
     }
   }
 
@@ -348,30 +353,7 @@ Status ImageDecoder::decode_mcu(uint32_t mcu) {
   const int y_stride = ms;
   const int cx0 = x0 >> sub, cy0 = y0 >> sub;
 
-  if (h.residual() && !direct) {
-    // The prediction goes into the sample buffer; only pixels inside the
-    // image are ever read back, so the rest needs no defined value, but it
-    // is cleared to keep the output deterministic.
-    std::memset(mcu_pix_, 0, kMcuSampleBytes);
-    const int w = (h.width - x0) < ms ? (h.width - x0) : ms;
-    const int hh = (h.height - y0) < ms ? (h.height - y0) : ms;
-    if (planes) {
-      for (int r = 0; r < hh; ++r) std::memcpy(mcu_pix_ + r * y_stride, target_.data[0] + (y0 + r) * target_.stride[0] + x0, w);
-      if (ncomp == 3) {
-        const int cw = ((x0 + w + sub) >> sub) - cx0, ch = ((y0 + hh + sub) >> sub) - cy0;
-        for (int c = 1; c < 3; ++c) {
-          uint8_t* dst = mcu_pix_ + (c == 1 ? kMcuCbOffset : kMcuCrOffset);
-          for (int r = 0; r < ch; ++r)
-            std::memcpy(dst + r * kChromaStride, target_.data[c] + (cy0 + r) * target_.stride[c] + cx0, cw);
-        }
-      }
-    } else if (!target_.predict(target_.predict_ctx, static_cast<uint16_t>(x0), static_cast<uint16_t>(y0),
-                                static_cast<uint16_t>(w), static_cast<uint16_t>(hh), mcu_pix_, y_stride,
-                                ncomp == 3 ? mcu_pix_ + kMcuCbOffset : nullptr,
-                                ncomp == 3 ? mcu_pix_ + kMcuCrOffset : nullptr, kChromaStride)) {
-      return Status::aborted;
-    }
-  }
+  if (h.residual() && !direct && !fetch_prediction(x0, y0)) return Status::aborted;
 
   for (int c = 0; c < ncomp; ++c) {
     const int bw = blocks_w(h, c);
@@ -417,24 +399,69 @@ Status ImageDecoder::decode_mcu(uint32_t mcu) {
 
   if (clock_) clock_->enter(StageClock::colour);
   if (direct) return Status::ok;
-  const detail::McuSamples s{mcu_pix_, y_stride, ncomp == 3 ? mcu_pix_ + kMcuCbOffset : nullptr,
-                             ncomp == 3 ? mcu_pix_ + kMcuCrOffset : nullptr, kChromaStride,
-                             static_cast<uint8_t>(sub), static_cast<uint8_t>(sub)};
-  if (planes) {
-    // A partial MCU on the right or bottom edge: copy what lies inside.
-    const int w = (h.width - x0) < ms ? (h.width - x0) : ms;
-    const int hh = (h.height - y0) < ms ? (h.height - y0) : ms;
-    for (int r = 0; r < hh; ++r) std::memcpy(target_.data[0] + (y0 + r) * target_.stride[0] + x0, mcu_pix_ + r * y_stride, w);
-    if (ncomp == 3) {
-      const int cw = ((x0 + w + sub) >> sub) - cx0, ch = ((y0 + hh + sub) >> sub) - cy0;
-      for (int c = 1; c < 3; ++c) {
-        const uint8_t* src = mcu_pix_ + (c == 1 ? kMcuCbOffset : kMcuCrOffset);
-        for (int r = 0; r < ch; ++r)
-          std::memcpy(target_.data[c] + (cy0 + r) * target_.stride[c] + cx0, src + r * kChromaStride, cw);
-      }
+  return deliver_mcu(x0, y0, row_end);
+}
+
+// Copies the part of the MCU at (x0, y0) inside the image between the
+// sample buffer and a planar target's planes (`to_target`: buffer -> planes).
+void ImageDecoder::copy_mcu_planes(int x0, int y0, bool to_target) {
+  const ImageHeader& h = header_;
+  const int ms = h.mcu_size();
+  const int sub = h.chroma == ChromaFormat::yuv420 ? 1 : 0;
+  const int w = (h.width - x0) < ms ? (h.width - x0) : ms;
+  const int hh = (h.height - y0) < ms ? (h.height - y0) : ms;
+  const int cx0 = x0 >> sub, cy0 = y0 >> sub;
+  const int cw = ((x0 + w + sub) >> sub) - cx0, ch = ((y0 + hh + sub) >> sub) - cy0;
+  for (int c = 0; c < h.components(); ++c) {
+    uint8_t* buf = c == 0 ? mcu_pix_ : mcu_pix_ + (c == 1 ? kMcuCbOffset : kMcuCrOffset);
+    const int buf_stride = c == 0 ? ms : kChromaStride;
+    uint8_t* plane = c == 0 ? target_.data[0] + y0 * target_.stride[0] + x0 : target_.data[c] + cy0 * target_.stride[c] + cx0;
+    for (int r = 0; r < (c == 0 ? hh : ch); ++r) {
+      uint8_t* p = plane + r * target_.stride[c];
+      uint8_t* b = buf + r * buf_stride;
+      if (to_target)
+        std::memcpy(p, b, c == 0 ? w : cw);
+      else
+        std::memcpy(b, p, c == 0 ? w : cw);
     }
+  }
+}
+
+// The prediction of the MCU at (x0, y0) into the sample buffer: from the
+// planes a planar target holds, else from the target's predict callback.
+// Only pixels inside the image are ever read back, so the rest needs no
+// defined value, but it is cleared to keep the output deterministic.
+bool ImageDecoder::fetch_prediction(int x0, int y0) {
+  const ImageHeader& h = header_;
+  const int ms = h.mcu_size();
+  std::memset(mcu_pix_, 0, kMcuSampleBytes);
+  if (target_.planar) {
+    copy_mcu_planes(x0, y0, false);
+    return true;
+  }
+  const bool colour = h.components() == 3;
+  const int w = (h.width - x0) < ms ? (h.width - x0) : ms;
+  const int hh = (h.height - y0) < ms ? (h.height - y0) : ms;
+  return target_.predict(target_.predict_ctx, static_cast<uint16_t>(x0), static_cast<uint16_t>(y0),
+                         static_cast<uint16_t>(w), static_cast<uint16_t>(hh), mcu_pix_, ms,
+                         colour ? mcu_pix_ + kMcuCbOffset : nullptr, colour ? mcu_pix_ + kMcuCrOffset : nullptr,
+                         kChromaStride);
+}
+
+// The MCU at (x0, y0), whole in the sample buffer, to a target that is not
+// written in place: the planes (a partial MCU on the right or bottom edge:
+// what lies inside) or packed pixels.
+Status ImageDecoder::deliver_mcu(int x0, int y0, bool row_end) {
+  if (target_.planar) {
+    copy_mcu_planes(x0, y0, true);
     return Status::ok;
   }
+  const ImageHeader& h = header_;
+  const int sub = h.chroma == ChromaFormat::yuv420 ? 1 : 0;
+  const bool colour = h.components() == 3;
+  const detail::McuSamples s{mcu_pix_, h.mcu_size(), colour ? mcu_pix_ + kMcuCbOffset : nullptr,
+                             colour ? mcu_pix_ + kMcuCrOffset : nullptr, kChromaStride,
+                             static_cast<uint8_t>(sub), static_cast<uint8_t>(sub)};
   return detail::deliver_packed(target_, geometry(h), s, x0, y0, row_end, packed_);
 }
 

@@ -1,40 +1,26 @@
-// vds encoder (host tools): runs the client's StreamParser and image decoders
-// on a whole stream held in memory, as a device would, and collects the
-// pixels (vds images to planes and RGB; JPEG chunks to RGB).
+// vds encoder (host tools): the client's images, decoded as a device would.
+// decode_stream_image plays a stream through vds::Player (the one path from
+// stream bytes to display) with RGB888 bands; decode_image_planes runs the
+// image decoder alone on an encoded image's chunks, for the Y'CbCr
+// reconstruction the encoder must match.
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 
+#include "vds/bytes.h"
 #include "vds/enc/image_codec.h"
-#include "vds/jpeg.h"
+#include "vds/player.h"
 
 namespace vds::enc {
 
 namespace {
 
-// One pass of the client over the stream with a given target.
-struct Pass {
-  const Planes* prediction = nullptr;
-  Planes blank;  // the destination's prior content when none is given
-  ImageTarget target;
-  bool want_planes = false;
-  Planes* planes = nullptr;
-  Image* rgb = nullptr;
-  ImageDecoder* img = nullptr;
-  JpegDecoder* jpeg = nullptr;
-  Arena* arena = nullptr;
-  bool started = false;
-  bool finished = false;
-  std::string kind;
-  Status status = Status::ok;
-  std::string error;
-  std::string message;  // a host-side problem, reported as it is
-};
-
+// Fills the prediction of a rectangle from the destination's prior planes.
 bool predict_from_planes(void* ctx, uint16_t x, uint16_t y, uint16_t w, uint16_t h, uint8_t* yo, ptrdiff_t ys,
                          uint8_t* cbo, uint8_t* cro, ptrdiff_t cs) {
   const Planes& p = *static_cast<const Planes*>(ctx);
+  if (x + w > p.width || y + h > p.height) return false;
   for (int r = 0; r < h; ++r) std::memcpy(yo + r * ys, p.row(0, y + r) + x, w);
   if (cbo != nullptr && p.components() == 3) {
     const int s = p.chroma == ChromaFormat::yuv420 ? 1 : 0;
@@ -48,147 +34,146 @@ bool predict_from_planes(void* ctx, uint16_t x, uint16_t y, uint16_t w, uint16_t
   return true;
 }
 
-ChunkResult on_chunk(void* ctx, uint32_t type, const uint8_t* payload, uint32_t size) {
-  Pass& p = *static_cast<Pass*>(ctx);
-  if (p.finished) return ChunkResult::unknown;  // only the first image
-  if (type == chunk::kImageHeader) {
-    ImageHeader h;
-    const Status hs = image_header_from_bytes(payload, size, &h);
-    if (hs != Status::ok) {
-      p.status = hs;
-      p.error = "IMGH";
-      return ChunkResult::abort;
-    }
-    p.kind = "vds";
-    if (p.prediction != nullptr &&
-        (p.prediction->width != h.width || p.prediction->height != h.height || p.prediction->chroma != h.chroma)) {
-      // No exception may cross the client library's frames (built without
-      // exception support): report through the pass, abort the parser.
-      p.status = Status::invalid_argument;
-      p.message = "the prediction does not match the image (" + std::to_string(h.width) + "x" +
-                  std::to_string(h.height) + ", " +
-                  (h.chroma == ChromaFormat::yuv420 ? "4:2:0" : h.chroma == ChromaFormat::yuv444 ? "4:4:4" : "grey") + ")";
-      return ChunkResult::abort;
-    }
-    if (p.want_planes) {
-      *p.planes = p.prediction != nullptr ? *p.prediction : Planes(h.width, h.height, h.chroma);
-      Planes& pl = *p.planes;
-      p.target = ImageTarget::planes(pl.plane[0].data(), pl.plane_width(0),
-                                     h.components() == 3 ? pl.plane[1].data() : nullptr, pl.plane_width(1),
-                                     h.components() == 3 ? pl.plane[2].data() : nullptr, pl.plane_width(2));
-    } else {
-      // Without a prediction the destination starts as the planes pass's
-      // does: Y' 0, Cb = Cr = 128 (black).
-      if (p.prediction == nullptr) p.blank = Planes(h.width, h.height, h.chroma);
-      const Planes& prior = p.prediction != nullptr ? *p.prediction : p.blank;
-      *p.rgb = planes_to_rgb(prior);
-      p.target = ImageTarget::frame(PixelFormat::rgb888, p.rgb->pixels.data(), static_cast<ptrdiff_t>(h.width) * 3);
-      p.target.predict = predict_from_planes;
-      p.target.predict_ctx = const_cast<Planes*>(&prior);
-    }
-    const Status s = p.img->start(payload, size, p.target);
-    if (s != Status::ok) {
-      p.status = s;
-      p.error = "IMGH";
-      return ChunkResult::abort;
-    }
-    p.started = true;
-    return ChunkResult::consumed;
-  }
-  if (type == chunk::kImageData) {
-    if (!p.started) {
-      p.status = Status::malformed;
-      p.error = "IMGD before IMGH";
-      return ChunkResult::abort;
-    }
-    const Status s = p.img->feed(payload, size);
-    if (s == Status::ok) p.finished = true;
-    if (is_error(s)) {
-      p.status = s;
-      p.error = "IMGD";
-      return ChunkResult::abort;
-    }
-    return ChunkResult::consumed;
-  }
-  if (type == chunk::kJpeg) {
-    if (p.want_planes) return ChunkResult::consumed;  // JPEG planes are not collected
-    if (!p.started) {
-      JpegInfo info;
-      const Status is = jpeg_peek_info(payload, size, &info);
-      if (is != Status::ok) {
-        p.status = is;
-        p.error = "JPEG header (it must lie in the first JPEG chunk)";
-        return ChunkResult::abort;
-      }
-      *p.rgb = Image(info.width, info.height, 3);
-      p.target = ImageTarget::frame(PixelFormat::rgb888, p.rgb->pixels.data(), static_cast<ptrdiff_t>(info.width) * 3);
-      p.jpeg->start(p.target);
-      p.started = true;
-      p.kind = "jpeg";
-    }
-    const Status s = p.jpeg->feed(payload, size);
-    if (s == Status::ok) p.finished = true;
-    if (is_error(s)) {
-      p.status = s;
-      p.error = "JPEG";
-      return ChunkResult::abort;
-    }
-    return ChunkResult::consumed;
-  }
-  return ChunkResult::unknown;
+// The frame width a stream's HEAD declares (0 if the stream does not start
+// with one): what the band buffer is sized from.
+uint16_t declared_width(std::span<const uint8_t> s) {
+  if (s.size() < kPreambleBytes + kChunkHeadBytes || std::memcmp(s.data(), kStreamMagic, sizeof kStreamMagic) != 0)
+    return 0;
+  const uint8_t* chunk = s.data() + kPreambleBytes;
+  const uint32_t size = load_le32(chunk + 4);
+  if (load_le32(chunk) != chunk::kHeader || size > kHeaderPayloadMax || s.size() < kPreambleBytes + kChunkHeadBytes + size)
+    return 0;
+  StreamHeader h;
+  if (header_from_bytes(chunk + kChunkHeadBytes, size, s[4], s[5], &h) != Status::ok) return 0;
+  return h.width;
 }
 
-bool on_header(void* ctx, const StreamHeader&) {
-  // A device carves its decoders once the header has declared what the
-  // stream needs (the parser has checked it fits).
-  Pass& p = *static_cast<Pass*>(ctx);
-  return p.img->init(*p.arena) == Status::ok && p.jpeg->init(*p.arena) == Status::ok;
+// One replay of the client: the first image of a stream, to RGB888.
+struct Replay {
+  const Player* player = nullptr;
+  const Planes* prior = nullptr;  // the destination's prior content (null: black)
+  Image* rgb = nullptr;
+  std::string* kind = nullptr;
+  std::string message;  // a host-side problem, reported as it is
+  bool began = false, shown = false;
+};
+
+const char* chroma_name(ChromaFormat c) {
+  return c == ChromaFormat::yuv420 ? "4:2:0" : c == ChromaFormat::yuv444 ? "4:4:4" : "grey";
 }
 
-void run_pass(std::span<const uint8_t> stream, Pass& p) {
-  // No chunk is larger than the stream; the decoders' workspaces follow.
-  const uint32_t capacity = static_cast<uint32_t>(std::clamp<size_t>(stream.size(), kHeaderPayloadMax, 1u << 24));
-  std::vector<uint8_t> ws(capacity + ImageDecoder::kWorkspaceBytes + JpegDecoder::kWorkspaceBytes + 64);
-  Arena arena(ws.data(), ws.size());
-  ImageDecoder img;
-  JpegDecoder jpeg;
-  p.img = &img;
-  p.jpeg = &jpeg;
-  p.arena = &arena;
-  StreamParser parser;
-  ChunkSink sink;
-  sink.ctx = &p;
-  sink.on_header = on_header;
-  sink.on_chunk = on_chunk;
-  if (parser.init(arena, capacity, sink) != Status::ok) throw std::logic_error("parser init");
-  Status s = parser.feed(stream.data(), stream.size());
-  if (s == Status::more_input) s = parser.finish();
-  if (!p.message.empty()) throw std::runtime_error(p.message);
-  if (p.status != Status::ok)
-    throw std::runtime_error("client decoder refused the " + p.error + ": " + status_name(p.status));
-  if (s != Status::ok)
-    throw std::runtime_error(std::string("client stream parser: ") + status_name(s) +
-                             (parser.error_detail()[0] ? std::string(" (") + parser.error_detail() + ")" : ""));
-  if (!p.started) throw std::runtime_error("the stream holds no image (no IMGH or JPEG chunk)");
-  if (!p.finished) throw std::runtime_error("the stream ends before the image is complete");
+bool begin_frame(void* ctx, uint16_t w, uint16_t h) {
+  Replay& r = *static_cast<Replay*>(ctx);
+  if (r.shown) return true;  // a later image: played, not kept
+  const bool jpeg = r.player->jpeg_open;
+  if (r.prior != nullptr && !jpeg) {
+    const ImageHeader& ih = r.player->image.header();
+    if (r.prior->width != w || r.prior->height != h || r.prior->chroma != ih.chroma) {
+      r.message = "the prediction does not match the image (" + std::to_string(w) + "x" + std::to_string(h) + ", " +
+                  chroma_name(ih.chroma) + ")";
+      return false;
+    }
+  }
+  *r.kind = jpeg ? "jpeg" : "vds";
+  *r.rgb = Image(w, h, 3);
+  r.began = true;
+  return true;
+}
+
+bool band(void* ctx, const PixelRect& b) {
+  if (static_cast<Replay*>(ctx)->shown) return true;
+  Image& img = *static_cast<Replay*>(ctx)->rgb;
+  for (int row = 0; row < b.h; ++row)
+    std::memcpy(&img.pixels[(static_cast<size_t>(b.y + row) * img.width) * 3], b.pixels + row * b.stride,
+                static_cast<size_t>(b.w) * 3);
+  return true;
+}
+
+// Only the first image is kept; the stream is played to its end, which
+// must be there.
+bool end_frame(void* ctx, uint32_t) {
+  static_cast<Replay*>(ctx)->shown = true;
+  return true;
+}
+
+// The prior content of a rectangle: the prediction's, or black (Y' 0,
+// Cb = Cr = 128) without one.
+bool predict(void* ctx, uint16_t x, uint16_t y, uint16_t w, uint16_t h, uint8_t* yo, ptrdiff_t ys, uint8_t* cbo,
+             uint8_t* cro, ptrdiff_t cs) {
+  const Replay& r = *static_cast<const Replay*>(ctx);
+  if (r.prior != nullptr && !r.shown) return predict_from_planes(const_cast<Planes*>(r.prior), x, y, w, h, yo, ys, cbo, cro, cs);
+  const ImageHeader& ih = r.player->image.header();
+  const int s = ih.chroma == ChromaFormat::yuv420 ? 1 : 0;
+  for (int row = 0; row < h; ++row) std::memset(yo + row * ys, 0, w);
+  if (cbo != nullptr) {
+    const int cw = ((x + w + s) >> s) - (x >> s), ch = ((y + h + s) >> s) - (y >> s);
+    for (int row = 0; row < ch; ++row) {
+      std::memset(cbo + row * cs, 128, cw);
+      std::memset(cro + row * cs, 128, cw);
+    }
+  }
+  return true;
 }
 
 }  // namespace
 
 DecodedImage decode_stream_image(std::span<const uint8_t> stream, const Planes* prediction) {
   DecodedImage out;
-  Pass rgb_pass;
-  rgb_pass.prediction = prediction;
-  rgb_pass.rgb = &out.rgb;
-  run_pass(stream, rgb_pass);
-  out.kind = rgb_pass.kind;
-  if (out.kind == "vds") {
-    Pass planes_pass;
-    planes_pass.prediction = prediction;
-    planes_pass.want_planes = true;
-    planes_pass.planes = &out.planes;
-    run_pass(stream, planes_pass);
+  // The host holds the stream whole: no chunk is larger than it.
+  PlayerConfig config;
+  config.format = PixelFormat::rgb888;
+  config.max_chunk_bytes = static_cast<uint32_t>(std::clamp<size_t>(stream.size(), kHeaderPayloadMax, 1u << 24));
+  const uint16_t width = declared_width(stream);
+  std::vector<uint8_t> ws(config.max_chunk_bytes +
+                          std::max(Player::image_workspace_bytes(width, config), Player::jpeg_workspace_bytes(width, config)) + 64);
+  Arena arena(ws.data(), ws.size());
+  Player player;
+  Replay r;
+  r.player = &player;
+  r.prior = prediction;
+  r.rgb = &out.rgb;
+  r.kind = &out.kind;
+  PlayerCallbacks cb;
+  cb.ctx = &r;
+  cb.begin_frame = begin_frame;
+  cb.band = band;
+  cb.end_frame = end_frame;
+  cb.predict = predict;
+  if (player.init(arena, config, cb) != Status::ok) throw std::logic_error("player init");
+  Status s = player.feed(stream.data(), stream.size());
+  if (s == Status::more_input) s = player.finish();
+  if (!r.message.empty()) throw std::runtime_error(r.message);
+  if (s == Status::ok && r.shown) return out;
+  if (is_error(s)) {
+    const std::string detail = player.error_detail() != nullptr && player.error_detail()[0] ? player.error_detail() : "";
+    throw std::runtime_error(std::string("the client refused the stream: ") + status_name(s) +
+                             (detail.empty() ? "" : " (" + detail + ")") + " at byte " +
+                             std::to_string(player.error_offset()));
   }
+  if (!r.began) throw std::runtime_error("the stream holds no image (no IMGH or JPEG chunk)");
+  throw std::runtime_error("the stream ends before the image is complete");
+}
+
+Planes decode_image_planes(const EncodedImage& e, const Planes* prediction) {
+  const ImageHeader& h = e.header;
+  Planes out = prediction != nullptr ? *prediction : Planes(h.width, h.height, h.chroma);
+  if (out.width != h.width || out.height != h.height || out.chroma != h.chroma)
+    throw std::runtime_error(std::string("the prediction does not match the image (") + std::to_string(h.width) + "x" +
+                             std::to_string(h.height) + ", " + chroma_name(h.chroma) + ")");
+  std::vector<uint8_t> ws(ImageDecoder::kWorkspaceBytes);
+  Arena arena(ws.data(), ws.size());
+  ImageDecoder dec;
+  if (dec.init(arena) != Status::ok) throw std::logic_error("image decoder init");
+  const bool colour = h.components() == 3;
+  const ImageTarget t = ImageTarget::planes(out.plane[0].data(), out.plane_width(0), colour ? out.plane[1].data() : nullptr,
+                                            out.plane_width(1), colour ? out.plane[2].data() : nullptr, out.plane_width(2));
+  Status s = dec.start(e.imgh.data(), static_cast<uint32_t>(e.imgh.size()), t);
+  if (s == Status::ok) s = Status::more_input;
+  for (size_t i = 0; i < e.imgd.size() && s == Status::more_input; ++i)
+    s = dec.feed(e.imgd[i].data(), static_cast<uint32_t>(e.imgd[i].size()));
+  if (s != Status::ok)
+    throw std::runtime_error(std::string("the client image decoder: ") +
+                             (s == Status::more_input ? "the image is incomplete" : status_name(s)));
   return out;
 }
 

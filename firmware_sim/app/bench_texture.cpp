@@ -1,13 +1,15 @@
-// Cortex-M4 side of bench/run_texture.sh: decodes the texture cases that
-// `bench_texture m4-case` writes (a vds stream through the stream parser and
-// vds::ImageDecoder, or a baseline JPEG through vds::JpegDecoder) and prints
-// instructions per decode and a CRC-32C of the decoded output, to compare
-// with the host's decode of the same file.
+// Cortex-M4 side of bench/run_texture.sh: plays the texture cases that
+// `bench_texture m4-case` writes (an images stream holding one vds image or
+// one baseline JPEG) through vds::Player, as the client does, into an
+// RGB565 frame, and prints the instructions per image (parse + decode of
+// the player's frame record: chunk framing and CRCs, entropy decoding,
+// inverse transform and colour conversion; the band copies excluded) and
+// the frame's CRC-32C, to compare with the host's play of the same file.
 //
 // Reads texture_case0.bin, texture_case1.bin, ... from the board's host
 // (QEMU's working directory) until one is missing. Case file: "VTX1",
-// u8 kind (0 = vds stream, 1 = JPEG file), u8 reps, u16 width, u16 height,
-// u16 target (0 = RGB565 frame, 1 = Y'CbCr planes), u32 size, then the bytes.
+// u8 kind (0 = vds image, 1 = JPEG), u8 reps, u16 width, u16 height,
+// u16 0, u32 size, then the stream's bytes.
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -15,11 +17,9 @@
 #include "print.h"
 #include "vds/arena.h"
 #include "vds/board.h"
-#include "vds/container.h"
-#include "vds/crc32c.h"
-#include "vds/image.h"
-#include "vds/jpeg.h"
 #include "vds/bytes.h"
+#include "vds/crc32c.h"
+#include "vds/player.h"
 
 #ifndef VDS_WORKSPACE_BYTES
 #error "VDS_WORKSPACE_BYTES (the client's workspace budget) must be set by the build"
@@ -31,13 +31,13 @@ using vds::fw::Line;
 
 constexpr uint32_t kCaseHeaderBytes = 16;
 constexpr uint32_t kCaseMagic = 0x31585456;  // "VTX1" read little-endian
-// The stream parser's chunk buffer: at least the max_chunk_payload of the
-// streams bench_texture writes (4096 by default).
+// The player's chunk buffer: at least the max_chunk_payload of the streams
+// bench_texture writes (4096 by default).
 constexpr uint32_t kChunkCapacity = 16384;
-// Output: an RGB565 frame (or the three planes) of up to this many pixels.
+// Output: an RGB565 frame of up to this many pixels.
 constexpr uint32_t kMaxPixels = 48 * 1024;
 
-// The case's bytes, the parser's chunk buffer and the decoders' workspaces
+// The case's bytes, the player's chunk buffer and the decoders' workspaces
 // come from this arena, which the board's workspace budget bounds.
 alignas(8) uint8_t g_workspace[VDS_WORKSPACE_BYTES];
 alignas(4) uint16_t g_frame[kMaxPixels];
@@ -45,73 +45,44 @@ alignas(4) uint16_t g_frame[kMaxPixels];
 struct Case {
   uint8_t kind, reps;
   uint16_t width, height;
-  bool planar;
   uint32_t size;
 };
 
-
-vds::ImageTarget target_for(const Case& c) {
-  uint8_t* const base = reinterpret_cast<uint8_t*>(g_frame);
-  if (c.planar) {
-    const int cw = (c.width + 1) / 2;
-    const uint32_t luma = static_cast<uint32_t>(c.width) * c.height;
-    const uint32_t chroma = static_cast<uint32_t>(cw) * ((c.height + 1) / 2);
-    return vds::ImageTarget::planes(base, c.width, base + luma, cw, base + luma + chroma, cw);
-  }
-  return vds::ImageTarget::frame(vds::PixelFormat::rgb565, base, c.width * 2);
-}
-
-uint32_t output_bytes(const Case& c) {
-  const uint32_t luma = static_cast<uint32_t>(c.width) * c.height;
-  if (!c.planar) return 2 * luma;
-  return luma + 2 * static_cast<uint32_t>((c.width + 1) / 2) * ((c.height + 1) / 2);
-}
-
-struct VdsCtx {
-  vds::ImageDecoder* dec;
-  vds::Arena* arena;
-  vds::ImageTarget target;
-  vds::Status status;
+struct Play {
+  uint64_t instructions = 0;  // parse + decode of the frame
+  uint32_t frames = 0;
 };
 
-bool on_header(void* ctx, const vds::StreamHeader&) {
-  VdsCtx& c = *static_cast<VdsCtx*>(ctx);
-  return c.dec->init(*c.arena) == vds::Status::ok;
+uint64_t clock(void*) { return vds::board::instructions(); }
+
+bool to_frame(void*, const vds::PixelRect& r) {
+  for (uint16_t row = 0; row < r.h; ++row)
+    std::memcpy(g_frame + static_cast<size_t>(r.y + row) * r.w, r.pixels + row * r.stride, static_cast<size_t>(r.w) * 2);
+  return true;
 }
 
-vds::ChunkResult on_chunk(void* ctx, uint32_t type, const uint8_t* p, uint32_t size) {
-  VdsCtx& c = *static_cast<VdsCtx*>(ctx);
-  const vds::Status s = c.dec->on_chunk(type, p, size, c.target);
-  if (vds::is_error(s)) {
-    c.status = s;
-    return vds::ChunkResult::abort;
-  }
-  return vds::ChunkResult::consumed;
+void shown(void* ctx, const vds::PlayedFrame& f) {
+  Play& p = *static_cast<Play*>(ctx);
+  p.instructions += f.parse + f.decode;
+  ++p.frames;
 }
 
-// One decode of a vds stream as the client runs it: the stream parser
-// (chunk CRC-32C checks included) feeding the image decoder.
-vds::Status decode_vds(vds::Arena& arena, const uint8_t* data, const Case& c) {
-  vds::ImageDecoder dec;
-  VdsCtx ctx{&dec, &arena, target_for(c), vds::Status::ok};
-  vds::ChunkSink sink;
-  sink.ctx = &ctx;
-  sink.on_header = on_header;
-  sink.on_chunk = on_chunk;
-  vds::StreamParser parser;
-  vds::Status s = parser.init(arena, kChunkCapacity, sink);
+// One play of the case's stream as the client runs it.
+vds::Status play(vds::Arena& arena, const uint8_t* data, const Case& c, Play& out) {
+  vds::PlayerConfig config = vds::kClientPlayerConfig;
+  config.max_chunk_bytes = kChunkCapacity;
+  vds::PlayerCallbacks cb;
+  cb.ctx = &out;
+  cb.band = to_frame;
+  cb.frame_shown = shown;
+  cb.clock = clock;
+  vds::Player player;
+  vds::Status s = player.init(arena, config, cb);
   if (s != vds::Status::ok) return s;
-  s = parser.feed(data, c.size);
-  if (ctx.status != vds::Status::ok) return ctx.status;
-  if (s != vds::Status::ok) return s;
-  return dec.done() ? vds::Status::ok : vds::Status::truncated;
-}
-
-vds::Status decode_jpeg(vds::Arena& arena, const uint8_t* data, const Case& c) {
-  vds::JpegDecoder dec;
-  const vds::Status s = dec.init(arena);
-  if (s != vds::Status::ok) return s;
-  return dec.decode(data, c.size, target_for(c));
+  s = player.feed(data, c.size);
+  if (s == vds::Status::more_input) s = player.finish();
+  if (s == vds::Status::ok && out.frames != 1) return vds::Status::truncated;
+  return s;
 }
 
 // Runs texture_case<index>.bin. Returns 0 when done, 1 on an error, 2 when
@@ -131,12 +102,11 @@ int run_case(uint32_t index) {
   c.reps = head[5];
   c.width = static_cast<uint16_t>(vds::load_le16(head + 6));
   c.height = static_cast<uint16_t>(vds::load_le16(head + 8));
-  c.planar = vds::load_le16(head + 10) == 1;
   c.size = vds::load_le32(head + 12);
   vds::Arena arena(g_workspace, sizeof g_workspace);
   uint8_t* const data = c.size > 0 ? static_cast<uint8_t*>(arena.alloc(c.size)) : nullptr;
   if (data == nullptr || c.kind > 1 || c.reps == 0 || c.width == 0 || c.height == 0 ||
-      output_bytes(c) > sizeof g_frame) {
+      static_cast<uint32_t>(c.width) * c.height > kMaxPixels) {
     vds::board::log(Line().str("m4 error: case does not fit this board: ").str(name.c_str()).str("\n").c_str());
     return 1;
   }
@@ -145,26 +115,25 @@ int run_case(uint32_t index) {
     return 1;
   }
   const size_t mark = arena.mark();
-  uint64_t spent = 0;
+  Play p;
   size_t high_water = 0;
   vds::Status s = vds::Status::ok;
   for (uint32_t r = 0; r < c.reps && s == vds::Status::ok; ++r) {
     std::memset(g_frame, 0, sizeof g_frame);
     arena.rewind(mark);
-    const uint64_t t0 = vds::board::instructions();
-    s = c.kind == 0 ? decode_vds(arena, data, c) : decode_jpeg(arena, data, c);
-    spent += vds::board::instructions() - t0;
-    high_water = arena.high_water();
+    p.frames = 0;
+    s = play(arena, data, c, p);
+    high_water = arena.high_water() - mark;
   }
   if (s != vds::Status::ok) {
     vds::board::log(Line().str("m4 error: ").str(name.c_str()).str(" status ").str(vds::status_name(s)).str("\n").c_str());
     return 1;
   }
-  const uint32_t crc = vds::crc32c(reinterpret_cast<const uint8_t*>(g_frame), output_bytes(c));
+  const uint32_t crc = vds::crc32c(reinterpret_cast<const uint8_t*>(g_frame), static_cast<size_t>(c.width) * c.height * 2);
   Line l;
   l.str("m4 case=").dec(index).str(c.kind == 0 ? " kind=vds" : " kind=jpeg");
-  l.str(c.planar ? " target=planes" : " target=rgb565").str(" bytes=").dec(c.size);
-  l.str(" instr=").dec(spent / c.reps).str(" workspace=").dec(high_water).str(" crc=").hex32(crc).str("\n");
+  l.str(" target=rgb565 bytes=").dec(c.size);
+  l.str(" instr=").dec(p.instructions / c.reps).str(" workspace=").dec(high_water).str(" crc=").hex32(crc).str("\n");
   vds::board::log(l.c_str());
   return 0;
 }
@@ -181,6 +150,7 @@ extern "C" int vds_app_main() {
   sizes.str("m4 sizes image_workspace=").dec(vds::ImageDecoder::kWorkspaceBytes);
   sizes.str(" image_object=").dec(sizeof(vds::ImageDecoder)).str(" jpeg_workspace=").dec(vds::JpegDecoder::kWorkspaceBytes);
   sizes.str(" jpeg_object=").dec(sizeof(vds::JpegDecoder)).str(" parser_object=").dec(sizeof(vds::StreamParser));
+  sizes.str(" player_object=").dec(sizeof(vds::Player));
   vds::board::log(sizes.str("\n").c_str());
   uint32_t n = 0;
   for (;; ++n) {

@@ -386,7 +386,7 @@ TEST_F(JpegConformance, StreamChunksCarryAJpeg) {
   ASSERT_GT(file.size(), 1000u);
   const Decoded whole = client_decode(file, 0);
   ASSERT_EQ(whole.status, Status::ok);
-  // decode_stream_image runs StreamParser + JpegDecoder.
+  // decode_stream_image plays the stream through vds::Player (JPEG images in RGB888 bands).
   const vds::enc::DecodedImage d = vds::enc::decode_stream_image(stream);
   EXPECT_EQ(d.kind, "jpeg");
   EXPECT_EQ(d.rgb.pixels, whole.rgb);

@@ -144,8 +144,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     o.slope = (data[3] >> 3) % 17;
     o.max_chunk_payload = 1u << 16;
     const vds::enc::EncodedImage e = vds::enc::encode_image(img, o);
+    if (!(vds::enc::decode_image_planes(e) == e.recon)) __builtin_trap();
     const vds::enc::DecodedImage d = vds::enc::decode_stream_image(vds::enc::image_stream(e));
-    if (!(d.planes == e.recon)) __builtin_trap();
+    if (d.rgb.pixels != vds::enc::planes_to_rgb(e.recon).pixels) __builtin_trap();
   }
   return 0;
 }

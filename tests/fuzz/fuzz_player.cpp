@@ -2,8 +2,9 @@
 // pieces of sizes the input chooses. The first byte picks the stream:
 // chunks of the input's bytes in a valid images- or model-mode container
 // (every CRC right, so the modes themselves see the bytes), raw bytes, or
-// a valid image or model stream whose chunk payloads the input's bytes
-// flip (CRCs recomputed, so the decoders meet the damage).
+// a valid image, JPEG-image or model stream whose chunk payloads the
+// input's bytes flip (CRCs recomputed, so the decoders meet the damage);
+// and the band format (RGB565 or RGB888) and whether a prediction is given.
 // Invariants: no crash or sanitizer report; every band lies inside its
 // frame and is at most config.band_rows high; bands come only between a
 // frame's begin and end; the player ends with ok, more_input or an error,
@@ -14,6 +15,7 @@
 #include <cstring>
 #include <vector>
 
+#include "jpeg_sample_422.h"
 #include "vds/container.h"
 #include "vds/enc/frames.h"
 #include "vds/enc/mesh_encoder.h"
@@ -38,7 +40,7 @@ std::vector<uint8_t> container(vds::StreamMode mode, const uint8_t* data, size_t
     h.max_triangles = 4096;
   }
   vds::enc::StreamWriter w(h);
-  const uint32_t images[] = {vds::chunk::kImageHeader, vds::chunk::kImageData};
+  const uint32_t images[] = {vds::chunk::kImageHeader, vds::chunk::kImageData, vds::chunk::kJpeg};
   const uint32_t meshes[] = {vds::chunk::kMeshHeader, vds::chunk::kMeshBase, vds::chunk::kMeshLevel,
                              vds::chunk::kMeshTail};
   size_t at = 0;
@@ -47,7 +49,7 @@ std::vector<uint8_t> container(vds::StreamMode mode, const uint8_t* data, size_t
     const size_t len = data[at + 1] * 8u % 600;
     at += 2;
     const size_t n = len < size - at ? len : size - at;
-    const uint32_t type = mode == vds::StreamMode::images ? images[pick % 2] : meshes[pick % 4];
+    const uint32_t type = mode == vds::StreamMode::images ? images[pick % 3] : meshes[pick % 4];
     w.add_chunk(type, std::vector<uint8_t>(data + at, data + at + n));
     at += n;
   }
@@ -94,6 +96,23 @@ const std::vector<uint8_t>& valid_images() {
   return s;
 }
 
+// Two 24x18 JPEG images in 100-byte JPEG chunks.
+const std::vector<uint8_t>& valid_jpeg_images() {
+  static const std::vector<uint8_t> s = [] {
+    vds::StreamHeader h = vds::enc::default_header(vds::StreamMode::images, 24, 18);
+    h.max_chunk_payload = 100;
+    h.workspace_bytes = static_cast<uint32_t>(vds::Player::jpeg_workspace_bytes(24, vds::kClientPlayerConfig));
+    vds::enc::StreamWriter w(h);
+    const std::vector<uint8_t> file(vds::test::kJpeg422, vds::test::kJpeg422 + sizeof vds::test::kJpeg422);
+    for (int image = 0; image < 2; ++image)
+      for (size_t at = 0; at < file.size(); at += 100)
+        w.add_chunk(vds::chunk::kJpeg, std::vector<uint8_t>(file.begin() + static_cast<long>(at),
+                                                          file.begin() + static_cast<long>(std::min(file.size(), at + 100))));
+    return w.finish();
+  }();
+  return s;
+}
+
 const std::vector<uint8_t>& valid_model() {
   static const std::vector<uint8_t> s = [] {
     vds::enc::Mesh m;
@@ -114,7 +133,9 @@ const std::vector<uint8_t>& valid_model() {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 2) return 0;
-  const uint8_t kind = data[0] % 5;
+  const uint8_t kind = data[0] % 6;
+  const bool rgb888 = (data[0] / 6) & 1;
+  const bool predict = (data[0] / 12) & 1;
   const uint8_t piece = static_cast<uint8_t>(data[1] | 1);
   data += 2;
   size -= 2;
@@ -123,6 +144,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       : kind == 1 ? container(vds::StreamMode::model, data, size)
       : kind == 2 ? std::vector<uint8_t>(data, data + size)
       : kind == 3 ? flipped(valid_images(), data, size)
+      : kind == 4 ? flipped(valid_jpeg_images(), data, size)
                   : flipped(valid_model(), data, size);
   static std::vector<uint8_t> ws(256 * 1024);
   vds::Arena arena(ws.data(), ws.size());
@@ -148,8 +170,25 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     v.open = false;
     return true;
   };
+  if (predict) {
+    // Mid-grey, bounds checked against the frame.
+    cb.predict = [](void* ctx, uint16_t x, uint16_t y, uint16_t w, uint16_t h, uint8_t* yo, ptrdiff_t ys, uint8_t* cb_out,
+                    uint8_t* cr_out, ptrdiff_t cs) {
+      const auto& v = *static_cast<Watch*>(ctx);
+      if (!v.open || w == 0 || h == 0 || x + w > v.w || y + h > v.h) abort();
+      for (int r = 0; r < h; ++r) std::memset(yo + r * ys, 128, w);
+      if (cb_out != nullptr)
+        for (int r = 0; r < (h + 1) / 2; ++r) {
+          std::memset(cb_out + r * cs, 128, (w + 1) / 2);
+          std::memset(cr_out + r * cs, 128, (w + 1) / 2);
+        }
+      return true;
+    };
+  }
+  vds::PlayerConfig config = vds::kClientPlayerConfig;
+  if (rgb888) config.format = vds::PixelFormat::rgb888;
   vds::Player player;
-  if (player.init(arena, vds::kClientPlayerConfig, cb) != vds::Status::ok) abort();
+  if (player.init(arena, config, cb) != vds::Status::ok) abort();
   vds::Status s = vds::Status::more_input;
   for (size_t at = 0; at < stream.size() && s == vds::Status::more_input; at += piece) {
     const size_t n = piece < stream.size() - at ? piece : stream.size() - at;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "vds/bytes.h"
 #include "vds/crc32c.h"
 #include "vds/enc/image_codec.h"
 #include "vds/enc/stream_writer.h"
@@ -54,13 +55,32 @@ Image synth(int w, int h, uint32_t seed) {
 
 std::vector<uint8_t> stream_of(const EncodedImage& e) { return vds::enc::image_stream(e); }
 
-// Decodes a stream's image through the client into planes; checks the RGB
-// pass against the planes too.
+// Decodes an image through the client decoder into planes; checks that the
+// player shows exactly those planes (its RGB888 bands) too.
 Planes client_planes(const EncodedImage& e, const Planes* prediction = nullptr) {
+  const Planes planes = vds::enc::decode_image_planes(e, prediction);
   const vds::enc::DecodedImage d = vds::enc::decode_stream_image(stream_of(e), prediction);
   EXPECT_EQ(d.kind, "vds");
-  EXPECT_EQ(d.rgb.pixels, vds::enc::planes_to_rgb(d.planes).pixels) << "rgb888 target differs from planes";
-  return d.planes;
+  EXPECT_EQ(d.rgb.pixels, vds::enc::planes_to_rgb(planes).pixels) << "the player's RGB888 bands differ from the planes";
+  return planes;
+}
+
+// The IMGH and IMGD payloads of a well-formed images stream, in order (the
+// container's framing: an 8-byte preamble, then type, size, payload, CRC).
+EncodedImage image_chunks_of(const std::vector<uint8_t>& s) {
+  EncodedImage e;
+  for (size_t at = vds::kPreambleBytes; at + vds::kChunkHeadBytes <= s.size();) {
+    const uint32_t type = vds::load_le32(&s[at]), size = vds::load_le32(&s[at + 4]);
+    const std::vector<uint8_t> payload(s.begin() + static_cast<ptrdiff_t>(at + vds::kChunkHeadBytes),
+                                       s.begin() + static_cast<ptrdiff_t>(at + vds::kChunkHeadBytes + size));
+    if (type == vds::chunk::kImageHeader) {
+      e.imgh = payload;
+      EXPECT_EQ(vds::image_header_from_bytes(payload.data(), size, &e.header), Status::ok);
+    }
+    if (type == vds::chunk::kImageData) e.imgd.push_back(payload);
+    at += vds::kChunkHeadBytes + size + vds::kChunkTailBytes;
+  }
+  return e;
 }
 
 TEST(ImageCodec, HeaderBytesRoundTripAndValidation) {
@@ -540,8 +560,10 @@ TEST(ImageCodec, GoldenStreamV1) {
   EXPECT_EQ(d.kind, "vds");
   EXPECT_EQ(d.rgb.width, 70);
   EXPECT_EQ(d.rgb.height, 46);
+  const Planes planes = vds::enc::decode_image_planes(image_chunks_of(golden));
+  EXPECT_EQ(d.rgb.pixels, vds::enc::planes_to_rgb(planes).pixels);
   uint32_t planes_crc = 0;
-  for (int c = 0; c < 3; ++c) planes_crc = vds::crc32c_update(planes_crc, d.planes.plane[c].data(), d.planes.plane[c].size());
+  for (int c = 0; c < 3; ++c) planes_crc = vds::crc32c_update(planes_crc, planes.plane[c].data(), planes.plane[c].size());
   std::printf("golden image-v1.vds: %zu bytes, hash %016llX, decoded planes crc %08X\n", golden.size(),
               static_cast<unsigned long long>(vds::test::golden_hash(golden)), planes_crc);
   EXPECT_EQ(golden.size(), kGoldenBytes);

@@ -8,9 +8,12 @@
 #include <cstring>
 #include <vector>
 
+#include "jpeg_sample_422.h"
 #include "mesh_test_meshes.h"
+#include "vds/crc32c.h"
 #include "vds/container.h"
 #include "vds/enc/frames.h"
+#include "vds/enc/image_codec.h"
 #include "vds/enc/mesh_encoder.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/player.h"
@@ -77,12 +80,13 @@ vds::PlayerCallbacks callbacks(Seen& s) {
 // Plays `s` fed in pieces of `piece` bytes (0: random 1..300) through an
 // arena of `bytes`.
 Status play(const std::vector<uint8_t>& s, Seen& seen, size_t piece, size_t bytes = 1u << 20,
-            vds::Player* out = nullptr) {
+            vds::Player* out = nullptr, const vds::PlayerConfig& config = vds::kClientPlayerConfig,
+            const vds::PlayerCallbacks* cbs = nullptr) {
   std::vector<uint8_t> ws(bytes);
   vds::Arena arena(ws.data(), ws.size());
   static vds::Player player;
   vds::Player& p = out != nullptr ? *out : player;
-  if (p.init(arena, vds::kClientPlayerConfig, callbacks(seen)) != Status::ok) return Status::invalid_argument;
+  if (p.init(arena, config, cbs != nullptr ? *cbs : callbacks(seen)) != Status::ok) return Status::invalid_argument;
   vds::test::Xorshift32 rng;
   Status st = Status::more_input;
   for (size_t at = 0; at < s.size() && st == Status::more_input;) {
@@ -209,6 +213,140 @@ TEST(Player, AModelLargerThanTheWorkspacePlaysWhatFitsAndEndsEarly) {
     EXPECT_EQ(seen.notices[1].first, vds::PlayerNotice::model_full);
   }
   EXPECT_TRUE(partial_seen) << "some workspace holds part of the model";
+}
+
+// Two JPEG images (the 24x18 sample) in JPEG chunks of `piece` bytes.
+std::vector<uint8_t> jpeg_stream(size_t piece) {
+  vds::StreamHeader h = vds::enc::default_header(vds::StreamMode::images, 24, 18);
+  h.frame_count = 2;
+  h.max_chunk_payload = static_cast<uint32_t>(piece);
+  h.workspace_bytes = static_cast<uint32_t>(vds::Player::jpeg_workspace_bytes(24, vds::kClientPlayerConfig));
+  vds::enc::StreamWriter w(h);
+  const std::vector<uint8_t> file(vds::test::kJpeg422, vds::test::kJpeg422 + sizeof vds::test::kJpeg422);
+  for (int image = 0; image < 2; ++image)
+    for (size_t at = 0; at < file.size(); at += piece)
+      w.add_chunk(vds::chunk::kJpeg, std::span(file).subspan(at, std::min(piece, file.size() - at)));
+  return w.finish();
+}
+
+TEST(Player, JpegImagesAreFramesLikeVdsImages) {
+  // The frame the JPEG decoder makes of the file on its own, RGB565.
+  std::vector<uint8_t> ws(vds::JpegDecoder::kWorkspaceBytes);
+  vds::Arena arena(ws.data(), ws.size());
+  vds::JpegDecoder dec;
+  ASSERT_EQ(dec.init(arena), Status::ok);
+  std::vector<uint8_t> frame(24 * 18 * 2);
+  ASSERT_EQ(dec.decode(vds::test::kJpeg422, sizeof vds::test::kJpeg422,
+                       vds::ImageTarget::frame(vds::PixelFormat::rgb565, frame.data(), 48)),
+            Status::ok);
+  const uint32_t want = vds::crc32c(frame.data(), frame.size());
+  for (size_t chunk : {size_t{8}, size_t{40}, size_t{4096}}) {
+    const std::vector<uint8_t> s = jpeg_stream(chunk);
+    for (size_t piece : {size_t{0}, size_t{1}, s.size()}) {
+      Seen seen;
+      ASSERT_EQ(play(s, seen, piece), Status::ok) << chunk << " " << piece;
+      EXPECT_EQ(seen.crcs, std::vector<uint32_t>(2, want));
+      EXPECT_EQ(seen.bands, 2u * 3u) << "18 rows of 4:2:2: bands of 8 rows";
+      EXPECT_FALSE(seen.band_outside);
+      EXPECT_FALSE(seen.band_in_no_frame);
+    }
+  }
+  // A JPEG of another size than the stream's frames is refused before a band is shown.
+  for (const auto& [w, h] : {std::pair<uint16_t, uint16_t>{24, 16}, {32, 18}, {16, 18}}) {
+    Seen seen;
+    EXPECT_EQ(play(resized_head(jpeg_stream(40), w, h), seen, 0), Status::malformed) << w << "x" << h;
+    EXPECT_EQ(seen.bands, 0u);
+    EXPECT_TRUE(seen.crcs.empty());
+  }
+}
+
+TEST(Player, AJpegInsideAVdsImageIsRefused) {
+  // A vds image's header, a JPEG, then the vds image's data.
+  const std::vector<uint8_t> vds_images = image_stream();
+  std::vector<std::pair<uint32_t, std::vector<uint8_t>>> chunks;
+  uint32_t head_len = 0;
+  std::memcpy(&head_len, vds_images.data() + vds::kPreambleBytes + 4, 4);
+  for (size_t at = vds::kPreambleBytes + vds::kChunkHeadBytes + head_len + vds::kChunkTailBytes;
+       at + vds::kChunkHeadBytes <= vds_images.size();) {
+    uint32_t type = 0, len = 0;
+    std::memcpy(&type, vds_images.data() + at, 4);
+    std::memcpy(&len, vds_images.data() + at + 4, 4);
+    chunks.emplace_back(type, std::vector<uint8_t>(vds_images.begin() + static_cast<std::ptrdiff_t>(at + 8),
+                                                   vds_images.begin() + static_cast<std::ptrdiff_t>(at + 8 + len)));
+    at += vds::kChunkHeadBytes + len + vds::kChunkTailBytes;
+  }
+  ASSERT_EQ(chunks[0].first, vds::chunk::kImageHeader);
+  vds::StreamHeader h = vds::enc::default_header(vds::StreamMode::images, 64, 48);
+  h.workspace_bytes = 32768;
+  h.max_chunk_payload = 4096;
+  vds::enc::StreamWriter w(h);
+  w.add_chunk(chunks[0].first, chunks[0].second);
+  w.add_chunk(vds::chunk::kJpeg, std::vector<uint8_t>(vds::test::kJpeg422, vds::test::kJpeg422 + sizeof vds::test::kJpeg422));
+  Seen seen;
+  EXPECT_EQ(play(w.finish(), seen, 0), Status::malformed);
+  EXPECT_EQ(seen.ended, 0u);
+}
+
+TEST(Player, Rgb888BandsShowTheSamePixelsAndModelsRefuseThem) {
+  const std::vector<uint8_t> s = image_stream();
+  vds::PlayerConfig c888 = vds::kClientPlayerConfig;
+  c888.format = vds::PixelFormat::rgb888;
+  struct Frames {
+    std::vector<std::vector<uint8_t>> rgb;
+    std::vector<uint32_t> crcs;
+  } got;
+  vds::PlayerCallbacks cb;
+  cb.ctx = &got;
+  cb.begin_frame = [](void* ctx, uint16_t w, uint16_t h) {
+    static_cast<Frames*>(ctx)->rgb.emplace_back(static_cast<size_t>(w) * h * 3);
+    return true;
+  };
+  cb.band = [](void* ctx, const vds::PixelRect& r) {
+    std::vector<uint8_t>& f = static_cast<Frames*>(ctx)->rgb.back();
+    for (int row = 0; row < r.h; ++row)
+      std::memcpy(&f[static_cast<size_t>(r.y + row) * r.w * 3], r.pixels + row * r.stride, static_cast<size_t>(r.w) * 3);
+    return true;
+  };
+  cb.frame_shown = [](void* ctx, const vds::PlayedFrame& f) { static_cast<Frames*>(ctx)->crcs.push_back(f.crc); };
+  Seen unused;
+  ASSERT_EQ(play(s, unused, 0, 1u << 20, nullptr, c888, &cb), Status::ok);
+  ASSERT_EQ(got.rgb.size(), 3u);
+  // The first frame as the host tools decode it, and each frame's CRC over its RGB888 rows.
+  EXPECT_EQ(got.rgb[0], vds::enc::decode_stream_image(s).rgb.pixels);
+  for (size_t f = 0; f < 3; ++f) EXPECT_EQ(got.crcs[f], vds::crc32c(got.rgb[f].data(), got.rgb[f].size()));
+  const vds::enc::MeshEncodeResult m = vds::enc::encode_mesh(vds::test::torus_mesh(12, 8), vds::enc::MeshEncodeOptions{});
+  EXPECT_EQ(play(m.stream, unused, 0, 8u << 20, nullptr, c888, &cb), Status::unsupported_feature);
+  c888.format = static_cast<vds::PixelFormat>(7);
+  vds::Player p;
+  std::vector<uint8_t> ws(1u << 16);
+  vds::Arena arena(ws.data(), ws.size());
+  EXPECT_EQ(p.init(arena, c888, cb), Status::invalid_argument);
+}
+
+TEST(Player, AModelReportsEveryLevelWithItsDecodeCount) {
+  const vds::enc::MeshEncodeResult r = vds::enc::encode_mesh(vds::test::torus_mesh(40, 20), vds::enc::MeshEncodeOptions{});
+  struct Levels {
+    std::vector<vds::PlayedLevel> seen;
+    uint64_t ticks = 0;
+  } levels;
+  Seen seen;
+  vds::PlayerCallbacks cb = callbacks(seen);
+  vds::PlayerCallbacks with = cb;
+  // A clock that moves one tick per call: every count is > 0 when work was done.
+  static Levels* current = nullptr;
+  current = &levels;
+  with.clock = [](void*) { return ++current->ticks; };
+  with.level = [](void*, const vds::PlayedLevel& l) { current->seen.push_back(l); };
+  vds::Player p;
+  ASSERT_EQ(play(r.stream, seen, 0, 8u << 20, &p, vds::kClientPlayerConfig, &with), Status::ok);
+  ASSERT_EQ(levels.seen.size(), static_cast<size_t>(p.mesh.header().levels) + 1);
+  for (size_t i = 0; i < levels.seen.size(); ++i) {
+    EXPECT_EQ(levels.seen[i].level, i);
+    EXPECT_GT(levels.seen[i].decode, 0u);
+    if (i > 0) EXPECT_GT(levels.seen[i].vertices, levels.seen[i - 1].vertices);
+  }
+  EXPECT_EQ(levels.seen.back().vertices, p.mesh.mesh().vertex_count());
+  EXPECT_EQ(levels.seen.back().triangles, p.mesh.mesh().triangle_count());
 }
 
 }  // namespace

@@ -41,7 +41,8 @@ struct PixelRect {
 // Returns false to stop decoding (the decoder then returns Status::aborted).
 using EmitFn = bool (*)(void* ctx, const PixelRect& rect);
 
-// Residual images with a packed or callback target: fills the prediction of
+// Residual images with a packed or callback target (and, when given, the
+// uncoded MCUs of a region image on such a target): fills the prediction of
 // the rectangle (x, y, w, h) of the image (luma samples; the chroma
 // rectangle is the same scaled by the chroma subsampling, rounded up) into
 // y/cb/cr, rows y_stride / c_stride bytes apart. Returns false to abort.
@@ -61,7 +62,8 @@ using PredictFn = bool (*)(void* ctx, uint16_t x, uint16_t y, uint16_t w, uint16
 //  - bands: data[0] = a caller-owned band buffer at least image-width pixels
 //    wide and one MCU row (16 lines at most) high; emit() is called once per
 //    MCU row with the band (x = 0, full width). In a region image MCUs
-//    that are not coded leave the band buffer as it was.
+//    that are not coded leave the band buffer as it was, or show the
+//    prediction when predict is given.
 struct ImageTarget {
   bool planar = false;
   PixelFormat format = PixelFormat::rgb565;
@@ -256,6 +258,9 @@ class ImageDecoder {
 
  private:
   Status decode_mcu(uint32_t mcu);
+  void copy_mcu_planes(int x0, int y0, bool to_target);
+  bool fetch_prediction(int x0, int y0);
+  Status deliver_mcu(int x0, int y0, bool row_end);
   int decode_block(image_model::RangeDecoder& rd, int comp, int bx, int by, bool first_col, int16_t* coef);
 
   StageClock* clock_ = nullptr;

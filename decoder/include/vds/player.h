@@ -16,15 +16,26 @@
 //   otherwise the first error, latched (error_offset(), error_detail()).
 // - Every displayed frame is: begin_frame(width, height), then band() for
 //   each band top to bottom (at most config.band_rows rows: a model's are
-//   band_rows high but the last, an image's one MCU row, 16 rows of 4:2:0,
-//   8 of 4:4:4 or grey), full width, RGB565 little-endian (bit 15..11 red,
-//   10..5 green, 4..0 blue), never outside the frame, then end_frame(crc) and
+//   band_rows high but the last, an image's one MCU row: 16 rows of 4:2:0,
+//   8 of 4:4:4 or grey, a JPEG's 8 or 16), full width, in config.format:
+//   RGB565 little-endian (bit 15..11 red, 10..5 green, 4..0 blue; the
+//   boards) or RGB888 (bytes R, G, B; host tools writing image files; image
+//   streams only), never outside the frame, then end_frame(crc) and
 //   frame_shown(record). The record's CRC-32C covers the frame's rows as
 //   displayed, top to bottom; its instruction counts come from the clock
-//   callback (0 without one): parse (chunk framing and CRCs), decode
-//   (entropy decoding + inverse transform + colour, or mesh decoding),
-//   display (bands, end_frame and, for a model, the drawing), with the
-//   image decoder's entropy and transform split out.
+//   callback (0 without one; any monotonic counter works, nanoseconds
+//   too): parse (chunk framing and CRCs), decode (entropy decoding +
+//   inverse transform + colour, or mesh decoding), display (bands,
+//   end_frame and, for a model, the drawing), with the image decoder's
+//   entropy and transform split out.
+// - Image streams: each image is a frame, a vds image (IMGH + IMGD) or a
+//   baseline JPEG (JPEG chunks, vds/jpeg.h). predict(), when given, is the
+//   destination's prior content (a host with a frame store): residual
+//   images add to it and a region image's uncoded MCUs show it. Without it
+//   a residual image is refused (invalid_argument) and a region image's
+//   uncoded MCUs keep what the band buffer held.
+// - Model streams: level() after the base (level 0) and after every level,
+//   with the mesh decoding spent on it; the mesh is `mesh.mesh()`.
 // - A callback returning false aborts: feed returns Status::aborted. An
 //   image whose size is not the stream's frame size is malformed, refused
 //   before any of its pixels is decoded.
@@ -46,6 +57,7 @@
 #include "vds/arena.h"
 #include "vds/container.h"
 #include "vds/image.h"
+#include "vds/jpeg.h"
 #include "vds/mesh.h"
 #include "vds/model_view.h"
 #include "vds/status.h"
@@ -60,6 +72,8 @@ struct PlayerConfig {
   uint32_t max_chunk_bytes = 4096;
   // Model streams: service() every this many mesh items (0: never).
   uint32_t mesh_service_items = 64;
+  // Band pixels: rgb565 (the boards) or rgb888 (image streams only).
+  PixelFormat format = PixelFormat::rgb565;
 };
 
 // What the client boards use. The host replay of a client uses it too, with
@@ -72,6 +86,13 @@ struct PlayedFrame {
   uint32_t crc = 0;    // CRC-32C of its RGB565 rows, top to bottom
   uint64_t parse = 0, decode = 0, display = 0;
   uint64_t entropy = 0, transform = 0;  // of decode (images)
+};
+
+// A model's level, complete (level 0: the base mesh).
+struct PlayedLevel {
+  uint32_t level = 0;
+  uint32_t vertices = 0, triangles = 0;
+  uint64_t decode = 0;  // mesh decoding since the previous level (clock units)
 };
 
 // What a notice reports; the values a, b, c are listed per kind.
@@ -91,6 +112,8 @@ struct PlayerCallbacks {
   uint64_t (*clock)(void* ctx) = nullptr;
   void (*notice)(void* ctx, PlayerNotice what, uint32_t a, uint32_t b, uint32_t c) = nullptr;
   bool (*send_up)(void* ctx, uint8_t kind, const uint8_t* data, size_t n) = nullptr;
+  void (*level)(void* ctx, const PlayedLevel& level) = nullptr;
+  PredictFn predict = nullptr;  // called with ctx
 };
 
 // The workspace plan of the stream being played.
@@ -125,8 +148,10 @@ struct PlayerMode {
 class Player {
  public:
   // Workspace an image stream of frames `width` pixels wide needs beyond the
-  // parser: the image decoder and the band buffer (what its HEAD declares).
+  // parser: the image decoder and the band buffer (what its HEAD declares);
+  // a stream of JPEG images, the JPEG decoder and the band buffer.
   static size_t image_workspace_bytes(uint16_t width, const PlayerConfig& config);
+  static size_t jpeg_workspace_bytes(uint16_t width, const PlayerConfig& config);
 
   Status init(Arena& arena, const PlayerConfig& config, const PlayerCallbacks& callbacks);
   Status feed(const uint8_t* data, size_t n);
@@ -146,6 +171,7 @@ class Player {
   uint64_t error_offset() const { return parser_.error_offset(); }
   const char* error_detail() const { return error_detail_ != nullptr ? error_detail_ : parser_.error_detail(); }
   uint32_t chunks() const { return parser_.chunks(); }
+  uint64_t bytes_consumed() const { return parser_.bytes_consumed(); }
 
   // --- For the modes (decoder/src/player/) ---------------------------------
   Arena& arena() { return *arena_; }
@@ -185,7 +211,10 @@ class Player {
 
   // Mode state. Only the mode the header selects is used.
   ImageDecoder image;
+  JpegDecoder jpeg;
+  bool image_ready = false, image_open = false, jpeg_ready = false, jpeg_open = false, jpeg_begun = false;
   uint8_t* band_buffer = nullptr;
+  uint64_t level_mark = 0;  // mesh decoding since the last level
   MeshDecoder mesh;
   ModelView view;
   ModelFrames model_frames;

@@ -14,7 +14,12 @@ bool render_band(void* ctx, const Band& b) {
 }
 
 bool start(Player& p, const StreamHeader&) {
+  if (p.config().format != PixelFormat::rgb565) {
+    p.fail(Status::unsupported_feature, "the model view draws RGB565 bands only");
+    return false;
+  }
   p.model_started = false;
+  p.level_mark = 0;
   p.model_frames = ModelFrames{};
   return true;  // the decoder and the view are set up when MSHH arrives
 }
@@ -63,10 +68,22 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
     if (!start_mesh(p, payload, size)) return ChunkResult::abort;
   }
   const uint64_t t0 = p.enter_chunk();
+  const bool had_base = p.mesh.drawable();
+  const uint32_t levels_before = p.mesh.levels_done();
   const Status s = p.mesh.consume(type, payload, size);
   const uint64_t t1 = p.work_clock();
   p.add_decode(t1 - t0);
+  p.level_mark += t1 - t0;
   ChunkResult result = ChunkResult::consumed;
+  if (!is_error(s) && ((!had_base && p.mesh.drawable()) || p.mesh.levels_done() != levels_before)) {
+    PlayedLevel l;
+    l.level = p.mesh.levels_done();
+    l.vertices = p.mesh.mesh().vertex_count();
+    l.triangles = p.mesh.mesh().triangle_count();
+    l.decode = p.level_mark;
+    p.level_mark = 0;
+    if (p.callbacks().level != nullptr) p.callbacks().level(p.callbacks().ctx, l);
+  }
   if (is_error(s)) {
     p.fail(s, "the mesh decoder refused a chunk");
     result = ChunkResult::abort;

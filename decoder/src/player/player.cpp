@@ -26,7 +26,8 @@ const detail::PlayerMode* find_mode(StreamMode m) {
 }  // namespace
 
 Status Player::init(Arena& arena, const PlayerConfig& config, const PlayerCallbacks& callbacks) {
-  if (config.band_rows < 16 || config.band_rows > 256 || config.band_rows % 16 != 0 || config.max_chunk_bytes == 0)
+  if (config.band_rows < 16 || config.band_rows > 256 || config.band_rows % 16 != 0 || config.max_chunk_bytes == 0 ||
+      (config.format != PixelFormat::rgb565 && config.format != PixelFormat::rgb888))
     return Status::invalid_argument;
   arena_ = &arena;
   config_ = config;
@@ -43,6 +44,8 @@ Status Player::init(Arena& arena, const PlayerConfig& config, const PlayerCallba
   frame_crc_ = 0;
   frames_ = 0;
   band_buffer = nullptr;
+  image_ready = image_open = jpeg_ready = jpeg_open = jpeg_begun = false;
+  level_mark = 0;
   model_frames = ModelFrames{};
   model_started = false;
   ChunkSink sink;
@@ -107,7 +110,8 @@ bool Player::begin_frame() {
 bool Player::band(const PixelRect& r) {
   const uint64_t t0 = work_clock();
   for (uint16_t row = 0; row < r.h; ++row)
-    frame_crc_ = crc32c_update(frame_crc_, r.pixels + row * r.stride, static_cast<size_t>(r.w) * 2);
+    frame_crc_ = crc32c_update(frame_crc_, r.pixels + row * r.stride,
+                               static_cast<size_t>(r.w) * static_cast<size_t>(bytes_per_pixel(config_.format)));
   const bool go = cb_.band == nullptr || cb_.band(cb_.ctx, r);
   display_total_ += work_clock() - t0;
   service();

@@ -120,16 +120,19 @@ std::vector<uint8_t> image_stream(const EncodedImage& e);
 // vds::JpegDecoder), as a device would run them ------------------------------
 
 struct DecodedImage {
-  Planes planes;  // vds images: the coded planes; JPEG: Y'CbCr at JPEG resolution is not kept
-  Image rgb;      // RGB (rgb888 target of the client decoder)
+  Image rgb;         // the first image of the stream as the client shows it, RGB888
   std::string kind;  // "vds" or "jpeg"
 };
 
-// Decodes the first image of a stream (IMGH/IMGD or JPEG chunks) through
-// the client's StreamParser and decoder, to both planes (vds images) and
-// RGB. `prediction` is the destination's prior content for residual and
-// region images (null: black). Throws std::runtime_error with the client's
-// status name.
+// Plays a stream through the client's vds::Player (RGB888 bands) and keeps
+// its first image (IMGH/IMGD or JPEG chunks). `prediction` is the
+// destination's prior content for residual and region images (null:
+// black). Throws std::runtime_error with the client's status and detail.
 DecodedImage decode_stream_image(std::span<const uint8_t> stream, const Planes* prediction = nullptr);
+
+// The client image decoder's Y'CbCr reconstruction of an encoded image (its
+// IMGH and IMGD payloads, no stream around them): what `recon` must equal.
+// `prediction` as above. Throws std::runtime_error.
+Planes decode_image_planes(const EncodedImage& e, const Planes* prediction = nullptr);
 
 }  // namespace vds::enc
