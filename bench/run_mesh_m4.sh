@@ -2,12 +2,12 @@
 # Progressive mesh decoding on the Cortex-M4 board: glmark2's bunny, horse
 # and cat at 10 and 12 bits, vds default coding (split levels, then the
 # single-rate tail), vds splits only (`--tail 0`) and the paper's coding
-# (`vds encode-mesh --paper`), decoded by the firmware vds_fw_bench_mesh in
-# QEMU mps2-an386 (-icount shift=0; the stream parser and the mesh decoder,
-# instructions counted inside the mesh decoder), and by the same firmware on
+# (`vds encode-mesh --paper`), played through vds::Player by the firmware
+# vds_fw_bench_mesh in QEMU mps2-an386 (-icount shift=0; the player's level
+# records count the mesh decoder's instructions), and by the same firmware on
 # the host board, whose mesh checksums after every level must be identical.
 # The firmware also draws the model after the base and every level as the
-# client does (vds::ModelView, 240x180), counted apart; the frame checksums
+# client does (vds::ModelView, 240x180, the player's frame records), counted apart; the frame checksums
 # must be identical on both boards too. Writes bench/results/mesh_m4.md.
 #
 # Usage: bench/run_mesh_m4.sh [BUILD_DIR]   (default build/host-release: it
@@ -87,8 +87,8 @@ L = ["# Progressive mesh decoding on the Cortex-M4 board", "",
      "(vds: arithmetic coding, area predictor, split levels to 4 % of the vertices, then the single-rate tail), "
      "`vds encode-mesh IN --bits B --tail 0` (vds splits only) and `vds encode-mesh IN --bits B --paper` (Huffman, "
      "Laplacian predictor) from glmark2-data's models, the horse and cat with `--up -z` so they are drawn "
-     "standing. Instructions are counted inside `MeshDecoder::consume` "
-     "(chunk parsing and CRC checks excluded). The same firmware on the host board printed the same mesh "
+     "standing. Each stream is played through `vds::Player` as the client plays it; instructions are the "
+     "mesh decoding of its level records (inside `MeshDecoder::consume`; chunk parsing and CRC checks excluded). The same firmware on the host board printed the same mesh "
      "checksum after every level.", "",
      "| model | bits | coding | stream bytes | vertices | levels | instructions | per vertex split | single-rate tail: instructions | per vertex | base | workspace bytes | bytes/vertex |",
      "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
@@ -109,12 +109,13 @@ for name, model, bits, coding, size in rows:
 L += ["", "Per vertex split: (instructions - base - tail) / the vertices the split levels add. The single-rate "
       "tail rebuilds the whole mesh: its instructions per vertex of the full mesh. Workspace: the arena's "
       "high-water mark (mesh, contexts or Huffman tables, split flags, the tail's border, the stream parser's "
-      "16 KiB chunk buffer), the model view's buffers not included.", "",
+      "16 KiB chunk buffer), less the model view's `ModelView::workspace_bytes` (its buffers with their "
+      "alignment slack).", "",
       "## Drawing the model (vds::ModelView, as the client firmware)", "",
       "After the base and after every level the firmware draws the mesh at 240x180 (shaded, z-buffered, "
       "16-row bands, every vertex projected once and every triangle's band range found once per frame), as the client does while a model streams in; the "
-      "instructions are counted around `ModelView::draw` (normals, colours, positions and the renderer; "
-      "nothing is displayed). The frame checksums were identical on the host board.", "",
+      "instructions are the display count of the player's frame records (`ModelView::draw`: normals, colours, "
+      "positions and the renderer; the player's band CRC; nothing is displayed). The frame checksums were identical on the host board.", "",
       "| model | bits | triangles | frames | all frames (instructions) | whole model, one frame | per triangle | "
       "frames/s at 100 MHz | view workspace bytes |",
       "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]

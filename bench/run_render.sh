@@ -74,15 +74,15 @@ if command -v arm-none-eabi-g++ >/dev/null; then
   HAVE_ARM=1
   echo "== arm-none-eabi-g++ -O2"
   mkdir -p "$WORK/m4" "$WORK/m4min"
-  for f in render render_setup render_clip render_camera homography fixed crc32c status; do
+  for f in render render_setup render_span render_clip render_camera homography fixed crc32c status; do
     arm-none-eabi-g++ "${ARM_FLAGS[@]}" -c "$ROOT/decoder/src/$f.cpp" -o "$WORK/m4/$f.o"
   done
-  for f in render render_setup render_clip render_camera; do
+  for f in render render_setup render_span render_clip render_camera; do
     arm-none-eabi-g++ "${ARM_FLAGS[@]}" -DVDS_CONFIG_RENDER_TEXTURE_FORMATS=1 -DVDS_CONFIG_RENDER_OUTPUT_FORMATS=1 \
       -DVDS_CONFIG_RENDER_DEPTH_FORMATS=1 -c "$ROOT/decoder/src/$f.cpp" -o "$WORK/m4min/$f.o"
   done
-  (cd "$WORK/m4" && arm-none-eabi-size render.o render_setup.o render_clip.o render_camera.o homography.o) | tee "$WORK/size.txt"
-  (cd "$WORK/m4min" && arm-none-eabi-size render.o render_setup.o render_clip.o render_camera.o) | tee "$WORK/size_min.txt"
+  (cd "$WORK/m4" && arm-none-eabi-size render.o render_setup.o render_span.o render_clip.o render_camera.o homography.o) | tee "$WORK/size.txt"
+  (cd "$WORK/m4min" && arm-none-eabi-size render.o render_setup.o render_span.o render_clip.o render_camera.o) | tee "$WORK/size_min.txt"
   cat "$WORK"/m4/render*.su "$WORK"/m4/homography.su >"$WORK/stack.txt"
   # Symbols the renderer objects take from outside themselves.
   arm-none-eabi-nm -u "$WORK"/m4/render*.o "$WORK/m4/homography.o" | awk 'NF {print $NF}' | grep -v ':$' | sort -u >"$WORK/undef_all.txt"

@@ -1,0 +1,640 @@
+// The span stage of the renderer: exact span start values from a polygon's
+// planes, one reciprocal per pixel (an interpolated table), nearest and
+// bilinear texture sampling in every texture and output format, and the
+// z-test; the loops selected per material and target. The rule u = (a x +
+// b y + c) / (g x + h y + i) is rational linear interpolation (Heckbert,
+// "Fundamentals of texture mapping and image warping", 1989); the
+// fixed-point scaling is in docs/renderer.md.
+#include <type_traits>
+
+#include "colour.h"
+#include "render_span.h"
+#include "vds/config.h"
+
+namespace vds::detail {
+
+namespace {
+
+template <TexAddress A>
+inline int32_t tx(int32_t u, int32_t mask, int32_t max) {
+  if constexpr (A == TexAddress::repeat) {
+    return u & mask;
+  } else {
+    return u < 0 ? 0 : (u > max ? max : u);
+  }
+}
+
+// Colours: rgb565 as uint16_t, 8-bit channels as 0x00RRGGBB.
+inline uint32_t expand565(uint32_t c) {
+  const uint32_t r = c >> 11, g = (c >> 5) & 63, b = c & 31;
+  return ((r << 3 | r >> 2) << 16) | ((g << 2 | g >> 4) << 8) | (b << 3 | b >> 2);
+}
+
+// JFIF full-range Y'CbCr -> R'G'B' (colour.h, the image output's
+// constants), each channel rounded and clamped.
+inline uint32_t ycbcr_to_rgb(int32_t y, int32_t cb, int32_t cr) {
+  using namespace colour;
+  const int32_t cbd = cb - kChromaCentre, crd = cr - kChromaCentre;
+  const int32_t r = y + ((kCrToR * crd + kHalf) >> kFracBits);
+  const int32_t g = y + ((-kCbToG * cbd - kCrToG * crd + kHalf) >> kFracBits);
+  const int32_t b = y + ((kCbToB * cbd + kHalf) >> kFracBits);
+  return (static_cast<uint32_t>(sat_u8(r)) << 16) | (static_cast<uint32_t>(sat_u8(g)) << 8) | sat_u8(b);
+}
+
+// Blend of two 0x00RR00BB (or 0x0000GG00) words with an 8-bit weight f of b:
+// (a 256 + (b - a) f + 128) >> 8 per field is a (256 - f) + b f rounded; the
+// fields are 16 bits apart and each sum stays below 2^16, so the packed
+// arithmetic is exact (modulo 2^32 on the way, exact at the end).
+inline uint32_t lerp_rb(uint32_t a, uint32_t b, uint32_t f) { return (((a << 8) + (b - a) * f + 0x00800080u) >> 8) & 0x00FF00FFu; }
+inline uint32_t lerp_g(uint32_t a, uint32_t b, uint32_t f) { return (((a << 8) + (b - a) * f + 0x00008000u) >> 8) & 0x0000FF00u; }
+inline uint32_t bilerp8888(uint32_t c00, uint32_t c01, uint32_t c10, uint32_t c11, uint32_t fu, uint32_t fv) {
+  const uint32_t rb0 = lerp_rb(c00 & 0xFF00FFu, c01 & 0xFF00FFu, fu);
+  const uint32_t rb1 = lerp_rb(c10 & 0xFF00FFu, c11 & 0xFF00FFu, fu);
+  const uint32_t g0 = lerp_g(c00 & 0xFF00u, c01 & 0xFF00u, fu);
+  const uint32_t g1 = lerp_g(c10 & 0xFF00u, c11 & 0xFF00u, fu);
+  return lerp_rb(rb0, rb1, fv) | lerp_g(g0, g1, fv);
+}
+inline uint32_t lerp8(uint32_t a, uint32_t b, uint32_t f) { return ((a << 8) + (b - a) * f + 128) >> 8 & 0xFFu; }
+
+// RGB565 spread to 0b00000GGGGGG00000RRRRR000000BBBBB: every channel gets 5
+// spare bits above it, enough for a blend with a 5-bit weight (0..32).
+constexpr uint32_t kSpreadMask = 0x07E0F81Fu;
+constexpr uint32_t kSpreadRound = 16u | (16u << 11) | (16u << 21);
+inline uint32_t spread565(uint32_t c) { return (c | (c << 16)) & kSpreadMask; }
+inline uint32_t lerp_spread(uint32_t a, uint32_t b, uint32_t f5) { return (((a << 5) + (b - a) * f5 + kSpreadRound) >> 5) & kSpreadMask; }
+inline uint16_t unspread565(uint32_t s) { return static_cast<uint16_t>((s | (s >> 16)) & 0xFFFFu); }
+
+template <PixelFormat O>
+using OutColor = std::conditional_t<O == PixelFormat::rgb565, uint16_t, uint32_t>;
+
+template <PixelFormat O>
+inline OutColor<O> from8888(uint32_t c) {
+  if constexpr (O == PixelFormat::rgb565) {
+    return pack565(c);
+  } else {
+    return c & 0xFFFFFFu;
+  }
+}
+template <PixelFormat O>
+inline OutColor<O> from565(uint32_t c) {
+  if constexpr (O == PixelFormat::rgb565) {
+    return static_cast<uint16_t>(c);
+  } else {
+    return expand565(c);
+  }
+}
+
+// One rgb565 / xrgb8888 texel at a linear index, as 0x00RRGGBB.
+template <TexFormat TF>
+inline uint32_t texel8888(const TexCtx& t, uint32_t index) {
+  if constexpr (TF == TexFormat::rgb565) {
+    return expand565(reinterpret_cast<const uint16_t*>(t.base)[index]);
+  } else {
+    return reinterpret_cast<const uint32_t*>(t.base)[index];
+  }
+}
+
+template <TexFormat TF, TexAddress A, PixelFormat O>
+struct NearestSampler {
+  static constexpr int kFracBits = 0;
+  static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
+  // (u, v): the texel containing the sample point.
+  static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
+    const int32_t col = tx<A>(u, t.wmask, t.wmax);
+    const int32_t row = tx<A>(v, t.hmask, t.hmax);
+    const uint32_t index = static_cast<uint32_t>(row) * t.stride + static_cast<uint32_t>(col);
+    if constexpr (TF == TexFormat::rgb565) {
+      return from565<O>(reinterpret_cast<const uint16_t*>(t.base)[index]);
+    } else if constexpr (TF == TexFormat::xrgb8888) {
+      return from8888<O>(reinterpret_cast<const uint32_t*>(t.base)[index]);
+    } else {
+      // The chroma sample (col/2, row/2) covers luma texels 2i and 2i + 1.
+      const uint32_t ci = static_cast<uint32_t>(row >> 1) * t.cstride + static_cast<uint32_t>(col >> 1);
+      return from8888<O>(ycbcr_to_rgb(t.base[index], t.cb[ci], t.cr[ci]));
+    }
+  }
+};
+
+// Bilinear weights: 5 bits where both texture and output are rgb565 (the
+// blend runs on all three channels at once in one 32-bit word), else 8 bits.
+constexpr int bilinear_frac_bits(TexFormat tf, PixelFormat o) {
+  return tf == TexFormat::rgb565 && o == PixelFormat::rgb565 ? 5 : 8;
+}
+
+template <TexFormat TF, TexAddress A, PixelFormat O>
+struct BilinearSampler {
+  static constexpr int kFracBits = bilinear_frac_bits(TF, O);
+  static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
+  static constexpr uint32_t kFracMask = (1u << kFracBits) - 1;
+  // (u, v): the sample point minus half a texel, kFracBits fraction bits.
+  static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
+    const int32_t i0 = u >> kFracBits, j0 = v >> kFracBits;
+    const uint32_t fu = static_cast<uint32_t>(u) & kFracMask, fv = static_cast<uint32_t>(v) & kFracMask;
+    const uint32_t c0 = static_cast<uint32_t>(tx<A>(i0, t.wmask, t.wmax));
+    const uint32_t c1 = static_cast<uint32_t>(tx<A>(i0 + 1, t.wmask, t.wmax));
+    const uint32_t r0 = static_cast<uint32_t>(tx<A>(j0, t.hmask, t.hmax)) * t.stride;
+    const uint32_t r1 = static_cast<uint32_t>(tx<A>(j0 + 1, t.hmask, t.hmax)) * t.stride;
+    if constexpr (TF == TexFormat::ycbcr420) {
+      const uint8_t* y = t.base;
+      const uint32_t yy = lerp8(lerp8(y[r0 + c0], y[r0 + c1], fu), lerp8(y[r1 + c0], y[r1 + c1], fu), fv);
+      // In chroma texels the point is u/2, minus half a chroma texel:
+      // (u_q8 + 128)/2 - 128 = u_q8/2 - 64.
+      const int32_t cu = (u >> 1) - 64, cv = (v >> 1) - 64;
+      const uint32_t gu = static_cast<uint32_t>(cu) & 255u, gv = static_cast<uint32_t>(cv) & 255u;
+      const uint32_t k0 = static_cast<uint32_t>(tx<A>(cu >> 8, t.cwmask, t.cwmax));
+      const uint32_t k1 = static_cast<uint32_t>(tx<A>((cu >> 8) + 1, t.cwmask, t.cwmax));
+      const uint32_t s0 = static_cast<uint32_t>(tx<A>(cv >> 8, t.chmask, t.chmax)) * t.cstride;
+      const uint32_t s1 = static_cast<uint32_t>(tx<A>((cv >> 8) + 1, t.chmask, t.chmax)) * t.cstride;
+      const uint32_t cb = lerp8(lerp8(t.cb[s0 + k0], t.cb[s0 + k1], gu), lerp8(t.cb[s1 + k0], t.cb[s1 + k1], gu), gv);
+      const uint32_t cr = lerp8(lerp8(t.cr[s0 + k0], t.cr[s0 + k1], gu), lerp8(t.cr[s1 + k0], t.cr[s1 + k1], gu), gv);
+      return from8888<O>(ycbcr_to_rgb(static_cast<int32_t>(yy), static_cast<int32_t>(cb), static_cast<int32_t>(cr)));
+    } else if constexpr (TF == TexFormat::rgb565 && O == PixelFormat::rgb565) {
+      const uint16_t* p = reinterpret_cast<const uint16_t*>(t.base);
+      const uint32_t top = lerp_spread(spread565(p[r0 + c0]), spread565(p[r0 + c1]), fu);
+      const uint32_t bot = lerp_spread(spread565(p[r1 + c0]), spread565(p[r1 + c1]), fu);
+      return unspread565(lerp_spread(top, bot, fv));
+    } else {
+      return from8888<O>(bilerp8888(texel8888<TF>(t, r0 + c0), texel8888<TF>(t, r0 + c1), texel8888<TF>(t, r1 + c0),
+                                    texel8888<TF>(t, r1 + c1), fu, fv));
+    }
+  }
+};
+
+// Bilinear filtering of a texture with an apron (Texture::apron): the right
+// and lower neighbours are at +1 and +stride whatever the addressing. Clamp
+// addressing clamps the sample position to [0, size - 1] before splitting it,
+// which gives exactly the clamp-to-edge result (the neighbour then has weight 0).
+template <TexFormat TF, TexAddress A, PixelFormat O>
+struct BilinearApronSampler {
+  static constexpr int kFracBits = bilinear_frac_bits(TF, O);
+  static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
+  static constexpr uint32_t kFracMask = (1u << kFracBits) - 1;
+  static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
+    uint32_t index;
+    uint32_t fu, fv;
+    if constexpr (A == TexAddress::repeat) {
+      index = static_cast<uint32_t>((v >> kFracBits) & t.hmask) * t.stride + static_cast<uint32_t>((u >> kFracBits) & t.wmask);
+      fu = static_cast<uint32_t>(u) & kFracMask;
+      fv = static_cast<uint32_t>(v) & kFracMask;
+    } else {
+      const int32_t uc = u < 0 ? 0 : (u > (t.wmax << kFracBits) ? (t.wmax << kFracBits) : u);
+      const int32_t vc = v < 0 ? 0 : (v > (t.hmax << kFracBits) ? (t.hmax << kFracBits) : v);
+      index = static_cast<uint32_t>(vc >> kFracBits) * t.stride + static_cast<uint32_t>(uc >> kFracBits);
+      fu = static_cast<uint32_t>(uc) & kFracMask;
+      fv = static_cast<uint32_t>(vc) & kFracMask;
+    }
+    if constexpr (TF == TexFormat::rgb565 && O == PixelFormat::rgb565) {
+      // The lower row by index, not by a second pointer: one register less
+      // in the span loop.
+      const uint16_t* p = reinterpret_cast<const uint16_t*>(t.base);
+      const uint32_t below = index + t.stride;
+      const uint32_t top = lerp_spread(spread565(p[index]), spread565(p[index + 1]), fu);
+      const uint32_t bot = lerp_spread(spread565(p[below]), spread565(p[below + 1]), fu);
+      return unspread565(lerp_spread(top, bot, fv));
+    } else {
+      return from8888<O>(bilerp8888(texel8888<TF>(t, index), texel8888<TF>(t, index + 1), texel8888<TF>(t, index + t.stride),
+                                    texel8888<TF>(t, index + t.stride + 1), fu, fv));
+    }
+  }
+};
+
+// ---------------------------------------------------------------------------
+// Output and depth buffers
+// ---------------------------------------------------------------------------
+template <PixelFormat O>
+struct Store;
+template <>
+struct Store<PixelFormat::rgb565> {
+  static constexpr int kBytes = 2;
+  static void put(uint8_t* p, uint16_t c) { *reinterpret_cast<uint16_t*>(p) = c; }
+};
+template <>
+struct Store<PixelFormat::rgb888> {
+  static constexpr int kBytes = 3;
+  static void put(uint8_t* p, uint32_t c) {
+    p[0] = static_cast<uint8_t>(c >> 16);
+    p[1] = static_cast<uint8_t>(c >> 8);
+    p[2] = static_cast<uint8_t>(c);
+  }
+};
+
+template <DepthFormat D>
+struct Depth;
+template <>
+struct Depth<DepthFormat::d16> {
+  using T = uint16_t;
+  static T value(int32_t q) { return static_cast<uint16_t>(q >> kDepth16Shift); }  // q < 2^30
+};
+template <>
+struct Depth<DepthFormat::d32> {
+  using T = uint32_t;
+  static T value(int32_t q) { return static_cast<uint32_t>(q); }
+};
+
+// ---------------------------------------------------------------------------
+// Span start values
+// ---------------------------------------------------------------------------
+// Integer state of one span piece: values at its first pixel and per-pixel
+// steps. Every value stays inside int32 over the piece (both ends checked),
+// W >= 1 throughout, and sh_base - clz(W) lies in [0, 31] for every pixel.
+struct RowState {
+  int32_t q, dq;
+  int32_t w, dw;
+  int32_t n[3], dn[3];
+  int32_t sh_base;
+};
+
+
+// Start value (plane / 2^s rounded) and step of one interpolant over `len`
+// pixels; the step is dropped (0) if the stepped end would leave [lo, hi].
+void interpolant(int64_t start_q16, int64_t gx, int s, int32_t len, int64_t lo, int64_t hi, int32_t* v, int32_t* dv) {
+  int64_t a = shift_round(start_q16, s);
+  a = a < lo ? lo : (a > hi ? hi : a);
+  int64_t d = shift_round(gx, s);
+  d = d < kI32Min ? kI32Min : (d > kI32Max ? kI32Max : d);
+  const int64_t end = a + d * (len - 1);  // |d (len - 1)| < 2^31 * 2^11
+  if (end < lo || end > hi) d = 0;
+  *v = static_cast<int32_t>(a);
+  *dv = static_cast<int32_t>(d);
+}
+
+constexpr int64_t kNumLimit = (int64_t{1} << 30) + 4096;  // |numerator| bound of a span
+
+
+// Row units from a plane value: rounded, the 16 fraction bits dropped.
+inline int64_t row_value(const Plane& p, int32_t dx, int32_t dy) {
+  return wrap_add64(eval(p, dx, dy), int64_t{1} << (kPlaneFrac - 1)) >> kPlaneFrac;
+}
+
+// v in [lo, hi] with one unsigned compare (no overflow: unsigned arithmetic).
+inline bool in_range(int64_t v, int64_t lo, int64_t hi) {
+  return static_cast<uint64_t>(v) - static_cast<uint64_t>(lo) <= static_cast<uint64_t>(hi - lo);
+}
+
+// The fast span set-up (PolySetup::fast): start values from the planes, the
+// polygon's fixed steps and exponent, and a check that both ends of the span
+// stay inside the limits the exponent was chosen for. false sends the span
+// to the general row_piece(). NN numerators, kProj a separate divisor.
+template <int NN, bool kProj>
+[[gnu::always_inline]] inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
+  if (!s.fast) return false;
+  const int32_t dx = x - s.xr, dy = y - s.yr;
+  const int64_t last = len - 1;
+  const int64_t q0 = row_value(s.q, dx, dy);
+  const int64_t q1 = q0 + int64_t{s.fast_dq} * last;
+  // q is also the divisor unless kProj: one check against both ranges.
+  const int64_t qlo = NN > 0 && !kProj ? s.fast_qlo : 1, qhi = NN > 0 && !kProj ? s.fast_qhi : kQMax;
+  if (!in_range(q0, qlo, qhi) || !in_range(q1, qlo, qhi)) return false;
+  r.q = static_cast<int32_t>(q0);
+  r.dq = s.fast_dq;
+  if constexpr (NN > 0) {
+    int64_t w0 = q0, w1 = q1;
+    if constexpr (kProj) {
+      w0 = row_value(s.w, dx, dy);
+      w1 = w0 + int64_t{s.fast_dw} * last;
+      if (!in_range(w0, s.wlo, s.whi) || !in_range(w1, s.wlo, s.whi)) return false;
+    }
+    r.w = static_cast<int32_t>(w0);
+    r.dw = s.fast_dw;
+    for (int j = 0; j < NN; ++j) {
+      const int64_t n0 = row_value(s.n[j], dx, dy);
+      const int64_t n1 = n0 + int64_t{s.fast_dn[j]} * last;
+      if (!in_range(n0, -kNumLimit, kNumLimit) || !in_range(n1, -kNumLimit, kNumLimit)) return false;
+      r.n[j] = static_cast<int32_t>(n0);
+      r.dn[j] = s.fast_dn[j];
+    }
+    r.sh_base = s.fast_shb;
+  }
+  return true;
+}
+
+// The same as a function of its own: most span loops call it, so that it is
+// not copied into each of them (see texture_span).
+template <int NN, bool kProj>
+[[gnu::noinline]] bool row_fast_call(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
+  return row_fast<NN, kProj>(s, y, x, len, r);
+}
+
+// Sets up the first `len` pixels of row y from x. false when the numerators
+// and the divisor cannot share one shift window over this many pixels (the
+// caller halves len; a single pixel always succeeds).
+bool row_piece(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
+  const int32_t dx = x - s.xr, dy = y - s.yr;
+  interpolant(eval(s.q, dx, dy), s.q.gx, kPlaneFrac, len, 1, kQMax, &r.q, &r.dq);
+  if (s.nn == 0) return true;
+
+  // The divisor W over the piece and its exponent ew (true W = W_row 2^ew).
+  int ew = 0;
+  int64_t w0, w1;
+  if (s.proj) {
+    const int64_t p0 = eval(s.w, dx, dy);
+    const int64_t p1 = wrap_add64(p0, wrap_mul64(s.w.gx, len - 1));
+    const uint64_t mx = abs64(p0) > abs64(p1) ? abs64(p0) : abs64(p1);
+    ew = bitlen64(mx) - 46;  // W_row = P >> (16 + ew) below 2^30
+    interpolant(p0, s.w.gx, kPlaneFrac + ew, len, 1, kI32Max, &r.w, &r.dw);
+    w0 = r.w;
+    w1 = int64_t{r.w} + int64_t{r.dw} * (len - 1);
+  } else {
+    r.w = r.q;
+    r.dw = r.dq;
+    w0 = r.q;
+    w1 = int64_t{r.q} + int64_t{r.dq} * (len - 1);
+  }
+  const int z_lo = clz32(static_cast<uint32_t>(w0 > w1 ? w0 : w1));
+  const int z_hi = clz32(static_cast<uint32_t>(w0 < w1 ? w0 : w1));
+
+  int64_t pn[3];
+  uint64_t mx = 0;
+  for (int j = 0; j < s.nn; ++j) {
+    pn[j] = eval(s.n[j], dx, dy);
+    const int64_t e = wrap_add64(pn[j], wrap_mul64(s.n[j].gx, len - 1));
+    if (abs64(pn[j]) > mx) mx = abs64(pn[j]);
+    if (abs64(e) > mx) mx = abs64(e);
+  }
+  // result = N_row y' >> (32 + sh), sh = sh_base - z, sh_base = 30 - (bw + en)
+  // with y' = recip_y(W) ~ 2^62 / (W 2^z) (docs/renderer.md).
+  const int bw = s.b0 - ew;
+  const int en_overflow = bitlen64(mx) - 46;  // |N_row| <= 2^30
+  const int en_lo = -1 - z_lo - bw;           // sh <= 31 at the largest W
+  const int en_hi = 30 - z_hi - bw;           // sh >= 0 at the smallest W
+  int en = en_overflow > en_lo ? en_overflow : en_lo;
+  if (en > en_hi) {
+    if (len > 1) return false;
+    // One pixel whose result overflows 32 bits (only wild input gets here):
+    // sample at 0 instead.
+    for (int j = 0; j < s.nn; ++j) r.n[j] = r.dn[j] = 0;
+    r.sh_base = z_lo;
+    return true;
+  }
+  r.sh_base = 30 - (bw + en);
+  for (int j = 0; j < s.nn; ++j) {
+    interpolant(pn[j], s.n[j].gx, kPlaneFrac + en, len, -(int64_t{1} << 30) - 4096, (int64_t{1} << 30) + 4096,
+                &r.n[j], &r.dn[j]);
+  }
+  return true;
+}
+
+// The per-pixel reciprocal. For m = w << clz(w) in [2^31, 2^32) (x = m / 2^32
+// in [1/2, 1)) it returns y ~= 2^62 / m = 2^30 / x by linear interpolation
+// between value_k = round(2^30 / x_k), x_k = 1/2 + k/512, with slope_k =
+// value_k - value_(k+1): y = value_k - slope_k t / 2^32 with t = m << 9 the
+// position inside the interval (Q0.32). With m = (256 + k) 2^23 + low,
+// slope_k (2^9 m) / 2^32 = slope_k (256 + k) + slope_k t / 2^32 exactly (the
+// first term is whole), so the table stores base_k = value_k + slope_k (256
+// + k) and slope_k 2^9 (below 2^32) and y = base_k - (slope_k 2^9 m) / 2^32,
+// all modulo 2^32 (y itself is below 2^31): no shift of m. 2 KiB; 8
+// Cortex-M4 instructions (CLZ, LSL, UBFX, ADD, LDR, LDR, UMULL, SUB) against
+// 12 for a table seed plus a Newton step (vds::recip_mant_fast). The chord
+// lies above the convex 1/x, so -2^-31 <= y / (2^62 / m) - 1 < 2^-18 (h^2/8
+// max|f''| with h = 1/512, plus the rounding of the entries);
+// tests/unit/render_test.cpp checks the bound. Each entry is one 64-bit
+// word, slope_k 2^9 in the high half and base_k in the low half, so that it
+// is one load whatever the byte order.
+struct RecipTable {
+  uint64_t e[256];
+};
+constexpr int32_t recip_node(uint64_t k) {
+  const uint64_t v = ((uint64_t{1} << 40) / (256 + k) + 1) / 2;  // round(2^39 / (256 + k))
+  return v > static_cast<uint64_t>(INT32_MAX) ? INT32_MAX : static_cast<int32_t>(v);  // the first clipped to 2^31 - 1
+}
+constexpr RecipTable make_recip_table() {
+  RecipTable t{};
+  for (uint64_t k = 0; k < 256; ++k) {
+    const uint64_t slope = static_cast<uint64_t>(recip_node(k) - recip_node(k + 1));  // < 2^23
+    const uint32_t base = static_cast<uint32_t>(static_cast<uint64_t>(recip_node(k)) + slope * (256 + k));
+    t.e[k] = (slope << 9) << 32 | base;
+  }
+  return t;
+}
+constexpr RecipTable kRecipTable = make_recip_table();
+
+inline int32_t recip_y(uint32_t w, int& z) {
+  z = __builtin_clz(w);  // w >= 1 (row_piece keeps every W and q positive)
+  const uint32_t m = w << z;
+  const uint64_t e = kRecipTable.e[(m >> 23) & 255u];
+  const uint32_t base = static_cast<uint32_t>(e), slope9 = static_cast<uint32_t>(e >> 32);
+  return static_cast<int32_t>(base - static_cast<uint32_t>((uint64_t{slope9} * m) >> 32));
+}
+// round-down of n * y / 2^(32 + sh): SMULL and an arithmetic shift.
+inline int32_t scaled(int32_t n, int32_t y, int sh) { return static_cast<int32_t>((int64_t{n} * y) >> 32) >> sh; }
+
+// ---------------------------------------------------------------------------
+// Span loops
+// ---------------------------------------------------------------------------
+template <PixelFormat O, DepthFormat D>
+void flat_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa, int32_t xb) {
+  using DT = typename Depth<D>::T;
+  RowState r;
+  if (!row_fast<0, false>(s, y, xa, xb - xa, r)) row_piece(s, y, xa, xb - xa, r);
+  const OutColor<O> c = static_cast<OutColor<O>>(s.flat);
+  // Both buffers are indexed from their span end with i = -len .. -1.
+  DT* const ze = static_cast<DT*>(b.depth) + static_cast<uint32_t>(y - b.y0) * static_cast<uint32_t>(b.width) + xb;
+  uint8_t* const oe = b.color + static_cast<uint32_t>(y - b.y0) * b.color_stride + xb * Store<O>::kBytes;
+  int32_t q = r.q;
+  const int32_t dq = r.dq;
+  int32_t i = xa - xb;
+  do {
+    const DT d = Depth<D>::value(q);
+    if (d > ze[i]) {
+      ze[i] = d;
+      Store<O>::put(oe + i * Store<O>::kBytes, c);
+    }
+    q = wrap_add32(q, dq);
+  } while (++i != 0);
+}
+
+// Colour entry i of a span whose colour and depth rows end at oe and ze
+// (delta = oe - ze in bytes). When colour and depth entries have the same
+// size, the colour address is the depth address plus delta: the span loop
+// then steps one pointer instead of two (one instruction per pixel less).
+template <PixelFormat O, class DT>
+inline uint8_t* pixel_at(uint8_t* oe, DT* ze, uintptr_t delta, int32_t i) {
+  if constexpr (Store<O>::kBytes == sizeof(DT)) {
+    return reinterpret_cast<uint8_t*>(reinterpret_cast<uintptr_t>(ze + i) + delta);
+  } else if constexpr (2 * Store<O>::kBytes == sizeof(DT)) {
+    // Half the depth address (depth entries are aligned) plus delta = oe - ze / 2.
+    return reinterpret_cast<uint8_t*>((reinterpret_cast<uintptr_t>(ze + i) >> 1) + delta);
+  } else {
+    return oe + i * Store<O>::kBytes;
+  }
+}
+
+template <class Sampler, bool kProj, PixelFormat O, DepthFormat D>
+void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa, int32_t xb) {
+  using DT = typename Depth<D>::T;
+  DT* const zrow = static_cast<DT*>(b.depth) + static_cast<uint32_t>(y - b.y0) * static_cast<uint32_t>(b.width);
+  uint8_t* const crow = b.color + static_cast<uint32_t>(y - b.y0) * b.color_stride;
+  const TexCtx tex = s.tex;  // a local copy: the stores below cannot alias it
+  while (xa < xb) {
+    int32_t len = xb - xa;
+    RowState r;
+    // The start values are inlined into the loops of rgb565 textures drawn
+    // to rgb565 (about 1 instruction per pixel less in the scenes of
+    // bench/results/render.md), called from the others (code size).
+    bool fast;
+    if constexpr (Sampler::kInlineStart && !kProj) {
+      fast = row_fast<2, kProj>(s, y, xa, len, r);
+    } else {
+      fast = row_fast_call<2, kProj>(s, y, xa, len, r);
+    }
+    if (!fast) {
+      while (!row_piece(s, y, xa, len, r)) len = (len + 1) >> 1;
+    }
+    // Both buffers are indexed from the piece end with i = -len .. -1.
+    DT* const ze = zrow + xa + len;
+    uint8_t* const oe = crow + (xa + len) * Store<O>::kBytes;
+    const uintptr_t delta = reinterpret_cast<uintptr_t>(oe) -
+                            (reinterpret_cast<uintptr_t>(ze) >> (sizeof(DT) == 2 * Store<O>::kBytes ? 1 : 0));
+    int32_t q = r.q, w = r.w, u = r.n[0], v = r.n[1];
+    const int32_t dq = r.dq, dw = r.dw, du = r.dn[0], dv = r.dn[1];
+    const int32_t shb = r.sh_base;
+    int32_t i = -len;
+    do {
+      const DT d = Depth<D>::value(q);
+      if (d > ze[i]) {
+        ze[i] = d;
+        int z;
+        const int32_t yr = recip_y(static_cast<uint32_t>(kProj ? w : q), z);
+        const int sh = shb - z;
+        Store<O>::put(pixel_at<O, DT>(oe, ze, delta, i), Sampler::sample(tex, scaled(u, yr, sh), scaled(v, yr, sh)));
+      }
+      q = wrap_add32(q, dq);
+      if constexpr (kProj) w = wrap_add32(w, dw);
+      u = wrap_add32(u, du);
+      v = wrap_add32(v, dv);
+    } while (++i != 0);
+    xa += len;
+  }
+}
+
+template <PixelFormat O, DepthFormat D>
+void gouraud_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa, int32_t xb) {
+  using DT = typename Depth<D>::T;
+  DT* const zrow = static_cast<DT*>(b.depth) + static_cast<uint32_t>(y - b.y0) * static_cast<uint32_t>(b.width);
+  uint8_t* const crow = b.color + static_cast<uint32_t>(y - b.y0) * b.color_stride;
+  while (xa < xb) {
+    int32_t len = xb - xa;
+    RowState r;
+    if (!row_fast<3, false>(s, y, xa, len, r)) {
+      while (!row_piece(s, y, xa, len, r)) len = (len + 1) >> 1;
+    }
+    DT* const ze = zrow + xa + len;
+    uint8_t* const oe = crow + (xa + len) * Store<O>::kBytes;
+    int32_t q = r.q, c0 = r.n[0], c1 = r.n[1], c2 = r.n[2];
+    int32_t i = -len;
+    do {
+      const DT d = Depth<D>::value(q);
+      if (d > ze[i]) {
+        ze[i] = d;
+        int z;
+        const int32_t yr = recip_y(static_cast<uint32_t>(q), z);
+        const int sh = r.sh_base - z;
+        // Channels in Q8.8, rounded to 8 bits.
+        const uint32_t rr = sat_u8((scaled(c0, yr, sh) + 128) >> 8);
+        const uint32_t gg = sat_u8((scaled(c1, yr, sh) + 128) >> 8);
+        const uint32_t bb = sat_u8((scaled(c2, yr, sh) + 128) >> 8);
+        Store<O>::put(oe + i * Store<O>::kBytes, from8888<O>((rr << 16) | (gg << 8) | bb));
+      }
+      q = wrap_add32(q, r.dq);
+      c0 = wrap_add32(c0, r.dn[0]);
+      c1 = wrap_add32(c1, r.dn[1]);
+      c2 = wrap_add32(c2, r.dn[2]);
+    } while (++i != 0);
+    xa += len;
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Span function selection (the formats compiled in: vds/config.h)
+// ---------------------------------------------------------------------------
+template <template <TexFormat, TexAddress, PixelFormat> class S, TexFormat TF, PixelFormat O, DepthFormat D>
+SpanFn pick_address(bool repeat, bool proj) {
+  if (repeat) {
+    return proj ? &texture_span<S<TF, TexAddress::repeat, O>, true, O, D>
+                : &texture_span<S<TF, TexAddress::repeat, O>, false, O, D>;
+  }
+  return proj ? &texture_span<S<TF, TexAddress::clamp, O>, true, O, D>
+              : &texture_span<S<TF, TexAddress::clamp, O>, false, O, D>;
+}
+
+template <TexFormat TF, PixelFormat O, DepthFormat D>
+SpanFn pick_filter(Filter f, bool apron, bool repeat, bool proj) {
+  if (!(VDS_CONFIG_RENDER_TEXTURE_FORMATS & (1 << static_cast<int>(TF)))) return nullptr;
+  if (f == Filter::nearest) return pick_address<NearestSampler, TF, O, D>(repeat, proj);
+  if constexpr (TF != TexFormat::ycbcr420) {
+    if (apron) return pick_address<BilinearApronSampler, TF, O, D>(repeat, proj);
+  }
+  return pick_address<BilinearSampler, TF, O, D>(repeat, proj);
+}
+
+template <PixelFormat O, DepthFormat D>
+SpanFn pick_span(const Mesh& m, bool repeat) {
+  if (!(VDS_CONFIG_RENDER_OUTPUT_FORMATS & (1 << static_cast<int>(O)))) return nullptr;
+  if (!(VDS_CONFIG_RENDER_DEPTH_FORMATS & (1 << static_cast<int>(D)))) return nullptr;
+  switch (m.shading) {
+    case Shading::flat: return &flat_span<O, D>;
+    case Shading::gouraud: return &gouraud_span<O, D>;
+    default: break;
+  }
+  const bool proj = m.shading == Shading::view_mapped;
+  const bool apron = m.texture->apron;
+  switch (m.texture->format) {
+    case TexFormat::rgb565: return pick_filter<TexFormat::rgb565, O, D>(m.filter, apron, repeat, proj);
+    case TexFormat::xrgb8888: return pick_filter<TexFormat::xrgb8888, O, D>(m.filter, apron, repeat, proj);
+    case TexFormat::ycbcr420: return pick_filter<TexFormat::ycbcr420, O, D>(m.filter, apron, repeat, proj);
+  }
+  return nullptr;
+}
+
+bool is_pow2(uint32_t v) { return v != 0 && (v & (v - 1)) == 0; }
+
+}  // namespace
+
+SpanFn select_span(const PolygonTarget& b, const Mesh& m, bool repeat) {
+  if (b.format == PixelFormat::rgb565) {
+    return b.depth_format == DepthFormat::d16 ? pick_span<PixelFormat::rgb565, DepthFormat::d16>(m, repeat)
+                                              : pick_span<PixelFormat::rgb565, DepthFormat::d32>(m, repeat);
+  }
+  return b.depth_format == DepthFormat::d16 ? pick_span<PixelFormat::rgb888, DepthFormat::d16>(m, repeat)
+                                            : pick_span<PixelFormat::rgb888, DepthFormat::d32>(m, repeat);
+}
+
+TexCtx make_tex_ctx(const Texture& t, bool repeat) {
+  TexCtx c{};
+  c.base = static_cast<const uint8_t*>(t.texels);
+  c.stride = t.stride;
+  c.wmask = t.width - 1;
+  c.hmask = t.height - 1;
+  c.wmax = t.width - 1;
+  c.hmax = t.height - 1;
+  if (t.format == TexFormat::ycbcr420) {
+    const int32_t cw = (t.width + 1) / 2, ch = (t.height + 1) / 2;
+    c.cb = t.cb;
+    c.cr = t.cr;
+    c.cstride = t.chroma_stride;
+    c.cwmask = cw - 1;
+    c.chmask = ch - 1;
+    c.cwmax = cw - 1;
+    c.chmax = ch - 1;
+  }
+  (void)repeat;
+  return c;
+}
+
+int fraction_bits(const Mesh& m, PixelFormat out) {
+  return m.filter == Filter::nearest ? 0 : bilinear_frac_bits(m.texture->format, out);
+}
+
+
+int32_t span_reciprocal(uint32_t w, int* z) {
+  int zz = 0;
+  const int32_t y = recip_y(w ? w : 1u, zz);
+  *z = zz;
+  return y;
+}
+
+bool texture_repeats(const Texture& t) {
+  return t.address == TexAddress::repeat && is_pow2(t.width) && is_pow2(t.height);
+}
+
+}  // namespace vds::detail

@@ -1,0 +1,75 @@
+// The span stage of the renderer: a polygon's set-up as the span loops
+// read it (PolySetup, filled by prepare_polygon in render_setup.cpp) and
+// the loop chosen for its material and target (select_span, in
+// render_span.cpp). Internal to the client library.
+#pragma once
+#include <cstdint>
+
+#include "render_fixed.h"
+#include "render_internal.h"
+
+namespace vds::detail {
+
+// ---------------------------------------------------------------------------
+// Texture access
+// ---------------------------------------------------------------------------
+struct TexCtx {
+  const uint8_t* base;
+  uint32_t stride;
+  int32_t wmask, hmask;  // repeat
+  int32_t wmax, hmax;    // clamp
+  const uint8_t* cb;
+  const uint8_t* cr;
+  uint32_t cstride;
+  int32_t cwmask, chmask, cwmax, chmax;
+};
+
+
+struct PolySetup;
+using SpanFn = void (*)(const BandTarget&, const PolySetup&, int32_t, int32_t, int32_t);
+
+struct PolySetup {
+  int32_t xr, yr;  // reference pixel of the planes
+  Plane q;         // depth (and the divisor unless proj)
+  Plane w;         // proj: the divisor g x + h y + i
+  Plane n[3];      // numerators
+  int nn;
+  bool proj;
+  // result = N / W * 2^b0 before the per-span scalings (docs/renderer.md).
+  int b0;
+  uint32_t flat;   // flat colour in the output format
+  TexCtx tex;
+  // Fast span set-up (fast == true): the planes' own scale serves the whole
+  // polygon (chosen from the values at its vertices with a margin), so a span
+  // start is (a0 + gx dx + gy dy + 2^15) >> 16 and the steps are fixed. A
+  // span whose start and end values stay inside [wlo, whi] (divisor) and
+  // +-kNumLimit (numerators) uses them; any other takes the per-span path.
+  bool fast;
+  int32_t fast_shb;
+  int32_t fast_dq, fast_dw, fast_dn[3];
+  int32_t wlo, whi;
+  int32_t fast_qlo, fast_qhi;  // [1, kQMax] and [wlo, whi] together (q is W), not empty
+};
+
+// Rounded to nearest: r5 = round(r 31 / 255) = (r 249 + 1014) >> 11 and
+// g6 = round(g 63 / 255) = (g 253 + 505) >> 10, exact for every 8-bit value.
+inline uint16_t pack565(uint32_t c) {
+  const uint32_t r = (c >> 16) & 255, g = (c >> 8) & 255, b = c & 255;
+  return static_cast<uint16_t>((((r * 249 + 1014) >> 11) << 11) | (((g * 253 + 505) >> 10) << 5) |
+                               ((b * 249 + 1014) >> 11));
+}
+
+// The per-pixel step of a plane in row units: gx / 2^16 rounded, saturated.
+inline int32_t step16(int64_t gx) {
+  const int64_t d = (gx + (int64_t{1} << (kPlaneFrac - 1))) >> kPlaneFrac;
+  return static_cast<int32_t>(d < kI32Min ? kI32Min : (d > kI32Max ? kI32Max : d));
+}
+
+// The span loop for a material on a target (nullptr: a format compiled out).
+SpanFn select_span(const PolygonTarget& target, const Mesh& m, bool repeat);
+// The texture as the span loops address it.
+TexCtx make_tex_ctx(const Texture& t, bool repeat);
+// Fraction bits of the texture coordinates: 0 for nearest sampling.
+int fraction_bits(const Mesh& m, PixelFormat out);
+
+}  // namespace vds::detail
