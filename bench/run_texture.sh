@@ -321,12 +321,13 @@ L.append('Each 240x180 view coded by `cjpeg -quality 85` (4:2:0, standard Huffma
          'RGB PSNR reaches that of the JPEG as the client decodes it (no fancy upsampling). Both decoded by the client '
          'library to an RGB565 frame, each as an images stream played by `vds::Player` as the client plays it (the JPEG '
          'in 4096-byte JPEG chunks): counts are the parse and decode of the player\'s frame record (chunk framing and '
-         'CRC-32C checks, entropy decoding, IDCT, colour conversion into the band), the band copies excluded. Cortex-M4: '
+         'CRC-32C checks, entropy decoding, IDCT, colour conversion into the band; `decode_stages` off, so no clock '
+         'reads per block), the band copies and the frame CRC excluded. Cortex-M4: '
          'executed instructions of the board firmware `vds_fw_bench_texture` (`firmware_sim/app/bench_texture.cpp`, '
          'the Cortex-M4 build: arm-none-eabi-g++ -O2) on the QEMU board mps2-an386 with `-icount shift=0` '
          '(`board::instructions()`, 40 instructions per tick), mean of 3 plays; input, chunk buffer and decoder '
          'workspace inside the board\'s 128 KiB workspace budget; x86-64: callgrind Ir '
-         '(clang -O3) inside `vds::Player::feed`, band copies included.\n')
+         '(clang -O3) inside `vds::Player::feed`, band copies and the frame CRC included.\n')
 L.append('| view | JPEG bytes | JPEG PSNR | M4 instr/px | x86 instr/px | vds bytes | vds PSNR | M4 instr/px | x86 instr/px | M4 = host output |')
 L.append('|---|---:|---:|---:|---:|---:|---:|---:|---:|---|')
 px = 240 * 180

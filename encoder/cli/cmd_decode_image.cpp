@@ -8,6 +8,7 @@
 #include "vds/enc/image_codec.h"
 #include "vds/enc/image_io.h"
 #include "vds/enc/stream_writer.h"
+#include "vds/io/image.h"
 
 namespace vds::cli {
 namespace {
@@ -35,15 +36,30 @@ void run_decode_image(const DecodeImageOptions& o) {
     prediction = enc::rgb_to_planes(p, c);
     pred = &prediction;
   }
-  enc::DecodedImage d;
+  // Rows go to the PNG as the client shows them: memory of one band
+  // however large the image its header declares; the PNG appears only once
+  // the image is whole.
+  struct ToPng : enc::ImageRowSink {
+    std::string path;
+    std::unique_ptr<io::PngRowWriter> png;
+    int width = 0, height = 0;
+    void begin(int w, int h) override {
+      width = w;
+      height = h;
+      png = std::make_unique<io::PngRowWriter>(path, w, h, 3);
+    }
+    void rows(int, int count, const uint8_t* pixels, ptrdiff_t stride) override { png->write_rows(pixels, count, stride); }
+  } sink;
+  sink.path = o.out;
+  std::string kind;
   try {
-    d = enc::decode_stream_image(stream, pred);
-  } catch (const std::exception& e) {
+    kind = enc::play_stream_image(stream, pred, sink);
+  } catch (const std::runtime_error& e) {
     throw Failure(kExitBadInput, o.in + ": " + e.what());
   }
-  enc::save_png(o.out, d.rgb);
-  std::printf("%s: %dx%d from a %s image of %zu stream bytes\n", o.out.c_str(), d.rgb.width, d.rgb.height,
-              d.kind.c_str(), stream.size());
+  sink.png->finish();
+  std::printf("%s: %dx%d from a %s image of %zu stream bytes\n", o.out.c_str(), sink.width, sink.height, kind.c_str(),
+              stream.size());
 }
 
 }  // namespace

@@ -74,10 +74,10 @@ void add_encode_frames(CLI::App& app) {
   sub->add_option("-o,--output", o->out, "Stream to write")->required();
   sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (inputs are scaled to cover it and centre-cropped)")
       ->capture_default_str();
-  sub->add_option("--fps", o->fps, "Frame rate")->capture_default_str()->check(CLI::PositiveNumber);
+  sub->add_option("--fps", o->fps, "Frame rate")->capture_default_str()->check(kPositive);
   sub->add_option("--quality", o->quality, "Quality 0..100 per frame")->capture_default_str()->check(CLI::Range(0, 100));
-  sub->add_option("--bytes", o->bytes, "Target bytes per frame (rate control)");
-  sub->add_option("--psnr", o->psnr, "Target PSNR per frame, dB (rate control)");
+  sub->add_option("--bytes", o->bytes, "Target bytes per frame (rate control)")->check(kPositive);
+  sub->add_option("--psnr", o->psnr, "Target PSNR per frame, dB (rate control)")->check(kPositive);
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes")->capture_default_str()
       ->check(CLI::Range(256u, 1u << 20));
   sub->add_option("--crc-out", o->crc_out, "Write the client CRC of each frame, one hex line per frame");

@@ -151,8 +151,8 @@ void add_encode_image(CLI::App& app) {
   sub->add_option("input", o->in, "Image to code")->required();
   sub->add_option("-o,--output", o->out, "Stream to write")->required();
   sub->add_option("--quality", o->quality, "Quality 0..100 (default 75)")->check(CLI::Range(0, 100));
-  sub->add_option("--bytes", o->bytes, "Code to at most this many bytes (best quality that fits)");
-  sub->add_option("--psnr", o->psnr, "Code to at least this RGB PSNR in dB (fewest bytes)")->check(CLI::PositiveNumber);
+  sub->add_option("--bytes", o->bytes, "Code to at most this many bytes (best quality that fits)")->check(kPositive);
+  sub->add_option("--psnr", o->psnr, "Code to at least this RGB PSNR in dB (fewest bytes)")->check(kPositive);
   sub->add_option("--chroma", o->chroma, "420 | 444 | grey")->capture_default_str();
   sub->add_option("--predict", o->predict, "Residual mode: the prediction the client adds to (an image file)");
   sub->add_option("--region", o->region, "Region mode: a mask image; MCUs with any non-zero mask pixel are coded");

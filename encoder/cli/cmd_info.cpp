@@ -7,7 +7,10 @@
 #include <vector>
 
 #include "commands.h"
+#include "vds/bytes.h"
 #include "vds/container.h"
+#include "vds/image.h"
+#include "vds/jpeg.h"
 #include "vds/enc/mesh_encoder.h"
 #include "vds/enc/stream_writer.h"
 
@@ -76,6 +79,31 @@ void run_info(const InfoOptions& o) {
     }
     if (c->mesh.add(type, payload, size)) {
       row.note = "progressive mesh";
+      c->rows.push_back(row);
+      return ChunkResult::consumed;
+    }
+    if (type == chunk::kImageHeader) {
+      ImageHeader ih;
+      if (image_header_from_bytes(payload, size, &ih) == Status::ok) {
+        const char* chroma = ih.chroma == ChromaFormat::yuv420 ? "4:2:0" : ih.chroma == ChromaFormat::yuv444 ? "4:4:4" : "grey";
+        row.note = "vds image header: " + std::to_string(ih.width) + "x" + std::to_string(ih.height) + " " + chroma +
+                   ", quantisers " + std::to_string(ih.quant_luma) + "/" + std::to_string(ih.quant_chroma) +
+                   (ih.residual() ? ", residual" : "") + (ih.region() ? ", region" : "");
+      } else {
+        row.note = "vds image header (malformed)";
+      }
+      c->rows.push_back(row);
+      return ChunkResult::consumed;
+    }
+    if (type == chunk::kImageData) {
+      row.note = size >= 6 ? "vds image data: MCUs " + std::to_string(load_le32(payload)) + "+" +
+                                 std::to_string(payload[4] | (payload[5] << 8))
+                           : "vds image data (malformed)";
+      c->rows.push_back(row);
+      return ChunkResult::consumed;
+    }
+    if (type == chunk::kJpeg) {
+      row.note = "baseline JPEG bytes";
       c->rows.push_back(row);
       return ChunkResult::consumed;
     }

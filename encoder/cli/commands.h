@@ -3,6 +3,7 @@
 // by main() as "vds VERB: message" with the failure's exit code.
 #pragma once
 #include <stdexcept>
+#include <cstdlib>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -14,7 +15,17 @@ enum Exit : int {
   kExitOk = 0,
   kExitBadInput = 1,  // a file that is missing, unreadable or not valid
   kExitUsage = 2,     // wrong options
+  kExitInternal = 3,  // the tool's own failure (a bug, or memory exhausted): not the input's fault
 };
+
+// An option that must be a number above zero (0 is not "unset").
+inline const CLI::Validator kPositive(
+    [](std::string& v) -> std::string {
+      char* end = nullptr;
+      const double d = std::strtod(v.c_str(), &end);
+      return end != v.c_str() && *end == '\0' && d > 0 ? std::string() : "must be a number above 0, not '" + v + "'";
+    },
+    "POSITIVE");
 
 struct Failure : std::runtime_error {
   Failure(int code, const std::string& what) : std::runtime_error(what), exit_code(code) {}

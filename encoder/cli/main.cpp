@@ -1,6 +1,8 @@
 // `vds <verb> [options]`: the command line of the vds encoder and tools.
 #include <cstdio>
 #include <exception>
+#include <new>
+#include <stdexcept>
 
 #include "commands.h"
 
@@ -31,10 +33,20 @@ int main(int argc, char** argv) {
     const CLI::App* sub = app.get_subcommands().empty() ? nullptr : app.get_subcommands().front();
     std::fprintf(stderr, "vds %s: %s\n", sub ? sub->get_name().c_str() : "", e.what());
     return e.exit_code;
-  } catch (const std::exception& e) {
+  } catch (const std::runtime_error& e) {
+    // The library's refusals of an input: they name the file, what and where.
     const CLI::App* sub = app.get_subcommands().empty() ? nullptr : app.get_subcommands().front();
     std::fprintf(stderr, "vds %s: %s\n", sub ? sub->get_name().c_str() : "", e.what());
     return vds::cli::kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    const CLI::App* sub = app.get_subcommands().empty() ? nullptr : app.get_subcommands().front();
+    std::fprintf(stderr, "vds %s: internal error: out of memory\n", sub ? sub->get_name().c_str() : "");
+    return vds::cli::kExitInternal;
+  } catch (const std::exception& e) {
+    // Misuse inside the tool (std::logic_error and the like): a bug.
+    const CLI::App* sub = app.get_subcommands().empty() ? nullptr : app.get_subcommands().front();
+    std::fprintf(stderr, "vds %s: internal error: %s\n", sub ? sub->get_name().c_str() : "", e.what());
+    return vds::cli::kExitInternal;
   }
   return vds::cli::kExitOk;
 }

@@ -5,6 +5,7 @@
 // reconstruction the encoder must match.
 #include <algorithm>
 #include <cstring>
+#include <exception>
 #include <stdexcept>
 #include <string>
 
@@ -34,27 +35,34 @@ bool predict_from_planes(void* ctx, uint16_t x, uint16_t y, uint16_t w, uint16_t
   return true;
 }
 
-// The frame width a stream's HEAD declares (0 if the stream does not start
-// with one): what the band buffer is sized from.
-uint16_t declared_width(std::span<const uint8_t> s) {
+// What a stream's HEAD declares, if the stream starts with a valid one
+// (else zeros): the band buffer and the chunk buffer are sized from it.
+StreamHeader declared_header(std::span<const uint8_t> s) {
+  StreamHeader h{};
   if (s.size() < kPreambleBytes + kChunkHeadBytes || std::memcmp(s.data(), kStreamMagic, sizeof kStreamMagic) != 0)
-    return 0;
+    return h;
   const uint8_t* chunk = s.data() + kPreambleBytes;
   const uint32_t size = load_le32(chunk + 4);
   if (load_le32(chunk) != chunk::kHeader || size > kHeaderPayloadMax || s.size() < kPreambleBytes + kChunkHeadBytes + size)
-    return 0;
-  StreamHeader h;
-  if (header_from_bytes(chunk + kChunkHeadBytes, size, s[4], s[5], &h) != Status::ok) return 0;
-  return h.width;
+    return h;
+  if (header_from_bytes(chunk + kChunkHeadBytes, size, s[4], s[5], &h) != Status::ok) return StreamHeader{};
+  return h;
 }
 
-// One replay of the client: the first image of a stream, to RGB888.
+// The largest chunk the host replay takes: a stream declaring more is refused
+// at its header ("workspace too small").
+constexpr uint32_t kReplayChunkMax = 1u << 24;
+
+// One replay of the client: the first image of a stream, to RGB888 rows.
+// No exception may cross the client library's frames (built without
+// exception support): the sink's is kept and thrown after the play.
 struct Replay {
   const Player* player = nullptr;
   const Planes* prior = nullptr;  // the destination's prior content (null: black)
-  Image* rgb = nullptr;
+  ImageRowSink* sink = nullptr;
   std::string* kind = nullptr;
   std::string message;  // a host-side problem, reported as it is
+  std::exception_ptr error;
   bool began = false, shown = false;
 };
 
@@ -75,17 +83,25 @@ bool begin_frame(void* ctx, uint16_t w, uint16_t h) {
     }
   }
   *r.kind = jpeg ? "jpeg" : "vds";
-  *r.rgb = Image(w, h, 3);
   r.began = true;
+  try {
+    r.sink->begin(w, h);
+  } catch (...) {
+    r.error = std::current_exception();
+    return false;
+  }
   return true;
 }
 
 bool band(void* ctx, const PixelRect& b) {
-  if (static_cast<Replay*>(ctx)->shown) return true;
-  Image& img = *static_cast<Replay*>(ctx)->rgb;
-  for (int row = 0; row < b.h; ++row)
-    std::memcpy(&img.pixels[(static_cast<size_t>(b.y + row) * img.width) * 3], b.pixels + row * b.stride,
-                static_cast<size_t>(b.w) * 3);
+  Replay& r = *static_cast<Replay*>(ctx);
+  if (r.shown) return true;
+  try {
+    r.sink->rows(b.y, b.h, b.pixels, b.stride);
+  } catch (...) {
+    r.error = std::current_exception();
+    return false;
+  }
   return true;
 }
 
@@ -117,13 +133,15 @@ bool predict(void* ctx, uint16_t x, uint16_t y, uint16_t w, uint16_t h, uint8_t*
 
 }  // namespace
 
-DecodedImage decode_stream_image(std::span<const uint8_t> stream, const Planes* prediction) {
-  DecodedImage out;
-  // The host holds the stream whole: no chunk is larger than it.
+std::string play_stream_image(std::span<const uint8_t> stream, const Planes* prediction, ImageRowSink& sink) {
+  std::string kind;
+  // The chunk buffer the stream declares (so that a stream cut short is
+  // "truncated", not "too large"), up to the host's limit.
+  const StreamHeader declared = declared_header(stream);
   PlayerConfig config;
   config.format = PixelFormat::rgb888;
-  config.max_chunk_bytes = static_cast<uint32_t>(std::clamp<size_t>(stream.size(), kHeaderPayloadMax, 1u << 24));
-  const uint16_t width = declared_width(stream);
+  config.max_chunk_bytes = std::clamp<uint32_t>(declared.max_chunk_payload, kHeaderPayloadMax, kReplayChunkMax);
+  const uint16_t width = declared.width;
   std::vector<uint8_t> ws(config.max_chunk_bytes +
                           std::max(Player::image_workspace_bytes(width, config), Player::jpeg_workspace_bytes(width, config)) + 64);
   Arena arena(ws.data(), ws.size());
@@ -131,8 +149,8 @@ DecodedImage decode_stream_image(std::span<const uint8_t> stream, const Planes* 
   Replay r;
   r.player = &player;
   r.prior = prediction;
-  r.rgb = &out.rgb;
-  r.kind = &out.kind;
+  r.sink = &sink;
+  r.kind = &kind;
   PlayerCallbacks cb;
   cb.ctx = &r;
   cb.begin_frame = begin_frame;
@@ -142,8 +160,9 @@ DecodedImage decode_stream_image(std::span<const uint8_t> stream, const Planes* 
   if (player.init(arena, config, cb) != Status::ok) throw std::logic_error("player init");
   Status s = player.feed(stream.data(), stream.size());
   if (s == Status::more_input) s = player.finish();
+  if (r.error) std::rethrow_exception(r.error);
   if (!r.message.empty()) throw std::runtime_error(r.message);
-  if (s == Status::ok && r.shown) return out;
+  if (s == Status::ok && r.shown) return kind;
   if (is_error(s)) {
     const std::string detail = player.error_detail() != nullptr && player.error_detail()[0] ? player.error_detail() : "";
     throw std::runtime_error(std::string("the client refused the stream: ") + status_name(s) +
@@ -152,6 +171,22 @@ DecodedImage decode_stream_image(std::span<const uint8_t> stream, const Planes* 
   }
   if (!r.began) throw std::runtime_error("the stream holds no image (no IMGH or JPEG chunk)");
   throw std::runtime_error("the stream ends before the image is complete");
+}
+
+DecodedImage decode_stream_image(std::span<const uint8_t> stream, const Planes* prediction) {
+  struct ToImage : ImageRowSink {
+    Image* img;
+    void begin(int w, int h) override { *img = Image(w, h, 3); }
+    void rows(int y, int count, const uint8_t* pixels, ptrdiff_t stride) override {
+      for (int row = 0; row < count; ++row)
+        std::memcpy(img->row(y + row), pixels + row * stride, static_cast<size_t>(img->width) * 3);
+    }
+  };
+  DecodedImage out;
+  ToImage sink;
+  sink.img = &out.rgb;
+  out.kind = play_stream_image(stream, prediction, sink);
+  return out;
 }
 
 Planes decode_image_planes(const EncodedImage& e, const Planes* prediction) {

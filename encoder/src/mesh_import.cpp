@@ -3,11 +3,15 @@
 #include "vds/enc/mesh_import.h"
 
 #include <algorithm>
+#include <cstring>
+#include <filesystem>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
 
+#include <assimp/BaseImporter.h>
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -16,42 +20,55 @@
 #include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <draco/core/decoder_buffer.h>
 
+#include "mesh_ply_check.h"
 #include "vds/enc/stream_writer.h"
 
 namespace vds::enc {
 namespace {
 
-bool ends_with_ci(const std::string& s, const std::string& tail) {
-  if (s.size() < tail.size()) return false;
-  for (size_t i = 0; i < tail.size(); ++i) {
-    const char a = static_cast<char>(std::tolower(static_cast<unsigned char>(s[s.size() - tail.size() + i])));
-    if (a != tail[i]) return false;
+// Assimp's file access confined to the model's own folder: a file that
+// references others (glTF buffers and images, OBJ materials) may open only
+// files in that folder or below it, never an absolute path elsewhere or a
+// path leading out with "..". A model held in memory may open none.
+class ConfinedIO : public Assimp::DefaultIOSystem {
+ public:
+  explicit ConfinedIO(std::filesystem::path root) : root_(std::move(root)) {}
+  bool Exists(const char* file) const override { return allowed(file) && DefaultIOSystem::Exists(file); }
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    if (!allowed(file) || std::strchr(mode, 'w') != nullptr || std::strchr(mode, 'a') != nullptr) return nullptr;
+    return DefaultIOSystem::Open(file, mode);
   }
-  return true;
-}
 
-Mesh load_draco(const std::string& path, MeshRepairReport* report) {
-  const std::vector<uint8_t> bytes = read_file(path);
-  Mesh m = decode_draco(bytes.data(), bytes.size(), path);
-  if (report) {
-    report->input_vertices = m.positions.size();
-    report->input_faces = m.triangles.size();
+ private:
+  bool allowed(const char* file) const {
+    if (root_.empty() || file == nullptr) return false;
+    std::error_code ec;
+    const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::path(file), ec);
+    if (ec) return false;
+    const std::string a = p.string(), r = root_.string();
+    return a.size() > r.size() && a.compare(0, r.size(), r) == 0 && a[r.size()] == '/';
   }
-  return m;
-}
+  std::filesystem::path root_;
+};
 
-Mesh load_assimp(const std::string& path, MeshRepairReport* report) {
-  Assimp::Importer importer;
-  // Positions and faces only: no normals, UVs or materials are needed, and
-  // the importer must not weld (we weld by our own rule).
+// The importer set up for a mesh: positions and faces only (no normals, UVs
+// or materials are needed, and the importer must not weld: we weld by our
+// own rule).
+void configure(Assimp::Importer& importer) {
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                                           aiComponent_COLORS | aiComponent_TEXCOORDS |
                                                           aiComponent_BONEWEIGHTS | aiComponent_ANIMATIONS |
                                                           aiComponent_TEXTURES | aiComponent_LIGHTS |
                                                           aiComponent_CAMERAS | aiComponent_MATERIALS);
-  const aiScene* scene =
-      importer.ReadFile(path, aiProcess_Triangulate | aiProcess_PreTransformVertices | aiProcess_RemoveComponent);
-  if (scene == nullptr) throw std::runtime_error(path + ": cannot import: " + importer.GetErrorString());
+}
+
+// Assimp validates what its loader built (face indices inside their mesh,
+// counts matching arrays) before any other step runs on it; triangulation
+// and the node transforms then work on a valid scene.
+constexpr unsigned kImportSteps = aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                                  aiProcess_PreTransformVertices | aiProcess_RemoveComponent;
+
+Mesh from_scene(const aiScene* scene, MeshRepairReport* report) {
   Mesh m;
   size_t non_triangles = 0;
   for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
@@ -76,6 +93,65 @@ Mesh load_assimp(const std::string& path, MeshRepairReport* report) {
   return m;
 }
 
+// The formats assimp reads for this tool: the ones its fuzz harness covers
+// (tests/fuzz/fuzz_mesh_import.cpp). Assimp reads dozens more, some of
+// which trust the counts a file declares.
+bool imported_format(const std::string& ext) {
+  static const char* const kFormats[] = {"obj", "ply", "gltf", "glb", "3ds"};
+  for (const char* f : kFormats)
+    if (ext == f) return true;
+  return false;
+}
+
+bool is_draco(const uint8_t* data, size_t size) { return size >= 5 && std::memcmp(data, "DRACO", 5) == 0; }
+
+// The file name's extension, lower case, without the dot ("" if none).
+std::string extension_of(const std::string& name) {
+  const size_t dot = name.find_last_of('.');
+  const size_t slash = name.find_last_of('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string e = name.substr(dot + 1);
+  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+
+// A mesh file's bytes, checked and imported. `root` is the folder whose
+// files the importer may open besides these bytes (empty: none).
+Mesh load_bytes(const uint8_t* data, size_t size, const std::string& name, const std::string& hint,
+                const std::filesystem::path& root, MeshRepairReport* report) {
+  if (size == 0) throw std::runtime_error(name + ": the file is empty");
+  if (hint == "drc" || is_draco(data, size)) {
+    Mesh m = decode_draco(data, size, name);
+    if (report) {
+      report->input_vertices = m.positions.size();
+      report->input_faces = m.triangles.size();
+    }
+    return m;
+  }
+  // PLY is checked by the project's own reader first: assimp's PLY loader
+  // trusts the header's counts and list lengths.
+  const bool ply = hint == "ply" || looks_like_ply(data, size);
+  if (ply) check_ply(data, size, name);
+  const std::string format = ply ? "ply" : hint;
+  Assimp::Importer importer;
+  configure(importer);
+  importer.SetIOHandler(new ConfinedIO(root));
+  // Only the loader of the format the name says: assimp would otherwise
+  // guess from the content (any file with "ply" in its first 200 bytes
+  // looks like a PLY to it) and hand the bytes to a loader nothing checked.
+  if (!imported_format(format) || importer.GetImporter(format.c_str()) == nullptr)
+    throw std::runtime_error(name + ": not a mesh format this tool reads ('" + format +
+                             "'; it reads .obj, .ply, .gltf, .glb, .3ds and .drc)");
+  for (size_t i = importer.GetImporterCount(); i-- > 0;) {
+    Assimp::BaseImporter* loader = importer.GetImporter(i);
+    if (loader != importer.GetImporter(format.c_str()) && importer.UnregisterLoader(loader) == aiReturn_SUCCESS)
+      delete loader;  // the importer owns its loaders only while they are registered
+  }
+  const aiScene* scene = importer.ReadFileFromMemory(data, size, kImportSteps, format.c_str());
+  if (scene == nullptr) throw std::runtime_error(name + ": cannot import: " + importer.GetErrorString());
+  return from_scene(scene, report);
+}
+
 }  // namespace
 
 Mesh decode_draco(const uint8_t* data, size_t size, const std::string& what) {
@@ -88,16 +164,27 @@ Mesh decode_draco(const uint8_t* data, size_t size, const std::string& what) {
   const draco::PointAttribute* pos = dm->GetNamedAttribute(draco::GeometryAttribute::POSITION);
   if (pos == nullptr || pos->num_components() < 3)
     throw std::runtime_error(what + ": Draco mesh has no 3-component position attribute");
+  // Numbers only: a boolean "position" is not one (and reading it as one is
+  // undefined behaviour inside libdraco's conversion).
+  if (pos->data_type() < draco::DT_INT8 || pos->data_type() > draco::DT_FLOAT64)
+    throw std::runtime_error(what + ": Draco position attribute is not numeric (type " +
+                             std::to_string(static_cast<int>(pos->data_type())) + ")");
   Mesh m;
   m.positions.resize(dm->num_points());
   for (uint32_t i = 0; i < dm->num_points(); ++i) {
     float v[3] = {0, 0, 0};
-    pos->ConvertValue<float, 3>(pos->mapped_index(draco::PointIndex(i)), v);
+    const draco::AttributeValueIndex at = pos->mapped_index(draco::PointIndex(i));
+    if (at.value() >= pos->size() || !pos->ConvertValue<float, 3>(at, v))
+      throw std::runtime_error(what + ": Draco point " + std::to_string(i) + " has no readable position");
     m.positions[i] = {v[0], v[1], v[2]};
   }
   m.triangles.resize(dm->num_faces());
   for (uint32_t f = 0; f < dm->num_faces(); ++f) {
     const draco::Mesh::Face& face = dm->face(draco::FaceIndex(f));
+    for (int k = 0; k < 3; ++k)
+      if (face[k].value() >= dm->num_points())
+        throw std::runtime_error(what + ": Draco face " + std::to_string(f) + " refers to point " +
+                                 std::to_string(face[k].value()) + " of " + std::to_string(dm->num_points()));
     m.triangles[f] = {face[0].value(), face[1].value(), face[2].value()};
   }
   return m;
@@ -125,13 +212,17 @@ std::vector<uint8_t> encode_draco(const Mesh& m, int qp, int cl) {
 }
 
 Mesh load_mesh_file(const std::string& path, MeshRepairReport* report) {
-  {
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (f == nullptr) throw std::runtime_error(path + ": cannot open");
-    std::fclose(f);
-  }
-  Mesh m = ends_with_ci(path, ".drc") ? load_draco(path, report) : load_assimp(path, report);
+  const std::vector<uint8_t> bytes = read_file(path);
+  std::error_code ec;
+  const std::filesystem::path root = std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec).parent_path();
+  Mesh m = load_bytes(bytes.data(), bytes.size(), path, extension_of(path), ec ? std::filesystem::path() : root, report);
   if (m.triangles.empty()) throw std::runtime_error(path + ": holds no triangles");
+  return m;
+}
+
+Mesh load_mesh_bytes(const uint8_t* data, size_t size, const std::string& name, MeshRepairReport* report) {
+  Mesh m = load_bytes(data, size, name, extension_of(name), std::filesystem::path(), report);
+  if (m.triangles.empty()) throw std::runtime_error(name + ": holds no triangles");
   return m;
 }
 

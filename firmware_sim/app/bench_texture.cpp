@@ -71,6 +71,7 @@ void shown(void* ctx, const vds::PlayedFrame& f) {
 vds::Status play(vds::Arena& arena, const uint8_t* data, const Case& c, Play& out) {
   vds::PlayerConfig config = vds::kClientPlayerConfig;
   config.max_chunk_bytes = kChunkCapacity;
+  config.decode_stages = false;  // decoding as one stage: no clock reads per block
   vds::PlayerCallbacks cb;
   cb.ctx = &out;
   cb.band = to_frame;

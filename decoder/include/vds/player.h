@@ -74,6 +74,11 @@ struct PlayerConfig {
   uint32_t mesh_service_items = 64;
   // Band pixels: rgb565 (the boards) or rgb888 (image streams only).
   PixelFormat format = PixelFormat::rgb565;
+  // With a clock: count a vds image's entropy decoding and inverse
+  // transform apart (PlayedFrame::entropy, transform). It reads the clock
+  // twice per block, about 2 instructions per pixel on a Cortex-M4; false
+  // counts decoding as one stage.
+  bool decode_stages = true;
 };
 
 // What the client boards use. The host replay of a client uses it too, with

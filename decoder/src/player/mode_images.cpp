@@ -65,7 +65,7 @@ bool vds_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size, 
       p.fail(Status::workspace_too_small, "the image decoder does not fit the workspace");
       return false;
     }
-    if (p.counting()) p.image.set_stage_clock(&p.stages());
+    if (p.counting() && p.config().decode_stages) p.image.set_stage_clock(&p.stages());
     p.image_ready = true;
   }
   *s = p.image.on_chunk(type, payload, size, band_target(p));

@@ -1,8 +1,8 @@
-// Host image files through stb_image (read) and libpng (write).
+// Host image files: loading a file (the readers are in image_read.cpp),
+// writing PNG through libpng, and the measures.
 #include "vds/io/image.h"
 
 #include <png.h>
-#include <stb_image.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,25 +15,6 @@
 
 namespace vds::io {
 
-Image decode_image(const uint8_t* data, size_t size, const std::string& what, int want_channels) {
-  if (want_channels < 0 || want_channels > 4 || want_channels == 2)
-    throw std::invalid_argument("want_channels must be 0, 1, 3 or 4");
-  if (size > static_cast<size_t>(std::numeric_limits<int>::max())) throw std::runtime_error(what + ": file too large");
-  int w = 0, h = 0, c = 0;
-  std::unique_ptr<stbi_uc, void (*)(void*)> px(
-      stbi_load_from_memory(data, static_cast<int>(size), &w, &h, &c, want_channels), stbi_image_free);
-  if (!px) throw std::runtime_error(what + ": not a readable image (" + stbi_failure_reason() + ")");
-  const int channels = want_channels ? want_channels : c;
-  if (channels == 2) {  // grey + alpha: keep grey only
-    Image img(w, h, 1);
-    for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = px.get()[2 * i];
-    return img;
-  }
-  Image img(w, h, channels);
-  std::copy(px.get(), px.get() + img.pixels.size(), img.pixels.begin());
-  return img;
-}
-
 Image load_image(const std::string& path, int want_channels) {
   std::ifstream f(path, std::ios::binary);
   if (!f) throw std::runtime_error(path + ": cannot open");
@@ -42,38 +23,111 @@ Image load_image(const std::string& path, int want_channels) {
   return decode_image(bytes.data(), bytes.size(), path, want_channels);
 }
 
-void save_png(const std::string& path, const Image& img) {
-  if (img.width <= 0 || img.height <= 0 || img.pixels.size() != static_cast<size_t>(img.width) * img.height * img.channels)
-    throw std::invalid_argument(path + ": image has no pixels or inconsistent size");
+struct PngRowWriter::State {
+  std::string path, temp;
+  std::FILE* f = nullptr;
+  png_structp png = nullptr;
+  png_infop info = nullptr;
+  int width = 0, height = 0, channels = 0, written = 0;
+};
+
+namespace {
+
+// Runs a libpng call under its error handler; false if libpng failed.
+template <class F>
+bool png_call(png_structp png, F&& f) {
+  if (setjmp(png_jmpbuf(png))) return false;
+  f();
+  return true;
+}
+
+}  // namespace
+
+PngRowWriter::PngRowWriter(const std::string& path, int width, int height, int channels) {
+  if (width <= 0 || height <= 0) throw std::invalid_argument(path + ": image has no pixels");
   int color = 0;
-  switch (img.channels) {
+  switch (channels) {
     case 1: color = PNG_COLOR_TYPE_GRAY; break;
     case 3: color = PNG_COLOR_TYPE_RGB; break;
     case 4: color = PNG_COLOR_TYPE_RGBA; break;
     default: throw std::invalid_argument(path + ": PNG needs 1, 3 or 4 channels");
   }
-  FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f) throw std::runtime_error(path + ": cannot open for writing");
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!png || !info) {
-    std::fclose(f);
-    png_destroy_write_struct(&png, nullptr);
+  s_ = new State;
+  s_->path = path;
+  s_->temp = path + ".part";
+  s_->width = width;
+  s_->height = height;
+  s_->channels = channels;
+  s_->f = std::fopen(s_->temp.c_str(), "wb");
+  if (s_->f == nullptr) {
+    delete s_;
+    s_ = nullptr;
+    throw std::runtime_error(path + ": cannot open for writing");
+  }
+  s_->png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  s_->info = s_->png ? png_create_info_struct(s_->png) : nullptr;
+  if (s_->png == nullptr || s_->info == nullptr) {
+    this->~PngRowWriter();
     throw std::runtime_error(path + ": libpng initialisation failed");
   }
-  if (setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(f);
+  png_structp png = s_->png;
+  png_infop info = s_->info;
+  std::FILE* f = s_->f;
+  const bool ok = png_call(png, [&] {
+    png_init_io(png, f);
+    png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8, color,
+                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+  });
+  if (!ok) {
+    this->~PngRowWriter();
     throw std::runtime_error(path + ": PNG write failed");
   }
-  png_init_io(png, f);
-  png_set_IHDR(png, info, static_cast<png_uint_32>(img.width), static_cast<png_uint_32>(img.height), 8, color,
-               PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < img.height; ++y) png_write_row(png, const_cast<png_bytep>(img.row(y)));
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  if (std::fclose(f) != 0) throw std::runtime_error(path + ": write error");
+}
+
+PngRowWriter::~PngRowWriter() {
+  if (s_ == nullptr) return;
+  if (s_->png != nullptr) png_destroy_write_struct(&s_->png, s_->info != nullptr ? &s_->info : nullptr);
+  if (s_->f != nullptr) {
+    std::fclose(s_->f);
+    std::remove(s_->temp.c_str());
+  }
+  delete s_;
+  s_ = nullptr;
+}
+
+void PngRowWriter::write_rows(const uint8_t* pixels, int rows, ptrdiff_t stride) {
+  if (s_ == nullptr || s_->f == nullptr) throw std::logic_error("PngRowWriter: write after finish");
+  if (rows < 0 || s_->written + rows > s_->height) throw std::logic_error(s_->path + ": more rows than the image has");
+  png_structp png = s_->png;
+  const bool ok = png_call(png, [&] {
+    for (int r = 0; r < rows; ++r) png_write_row(png, const_cast<png_bytep>(pixels + r * stride));
+  });
+  if (!ok) throw std::runtime_error(s_->path + ": PNG write failed");
+  s_->written += rows;
+}
+
+void PngRowWriter::finish() {
+  if (s_ == nullptr || s_->f == nullptr) throw std::logic_error("PngRowWriter: finish twice");
+  if (s_->written != s_->height) throw std::logic_error(s_->path + ": finish before every row was written");
+  png_structp png = s_->png;
+  if (!png_call(png, [&] { png_write_end(png, nullptr); })) throw std::runtime_error(s_->path + ": PNG write failed");
+  png_destroy_write_struct(&s_->png, &s_->info);
+  s_->png = nullptr;
+  const int closed = std::fclose(s_->f);
+  s_->f = nullptr;
+  if (closed != 0 || std::rename(s_->temp.c_str(), s_->path.c_str()) != 0) {
+    std::remove(s_->temp.c_str());
+    throw std::runtime_error(s_->path + ": write error");
+  }
+}
+
+void save_png(const std::string& path, const Image& img) {
+  if (img.width <= 0 || img.height <= 0 || img.pixels.size() != static_cast<size_t>(img.width) * img.height * img.channels)
+    throw std::invalid_argument(path + ": image has no pixels or inconsistent size");
+  PngRowWriter w(path, img.width, img.height, img.channels);
+  w.write_rows(img.pixels.data(), img.height, static_cast<ptrdiff_t>(img.width) * img.channels);
+  w.finish();
 }
 
 double mse(const Image& a, const Image& b) {

@@ -124,6 +124,21 @@ struct DecodedImage {
   std::string kind;  // "vds" or "jpeg"
 };
 
+// Where play_stream_image puts the first image's RGB888 rows: begin() once
+// with the image's size (as its header declares it: refuse there what is
+// too large to take), then rows() top to bottom. An exception from either
+// ends the play and is thrown by play_stream_image.
+struct ImageRowSink {
+  virtual ~ImageRowSink() = default;
+  virtual void begin(int width, int height) = 0;
+  virtual void rows(int y, int count, const uint8_t* pixels, ptrdiff_t stride) = 0;
+};
+
+// Plays a stream through the client's vds::Player (RGB888 bands), the first
+// image to `sink`, in memory of one band; returns its kind ("vds" or
+// "jpeg"). The stream must be whole and well formed; same throws as below.
+std::string play_stream_image(std::span<const uint8_t> stream, const Planes* prediction, ImageRowSink& sink);
+
 // Plays a stream through the client's vds::Player (RGB888 bands) and keeps
 // its first image (IMGH/IMGD or JPEG chunks). `prediction` is the
 // destination's prior content for residual and region images (null:

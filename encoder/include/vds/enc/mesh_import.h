@@ -63,12 +63,20 @@ struct MeshRepairReport {
   std::string summary() const;
 };
 
-// Loads a mesh file. `.drc` goes through libdraco, everything else through
-// assimp (triangulated, node transforms applied, all meshes of the scene
-// merged). Only positions and faces are kept. The result is NOT yet
-// repaired: call repair_mesh(). Throws std::runtime_error naming the file
-// and the reason if it cannot be read or holds no triangles.
+// Loads a mesh file. Draco (`.drc`, or bytes starting "DRACO") goes through
+// libdraco, everything else through assimp (its data-structure validation
+// first, then triangulated, node transforms applied, all meshes of the
+// scene merged); a PLY file is checked by the project's own reader first
+// (declared counts against the file's size, list lengths, vertex indices).
+// The importer may open only files in the model's folder (glTF buffers).
+// Only positions and faces are kept. The result is NOT yet repaired: call
+// repair_mesh(). Throws std::runtime_error naming the file, what is wrong
+// and where, if it cannot be read or holds no triangles.
 Mesh load_mesh_file(const std::string& path, MeshRepairReport* report = nullptr);
+// The same for a file's bytes held in memory; `name`'s extension says the
+// format where the bytes do not (.obj, .gltf, .glb, ...); no other file may
+// be opened.
+Mesh load_mesh_bytes(const uint8_t* data, size_t size, const std::string& name, MeshRepairReport* report = nullptr);
 
 // Decodes a Draco mesh held in memory (libdraco): positions and faces.
 // Throws std::runtime_error with `what` in the message if it is not one.

@@ -1,8 +1,9 @@
-// Host image files: load PNG/JPEG/TGA/BMP (stb_image), write PNG (libpng),
+// Host image files: load PNG (libpng), JPEG (libjpeg-turbo) and TGA, write PNG (libpng),
 // and the measures every benchmark uses (PSNR). A leaf library (libpng and
-// stb only, nothing of vds) that the encoder and the host-native board both
+// libjpeg-turbo only, nothing of vds) that the encoder and the host-native board both
 // use.
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -24,13 +25,41 @@ struct Image {
   uint8_t at(int x, int y, int c) const { return pixels[(static_cast<size_t>(y) * width + x) * channels + c]; }
 };
 
+// The largest image read: kMaxImageSide on a side and kMaxImagePixels in
+// all. A file that declares more is refused before its pixels are decoded
+// (a few hundred compressed bytes can declare gigabytes).
+constexpr int kMaxImageSide = 16384;
+constexpr int64_t kMaxImagePixels = int64_t{64} << 20;
+
 // Loads an image file; `want_channels` 0 keeps the file's own, 1/3/4 converts.
 // Throws std::runtime_error naming the file and the reason.
 Image load_image(const std::string& path, int want_channels = 0);
-// Decodes an in-memory image file (PNG, JPEG, TGA, BMP).
+// Decodes an in-memory image file (PNG, JPEG, binary PNM or TGA; the kind from its first
+// bytes, TGA when none matches).
 Image decode_image(const uint8_t* data, size_t size, const std::string& what, int want_channels = 0);
 // Writes a PNG (1, 3 or 4 channels). Throws std::runtime_error on failure.
+// The file appears whole or not at all (written beside it, then renamed);
+// what was at `path` before stays until then.
 void save_png(const std::string& path, const Image& img);
+
+// A PNG written row by row, in memory of one row: for images too large to
+// hold whole. The file appears at `path` only at finish(); a writer
+// destroyed before then removes what it wrote. Throws std::runtime_error.
+class PngRowWriter {
+ public:
+  PngRowWriter(const std::string& path, int width, int height, int channels);
+  ~PngRowWriter();
+  PngRowWriter(const PngRowWriter&) = delete;
+  PngRowWriter& operator=(const PngRowWriter&) = delete;
+  // The next `rows` rows, `stride` bytes apart (width x channels bytes each).
+  void write_rows(const uint8_t* pixels, int rows, ptrdiff_t stride);
+  // Every row written: closes the file and moves it to `path`.
+  void finish();
+
+ private:
+  struct State;
+  State* s_ = nullptr;
+};
 
 // Same size and channels, else throws std::invalid_argument.
 double mse(const Image& a, const Image& b);

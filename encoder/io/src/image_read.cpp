@@ -1,0 +1,281 @@
+// Host image files in: PNG through libpng, JPEG through libjpeg-turbo (its
+// TurboJPEG interface), TGA and binary PNM (P5, P6) through the readers below (uncompressed and RLE,
+// true colour and grey: what game textures use). Every reader checks the
+// size an image declares against vds/io/image.h's limits before a pixel is
+// decoded, and refuses with the file's name, what is wrong and where.
+#include <png.h>
+#include <turbojpeg.h>
+
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+#include "vds/io/image.h"
+
+namespace vds::io {
+
+namespace {
+
+[[noreturn]] void refuse(const std::string& what, const std::string& why) { throw std::runtime_error(what + ": " + why); }
+
+void check_size(const std::string& what, const char* format, int64_t w, int64_t h) {
+  if (w <= 0 || h <= 0 || w > kMaxImageSide || h > kMaxImageSide || w * h > kMaxImagePixels)
+    refuse(what, std::string(format) + " declares a " + std::to_string(w) + "x" + std::to_string(h) +
+                     " image; the most read is " + std::to_string(kMaxImageSide) + " on a side and " +
+                     std::to_string(kMaxImagePixels >> 20) + " Mpixels");
+}
+
+// JFIF luma of 8-bit R'G'B', as the earlier reader computed it.
+uint8_t luma(const uint8_t* p) { return static_cast<uint8_t>((p[0] * 77 + p[1] * 150 + p[2] * 29) >> 8); }
+
+// `in` (1 grey, 2 grey+alpha, 3 RGB, 4 RGBA) to `want` channels (0: keep,
+// except that grey+alpha keeps grey only).
+Image convert(const Image& in, int want) {
+  const int c = in.channels;
+  if (want == 0) want = c == 2 ? 1 : c;
+  if (want == c) return in;
+  Image out(in.width, in.height, want);
+  const size_t n = static_cast<size_t>(in.width) * in.height;
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t* s = &in.pixels[i * c];
+    uint8_t* d = &out.pixels[i * want];
+    const bool colour = c >= 3;
+    const uint8_t alpha = c == 2 ? s[1] : c == 4 ? s[3] : 255;
+    if (want == 1) {
+      d[0] = colour ? luma(s) : s[0];
+    } else {
+      d[0] = s[0];
+      d[1] = colour ? s[1] : s[0];
+      d[2] = colour ? s[2] : s[0];
+      if (want == 4) d[3] = alpha;
+    }
+  }
+  return out;
+}
+
+// --- PNG ------------------------------------------------------------------------
+
+struct PngSource {
+  const uint8_t* data;
+  size_t size, at;
+};
+
+Image read_png(const uint8_t* data, size_t size, const std::string& what) {
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (png == nullptr || info == nullptr) {
+    png_destroy_read_struct(&png, nullptr, nullptr);
+    throw std::runtime_error(what + ": libpng initialisation failed");
+  }
+  // libpng reports errors by longjmp: nothing with a destructor lives in
+  // this frame between setjmp and the end of the read.
+  struct Read {
+    Image img;
+    std::string error;
+  };
+  std::unique_ptr<Read> r(new Read);
+  png_set_error_fn(
+      png, r.get(),
+      [](png_structp p, png_const_charp msg) {
+        static_cast<Read*>(png_get_error_ptr(p))->error = msg;
+        png_longjmp(p, 1);
+      },
+      [](png_structp, png_const_charp) {});
+  PngSource src{data, size, 0};
+  png_set_read_fn(png, &src, [](png_structp p, png_bytep out, png_size_t n) {
+    PngSource& s = *static_cast<PngSource*>(png_get_io_ptr(p));
+    if (n > s.size - s.at) png_error(p, "the file ends inside the image");
+    std::memcpy(out, s.data + s.at, n);
+    s.at += n;
+  });
+  // A limit on what libpng itself allocates for ancillary chunks.
+  png_set_chunk_malloc_max(png, 8u << 20);
+  bool too_big = false;
+  png_uint_32 w = 0, h = 0;
+  if (setjmp(png_jmpbuf(png)) == 0) {
+    png_read_info(png, info);
+    w = png_get_image_width(png, info);
+    h = png_get_image_height(png, info);
+    too_big = w == 0 || h == 0 || w > static_cast<png_uint_32>(kMaxImageSide) || h > static_cast<png_uint_32>(kMaxImageSide) ||
+              int64_t{w} * h > kMaxImagePixels;
+    if (!too_big) {
+      // 8 bits per channel: palettes and low bit depths expanded, 16 bits
+      // cut to their high byte, transparency as an alpha channel.
+      png_set_expand(png);
+      png_set_strip_16(png);
+      png_set_interlace_handling(png);
+      png_read_update_info(png, info);
+      const int channels = png_get_channels(png, info);
+      if (channels < 1 || channels > 4 || png_get_rowbytes(png, info) != static_cast<size_t>(w) * channels)
+        png_error(png, "unexpected row layout");
+      r->img = Image(static_cast<int>(w), static_cast<int>(h), channels);
+      // Rows one at a time (interlaced images take several passes).
+      const int passes = png_set_interlace_handling(png);
+      for (int pass = 0; pass < passes; ++pass)
+        for (png_uint_32 y = 0; y < h; ++y) png_read_row(png, r->img.row(static_cast<int>(y)), nullptr);
+      png_read_end(png, nullptr);
+    }
+  } else {
+    png_destroy_read_struct(&png, &info, nullptr);
+    refuse(what, "not a readable PNG (" + r->error + ")");
+  }
+  png_destroy_read_struct(&png, &info, nullptr);
+  if (too_big) check_size(what, "the PNG", w, h);
+  return std::move(r->img);
+}
+
+// --- JPEG -----------------------------------------------------------------------
+
+Image read_jpeg(const uint8_t* data, size_t size, const std::string& what) {
+  std::unique_ptr<void, int (*)(tjhandle)> tj(tjInitDecompress(), tjDestroy);
+  if (!tj) throw std::runtime_error(what + ": libjpeg-turbo initialisation failed");
+  int w = 0, h = 0, sub = 0, cs = 0;
+  if (size > 0xFFFFFFFFu ||
+      tjDecompressHeader3(tj.get(), data, static_cast<unsigned long>(size), &w, &h, &sub, &cs) != 0)
+    refuse(what, std::string("not a readable JPEG (") + tjGetErrorStr2(tj.get()) + ")");
+  check_size(what, "the JPEG", w, h);
+  if (cs == TJCS_CMYK || cs == TJCS_YCCK) refuse(what, "a CMYK JPEG (RGB or grey are read)");
+  const bool grey = cs == TJCS_GRAY;
+  Image img(w, h, grey ? 1 : 3);
+  if (tjDecompress2(tj.get(), data, static_cast<unsigned long>(size), img.pixels.data(), w, 0, h,
+                    grey ? TJPF_GRAY : TJPF_RGB, TJFLAG_ACCURATEDCT | TJFLAG_STOPONWARNING) != 0)
+    refuse(what, std::string("not a readable JPEG (") + tjGetErrorStr2(tj.get()) + ")");
+  return img;
+}
+
+// --- TGA (Truevision TGA 2.0: image types 2, 3, 10 and 11) ---------------------
+
+Image read_tga(const uint8_t* data, size_t size, const std::string& what) {
+  constexpr size_t kHeader = 18;
+  if (size < kHeader) refuse(what, "not an image file (PNG, JPEG or TGA): too short for a TGA header");
+  const int id_len = data[0], map_type = data[1], type = data[2];
+  const int map_len = data[5] | (data[6] << 8), map_bits = data[7];
+  const int w = data[12] | (data[13] << 8), h = data[14] | (data[15] << 8);
+  const int bits = data[16], desc = data[17];
+  const bool rle = type == 10 || type == 11, grey = type == 3 || type == 11;
+  if (type != 2 && type != 3 && type != 10 && type != 11)
+    refuse(what, "not an image file this tool reads (PNG, JPEG, or a true-colour or grey TGA; TGA image type " +
+                     std::to_string(type) + ")");
+  if (map_type > 1) refuse(what, "TGA colour map type " + std::to_string(map_type) + " (byte 1)");
+  check_size(what, "the TGA", w, h);
+  if (grey ? bits != 8 : (bits != 16 && bits != 24 && bits != 32))
+    refuse(what, "TGA of " + std::to_string(bits) + " bits per pixel for image type " + std::to_string(type) + " (byte 16)");
+  const int bpp = bits / 8;
+  // 16-bit pixels are read as RGB (their attribute bit is not alpha in
+  // every writer's files).
+  const int channels = grey ? 1 : bits == 32 ? 4 : 3;
+  size_t at = kHeader + static_cast<size_t>(id_len) + (map_type == 1 ? static_cast<size_t>(map_len) * ((map_bits + 7) / 8) : 0);
+  if (at > size) refuse(what, "the TGA ends inside its image ID or colour map");
+  const size_t pixels = static_cast<size_t>(w) * h;
+  // Every pixel takes at least one byte of the file (RLE: a packet of 128
+  // pixels takes 1 + bpp bytes): refuse what the file cannot hold before
+  // allocating the image.
+  const size_t least = rle ? (pixels + 127) / 128 * (1 + static_cast<size_t>(bpp)) : pixels * static_cast<size_t>(bpp);
+  if (size - at < least)
+    refuse(what, "the TGA declares " + std::to_string(w) + "x" + std::to_string(h) + " pixels, at least " +
+                     std::to_string(least) + " bytes, but " + std::to_string(size - at) + " follow its header");
+  Image img(w, h, channels);
+  auto put = [&](size_t i, const uint8_t* p) {
+    uint8_t* d = &img.pixels[i * channels];
+    if (grey) {
+      d[0] = p[0];
+    } else if (bpp == 2) {
+      const int v = p[0] | (p[1] << 8);
+      d[0] = static_cast<uint8_t>(((v >> 10) & 31) * 255 / 31);
+      d[1] = static_cast<uint8_t>(((v >> 5) & 31) * 255 / 31);
+      d[2] = static_cast<uint8_t>((v & 31) * 255 / 31);
+    } else {
+      d[0] = p[2];
+      d[1] = p[1];
+      d[2] = p[0];
+      if (channels == 4) d[3] = p[3];
+    }
+  };
+  if (!rle) {
+    for (size_t i = 0; i < pixels; ++i) put(i, data + at + i * bpp);
+  } else {
+    size_t i = 0;
+    while (i < pixels) {
+      if (at >= size) refuse(what, "the TGA ends inside its pixels (pixel " + std::to_string(i) + ", byte " + std::to_string(at) + ")");
+      const int head = data[at++];
+      const size_t n = static_cast<size_t>(head & 127) + 1;
+      if (n > pixels - i) refuse(what, "a TGA run passes the last pixel (byte " + std::to_string(at - 1) + ")");
+      const size_t need = (head & 128) ? static_cast<size_t>(bpp) : n * bpp;
+      if (size - at < need) refuse(what, "the TGA ends inside its pixels (pixel " + std::to_string(i) + ", byte " + std::to_string(at) + ")");
+      for (size_t k = 0; k < n; ++k) put(i + k, data + at + ((head & 128) ? 0 : k * bpp));
+      at += need;
+      i += n;
+    }
+  }
+  // Rows are stored bottom to top unless the descriptor's bit 5 says top first.
+  if ((desc & 0x20) == 0) {
+    const size_t row = static_cast<size_t>(w) * channels;
+    for (int y = 0; y < h / 2; ++y) std::swap_ranges(img.row(y), img.row(y) + row, img.row(h - 1 - y));
+  }
+  return img;
+}
+
+// --- PNM (P5 grey, P6 RGB; maxval up to 65535, read to 8 bits) ------------------
+
+Image read_pnm(const uint8_t* data, size_t size, const std::string& what) {
+  const bool grey = data[1] == '5';
+  size_t at = 2;
+  int64_t field[3];
+  for (int k = 0; k < 3; ++k) {
+    // Whitespace and comments, then a decimal number.
+    for (;;) {
+      while (at < size && (data[at] == ' ' || data[at] == '\t' || data[at] == '\r' || data[at] == '\n')) ++at;
+      if (at < size && data[at] == '#') {
+        while (at < size && data[at] != '\n') ++at;
+        continue;
+      }
+      break;
+    }
+    int64_t v = 0;
+    const size_t s = at;
+    while (at < size && data[at] >= '0' && data[at] <= '9' && at - s < 9) v = v * 10 + (data[at++] - '0');
+    if (at == s) refuse(what, "a PNM header field is not a number (byte " + std::to_string(at) + ")");
+    field[k] = v;
+  }
+  if (at >= size || !(data[at] == ' ' || data[at] == '\t' || data[at] == '\r' || data[at] == '\n'))
+    refuse(what, "the PNM header does not end in whitespace (byte " + std::to_string(at) + ")");
+  ++at;
+  const int64_t w = field[0], h = field[1], maxval = field[2];
+  check_size(what, "the PNM", w, h);
+  if (maxval < 1 || maxval > 65535) refuse(what, "PNM maxval " + std::to_string(maxval) + " (1..65535)");
+  const int channels = grey ? 1 : 3;
+  const size_t sample = maxval > 255 ? 2 : 1;
+  const size_t need = static_cast<size_t>(w) * h * channels * sample;
+  if (size - at < need)
+    refuse(what, "the PNM declares " + std::to_string(w) + "x" + std::to_string(h) + " pixels, " + std::to_string(need) +
+                     " bytes, but " + std::to_string(size - at) + " follow its header");
+  Image img(static_cast<int>(w), static_cast<int>(h), channels);
+  for (size_t i = 0; i < img.pixels.size(); ++i) {
+    const int64_t v = sample == 2 ? (data[at + 2 * i] << 8) | data[at + 2 * i + 1] : data[at + i];
+    img.pixels[i] = static_cast<uint8_t>(maxval == 255 ? v : (v > maxval ? 255 : (v * 255 + maxval / 2) / maxval));
+  }
+  return img;
+}
+
+}  // namespace
+
+Image decode_image(const uint8_t* data, size_t size, const std::string& what, int want_channels) {
+  if (want_channels < 0 || want_channels > 4 || want_channels == 2)
+    throw std::invalid_argument("want_channels must be 0, 1, 3 or 4");
+  if (size == 0) refuse(what, "the file is empty");
+  Image img;
+  if (size >= 8 && png_sig_cmp(data, 0, 8) == 0)
+    img = read_png(data, size, what);
+  else if (size >= 3 && data[0] == 0xFF && data[1] == 0xD8 && data[2] == 0xFF)
+    img = read_jpeg(data, size, what);
+  else if (size >= 3 && data[0] == 'P' && (data[1] == '5' || data[1] == '6'))
+    img = read_pnm(data, size, what);
+  else if (size >= 2 && data[0] == 'B' && data[1] == 'M')
+    refuse(what, "a BMP file (PNG, JPEG or TGA are read)");
+  else
+    img = read_tga(data, size, what);
+  return convert(img, want_channels);
+}
+
+}  // namespace vds::io
