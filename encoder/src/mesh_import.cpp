@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <set>
 #include <stdexcept>
 
 #include <assimp/BaseImporter.h>
@@ -33,22 +34,36 @@ namespace {
 class ConfinedIO : public Assimp::DefaultIOSystem {
  public:
   explicit ConfinedIO(std::filesystem::path root) : root_(std::move(root)) {}
-  bool Exists(const char* file) const override { return allowed(file) && DefaultIOSystem::Exists(file); }
-  Assimp::IOStream* Open(const char* file, const char* mode) override {
-    if (!allowed(file) || std::strchr(mode, 'w') != nullptr || std::strchr(mode, 'a') != nullptr) return nullptr;
-    return DefaultIOSystem::Open(file, mode);
+  bool Exists(const char* file) const override {
+    const std::string p = resolve(file);
+    return !p.empty() && DefaultIOSystem::Exists(p.c_str());
   }
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    const std::string p = resolve(file);
+    if (p.empty() || std::strchr(mode, 'w') != nullptr || std::strchr(mode, 'a') != nullptr) return nullptr;
+    return DefaultIOSystem::Open(p.c_str(), mode);
+  }
+  // The first file the importer was not allowed to open.
+  const std::string& refused() const { return refused_; }
 
  private:
-  bool allowed(const char* file) const {
-    if (root_.empty() || file == nullptr) return false;
+  // A file the model names (relative to the model's folder), as an absolute
+  // path inside that folder; "" (and noted) if it lies outside.
+  std::string resolve(const char* file) const {
+    if (file == nullptr) return "";
+    std::filesystem::path p(file);
     std::error_code ec;
-    const std::filesystem::path p = std::filesystem::weakly_canonical(std::filesystem::path(file), ec);
-    if (ec) return false;
-    const std::string a = p.string(), r = root_.string();
-    return a.size() > r.size() && a.compare(0, r.size(), r) == 0 && a[r.size()] == '/';
+    if (!root_.empty() && p.is_relative()) p = root_ / p;
+    const std::string a = root_.empty() ? "" : std::filesystem::weakly_canonical(p, ec).string();
+    const std::string r = root_.string();
+    if (ec || a.size() <= r.size() || a.compare(0, r.size(), r) != 0 || a[r.size()] != '/') {
+      if (refused_.empty()) refused_ = file;
+      return "";
+    }
+    return a;
   }
   std::filesystem::path root_;
+  mutable std::string refused_;
 };
 
 // The importer set up for a mesh: positions and faces only (no normals, UVs
@@ -135,7 +150,8 @@ Mesh load_bytes(const uint8_t* data, size_t size, const std::string& name, const
   const std::string format = ply ? "ply" : hint;
   Assimp::Importer importer;
   configure(importer);
-  importer.SetIOHandler(new ConfinedIO(root));
+  ConfinedIO* io = new ConfinedIO(root);  // owned by the importer
+  importer.SetIOHandler(io);
   // Only the loader of the format the name says: assimp would otherwise
   // guess from the content (any file with "ply" in its first 200 bytes
   // looks like a PLY to it) and hand the bytes to a loader nothing checked.
@@ -144,10 +160,16 @@ Mesh load_bytes(const uint8_t* data, size_t size, const std::string& name, const
                              "'; it reads .obj, .ply, .gltf, .glb, .3ds and .drc)");
   for (size_t i = importer.GetImporterCount(); i-- > 0;) {
     Assimp::BaseImporter* loader = importer.GetImporter(i);
-    if (loader != importer.GetImporter(format.c_str()) && importer.UnregisterLoader(loader) == aiReturn_SUCCESS)
+    std::set<std::string> extensions;
+    loader->GetExtensionList(extensions);
+    // Every loader that claims the extension stays (glTF 1 and 2 share one).
+    if (extensions.count(format) == 0 && importer.UnregisterLoader(loader) == aiReturn_SUCCESS)
       delete loader;  // the importer owns its loaders only while they are registered
   }
   const aiScene* scene = importer.ReadFileFromMemory(data, size, kImportSteps, format.c_str());
+  if (!io->refused().empty())
+    throw std::runtime_error(name + ": refers to '" + io->refused() +
+                             "', which is not in the model's folder (only files beside the model or below it are read)");
   if (scene == nullptr) throw std::runtime_error(name + ": cannot import: " + importer.GetErrorString());
   return from_scene(scene, report);
 }

@@ -64,3 +64,50 @@ TEST(ImageIo, SideBySide) {
 }
 
 }  // namespace
+
+// --- Files a user did not make ----------------------------------------------------
+
+namespace {
+
+std::string refusal(const std::vector<uint8_t>& file) {
+  try {
+    vds::io::decode_image(file.data(), file.size(), "f");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::vector<uint8_t> tga(int type, int w, int h, int bits, const std::vector<uint8_t>& pixels, int desc = 0x20) {
+  std::vector<uint8_t> f = {0, 0, static_cast<uint8_t>(type), 0, 0, 0, 0, 0, 0, 0, 0, 0,
+                            static_cast<uint8_t>(w), static_cast<uint8_t>(w >> 8), static_cast<uint8_t>(h),
+                            static_cast<uint8_t>(h >> 8), static_cast<uint8_t>(bits), static_cast<uint8_t>(desc)};
+  f.insert(f.end(), pixels.begin(), pixels.end());
+  return f;
+}
+
+}  // namespace
+
+TEST(ImageIoHostile, SizesBeyondTheLimitAreRefusedBeforeDecoding) {
+  EXPECT_EQ(refusal(tga(2, 16384, 16384, 24, std::vector<uint8_t>(100))),
+            "f: the TGA declares a 16384x16384 image; the most read is 16384 on a side and 64 Mpixels");
+  EXPECT_NE(refusal(tga(2, 4096, 4096, 24, std::vector<uint8_t>(100))).find("but 100 follow its header"), std::string::npos);
+  const std::string ppm = "P6\n4096 4096\n255\n";
+  EXPECT_NE(refusal(std::vector<uint8_t>(ppm.begin(), ppm.end())).find("follow its header"), std::string::npos);
+  EXPECT_NE(refusal({'B', 'M', 0, 0}).find("BMP"), std::string::npos);
+  EXPECT_NE(refusal({0xFF, 0xD8, 0xFF, 0xE0, 0, 0}).find("not a readable JPEG"), std::string::npos);
+}
+
+TEST(ImageIoHostile, TgaKindsReadAsWritten) {
+  // 2x2 true colour, stored bottom row first (descriptor bit 5 clear), BGR.
+  const vds::io::Image raw = vds::io::decode_image(
+      tga(2, 2, 2, 24, {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12}, 0).data(), 18 + 12, "t");
+  EXPECT_EQ(raw.pixels, (std::vector<uint8_t>{9, 8, 7, 12, 11, 10, 3, 2, 1, 6, 5, 4}));
+  // The same pixels run-length coded (a run of 2, then 2 raw), top row first.
+  const std::vector<uint8_t> rle = tga(10, 2, 2, 24, {0x81, 1, 2, 3, 0x01, 4, 5, 6, 7, 8, 9});
+  const vds::io::Image r = vds::io::decode_image(rle.data(), rle.size(), "t");
+  EXPECT_EQ(r.pixels, (std::vector<uint8_t>{3, 2, 1, 3, 2, 1, 6, 5, 4, 9, 8, 7}));
+  // A run past the last pixel and a file ending inside a run are refused.
+  EXPECT_NE(refusal(tga(10, 2, 2, 24, {0x84, 1, 2, 3})).find("run passes the last pixel"), std::string::npos);
+  EXPECT_NE(refusal(tga(10, 2, 2, 24, {0x01, 1, 2, 3, 4, 5})).find("ends inside its pixels"), std::string::npos);
+}

@@ -227,3 +227,95 @@ TEST(MeshImport, QuantisationSpansTheGrid) {
 }
 
 }  // namespace
+
+// --- Files a user did not make (each of these crashed, aborted or took
+// gigabytes before the PLY check) -----------------------------------------------
+
+namespace {
+
+std::string ply_binary(uint64_t nv, uint64_t nf, const std::string& body) {
+  return "ply\nformat binary_little_endian 1.0\nelement vertex " + std::to_string(nv) +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement face " + std::to_string(nf) +
+         "\nproperty list uchar int vertex_indices\nend_header\n" + body;
+}
+
+std::string le(const void* p, size_t n) { return std::string(static_cast<const char*>(p), n); }
+
+std::string quad_body(bool with_faces) {
+  std::string b;
+  const float v[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}};
+  for (const auto& p : v) b += le(p, 12);
+  if (with_faces) {
+    const int32_t f[2][3] = {{0, 1, 2}, {1, 3, 2}};
+    for (const auto& t : f) b += std::string(1, '\3') + le(t, 12);
+  }
+  return b;
+}
+
+// The message load_mesh_bytes refuses `file` with ("" if it is accepted).
+std::string refusal(const std::string& file, const std::string& name = "m.ply") {
+  try {
+    vds::enc::load_mesh_bytes(reinterpret_cast<const uint8_t*>(file.data()), file.size(), name);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(MeshImportHostile, AWellFormedPlyIsRead) {
+  EXPECT_EQ(refusal(ply_binary(4, 2, quad_body(true))), "");
+}
+
+TEST(MeshImportHostile, PlyFaceListCutShort) {
+  const std::string whole = ply_binary(4, 2, quad_body(true));
+  EXPECT_NE(refusal(whole.substr(0, whole.size() - 6)).find("m.ply: face 1 of 2: its list of 3 items runs past the end"),
+            std::string::npos);
+}
+
+TEST(MeshImportHostile, PlyFaceOf255IndicesCutShort) {
+  const int32_t three[3] = {0, 1, 2};
+  const std::string f = ply_binary(4, 1, quad_body(false)) + "\xff" + le(three, 12);
+  EXPECT_NE(refusal(f).find("face 0 of 1: its list of 255 items runs past the end of the file (byte"), std::string::npos);
+}
+
+TEST(MeshImportHostile, PlyIndicesOutsideTheVertices) {
+  const std::string f =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n3 0 1 2\n3 1 3 2\n";
+  EXPECT_EQ(refusal(f), "m.ply: face 0 of 2: vertex index 2 is not one of the 2 vertices (line 12)");
+}
+
+TEST(MeshImportHostile, PlyCountsBeyondTheFileAreRefusedBeforeAnyAllocation) {
+  std::string huge = ply_binary(1000000000, 2, quad_body(true));
+  huge.resize(4096, '\0');
+  EXPECT_NE(refusal(huge).find("declares 1000000000 vertex elements (with those before, at least 12000000000 bytes) but "
+                               "the file holds"),
+            std::string::npos);
+  EXPECT_NE(refusal(ply_binary(4, 4000000, quad_body(true))).find("declares 4000000 face elements"), std::string::npos);
+}
+
+TEST(MeshImportHostile, PlyAsciiTakesPlainNumbersOnly) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  EXPECT_EQ(refusal(head + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "");
+  EXPECT_NE(refusal(head + std::string("0 0 0\n1 0 0\n0\0 1 0\n3 0 1 2\n", 28)).find("is not a number"), std::string::npos);
+  EXPECT_NE(refusal(head + "0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n").find("'nan' is not a number"), std::string::npos);
+  EXPECT_NE(refusal(head + "0 0 0\n1 0 0\n0 1 0\n3 0 +1 2\n").find("'+1' is not an integer"), std::string::npos);
+  EXPECT_NE(refusal(head + "0 0 0\n1 0 0\n0 1 0\n2 0 1\n").find("a face needs 3 to 256 vertices"), std::string::npos);
+}
+
+TEST(MeshImportHostile, OnlyTheNamedFormatIsTried) {
+  // A file that starts like a PLY is checked as one whatever its name says.
+  const std::string whole = ply_binary(4, 2, quad_body(true));
+  EXPECT_NE(refusal(whole.substr(0, whole.size() - 6), "m.obj").find("runs past the end"), std::string::npos);
+  // An OBJ whose first 200 bytes say "ply" is read by the OBJ reader alone
+  // (assimp guessing from the content would take it for a PLY).
+  EXPECT_EQ(refusal("# exported with ply tools\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "m.obj"), "");
+  EXPECT_NE(refusal("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "m.off").find("not a mesh format this tool reads"),
+            std::string::npos);
+  EXPECT_NE(refusal(std::string("DRACO") + std::string(64, '\x01'), "m.drc").find("m.drc: not a Draco mesh"),
+            std::string::npos);
+}

@@ -134,6 +134,7 @@ Image read_jpeg(const uint8_t* data, size_t size, const std::string& what) {
   if (size > 0xFFFFFFFFu ||
       tjDecompressHeader3(tj.get(), data, static_cast<unsigned long>(size), &w, &h, &sub, &cs) != 0)
     refuse(what, std::string("not a readable JPEG (") + tjGetErrorStr2(tj.get()) + ")");
+  if (w <= 0 || h <= 0) refuse(what, "not a readable JPEG (no frame header)");
   check_size(what, "the JPEG", w, h);
   if (cs == TJCS_CMYK || cs == TJCS_YCCK) refuse(what, "a CMYK JPEG (RGB or grey are read)");
   const bool grey = cs == TJCS_GRAY;

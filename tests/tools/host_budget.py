@@ -1,0 +1,241 @@
+#!/usr/bin/env python3
+"""Host commands on files a user did not make, each under its resource budget
+(docs/security.md): every hostile file is refused with exit code 1 and one
+line naming the file and what is wrong, leaves no output behind, and stays
+within
+
+    memory: 256 MiB + 16 x the input's size + 48 bytes per pixel of an
+            image the input holds (a picture is decoded whole: its pixels
+            are the importer's output), as peak resident memory; enforced:
+            RLIMIT_AS (the budget + 512 MiB for code and libraries) without
+            sanitizers, ASan's hard_rss_limit_mb under them (the budget x
+            1.25 + 64 MiB: shadow memory and a 16 MiB quarantine), and the
+            child's peak RSS checked after it ends;
+    time:   10 s + 1 s per MB of input + 1 s per Mpixel (x3 under
+            sanitizers).
+
+Each case is one that crashed, hung or took gigabytes before: a binary PLY
+whose face list is cut short, a face of 255 indices, indices outside the
+vertices, a 4 KB PLY claiming 10^9 vertices, 4,000,000 faces with 4 present,
+a stream declaring a 16384x16384 image, images declaring 65535x65535, and the
+smaller ones (--bytes 0, a short truncated stream, vds info on image chunks).
+
+Usage: host_budget.py VDS TMPDIR SANITIZED(0|1) [--report FILE]
+  --report writes one line per case: name, exit code, seconds, peak RSS (KiB).
+"""
+import os
+import resource
+import struct
+import subprocess
+import sys
+import time
+import zlib
+
+VDS, TMP, SANITIZED = sys.argv[1], sys.argv[2], sys.argv[3] == "1"
+REPORT = sys.argv[sys.argv.index("--report") + 1] if "--report" in sys.argv else None
+os.makedirs(TMP, exist_ok=True)
+failures = []
+rows = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what, flush=True)
+    if not cond:
+        failures.append(what)
+
+
+def write(name, data):
+    path = os.path.join(TMP, name)
+    with open(path, "wb") as f:
+        f.write(data if isinstance(data, bytes) else data.encode())
+    return path
+
+
+def budget_mb(input_bytes, pixels):
+    return 256 + (16 * input_bytes + 48 * pixels) / (1 << 20)
+
+
+def run(name, args, input_path, expect_code, expect_text="", output=None, pixels=0):
+    """Runs `vds ARGS` under the budget of `input_path` (holding an image of
+    `pixels`); checks the outcome."""
+    size = os.path.getsize(input_path) if input_path else 0
+    mb = budget_mb(size, pixels)
+    rss_mb = mb * 1.25 + 64 if SANITIZED else mb
+    seconds = (10 + size / 1e6 + pixels / 1e6) * (3 if SANITIZED else 1)
+    env = dict(os.environ)
+    preexec = None
+    if SANITIZED:
+        env["ASAN_OPTIONS"] = f"hard_rss_limit_mb={int(rss_mb)}:quarantine_size_mb=16:detect_leaks=0"
+    else:
+        limit = int(mb + 512) << 20
+
+        def preexec():
+            resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    if output:
+        for p in (output, output + ".part"):
+            if os.path.exists(p):
+                os.remove(p)
+    t0 = time.monotonic()
+    with open(os.path.join(TMP, "stdout.txt"), "w+") as fo, open(os.path.join(TMP, "stderr.txt"), "w+") as fe:
+        p = subprocess.Popen([VDS, *args], stdout=fo, stderr=fe, env=env, preexec_fn=preexec)
+        # wait4 gives this child's own peak memory.
+        timed_out = False
+        while True:
+            pid, status, usage = os.wait4(p.pid, os.WNOHANG)
+            if pid == p.pid:
+                break
+            if time.monotonic() - t0 > seconds:
+                p.kill()
+                pid, status, usage = os.wait4(p.pid, 0)
+                timed_out = True
+                break
+            time.sleep(0.01)
+        p.returncode = os.waitstatus_to_exitcode(status)
+        fo.seek(0)
+        fe.seek(0)
+        out, err = fo.read(), fe.read()
+    spent = time.monotonic() - t0
+    rss = usage.ru_maxrss
+    rows.append((name, p.returncode, spent, rss))
+    check(rss <= rss_mb * 1024, f"{name}: peak memory {rss / 1024:.0f} MiB within {rss_mb:.0f} MiB")
+    label = f"{name}: vds {' '.join(os.path.basename(a) if os.path.sep in a else a for a in args)}"
+    check(not timed_out, f"{label} ends within {seconds:.0f} s (took {spent:.1f} s)")
+    check(p.returncode == expect_code,
+          f"{label} exits {expect_code} (got {p.returncode}; stderr: {err.strip()[:300]})")
+    if expect_code == 1:
+        lines = [l for l in err.splitlines() if l.strip()]
+        check(len(lines) == 1 and os.path.basename(input_path) in lines[0] and expect_text in lines[0],
+              f"{label} says in one line which file and '{expect_text}' (stderr: {err.strip()[:300]})")
+        check("internal error" not in err and "Sanitizer" not in err, f"{label} is a refusal, not a failure")
+    if output:
+        if expect_code == 0:
+            check(os.path.exists(output), f"{label} writes {os.path.basename(output)}")
+        else:
+            check(not os.path.exists(output) and not os.path.exists(output + ".part"),
+                  f"{label} leaves no output behind")
+    return out, err
+
+
+# --- PLY and other meshes ---------------------------------------------------------------
+
+def ply_binary(nv, nf, verts, faces, tail=b""):
+    head = (f"ply\nformat binary_little_endian 1.0\nelement vertex {nv}\nproperty float x\nproperty float y\n"
+            f"property float z\nelement face {nf}\nproperty list uchar int vertex_indices\nend_header\n").encode()
+    body = b"".join(struct.pack("<3f", *v) for v in verts)
+    for f in faces:
+        body += struct.pack("<B", len(f)) + b"".join(struct.pack("<i", i) for i in f)
+    return head + body + tail
+
+
+quad = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)]
+whole = ply_binary(4, 2, quad, [(0, 1, 2), (1, 3, 2)])
+mesh_out = os.path.join(TMP, "out.vds")
+run("ply_valid", ["encode-mesh", write("valid.ply", whole), "-o", mesh_out], os.path.join(TMP, "valid.ply"), 0,
+    output=mesh_out)
+run("ply_face_list_cut", ["encode-mesh", write("cut.ply", whole[:-6]), "-o", mesh_out], os.path.join(TMP, "cut.ply"), 1,
+    "runs past the end", mesh_out)
+run("ply_face_of_255", ["encode-mesh", write("len255.ply", ply_binary(4, 1, quad, []) + b"\xff" + struct.pack("<3i", 0, 1, 2)),
+                        "-o", mesh_out], os.path.join(TMP, "len255.ply"), 1, "face 0 of 1", mesh_out)
+run("ply_255_indices_present",
+    ["encode-mesh", write("big_face.ply", ply_binary(4, 1, quad, [tuple(i % 4 for i in range(255))])), "-o", mesh_out],
+    os.path.join(TMP, "big_face.ply"), 0, output=mesh_out)
+oob = ("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+       "element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n3 0 1 2\n3 1 3 2\n")
+run("ply_index_outside", ["encode-mesh", write("oob.ply", oob), "-o", mesh_out], os.path.join(TMP, "oob.ply"), 1,
+    "vertex index 2 is not one of the 2 vertices (line 12)", mesh_out)
+huge = ply_binary(10**9, 2, quad, [(0, 1, 2), (1, 3, 2)])
+run("ply_claims_1e9_vertices", ["encode-mesh", write("huge.ply", huge + b"\0" * (4096 - len(huge))), "-o", mesh_out],
+    os.path.join(TMP, "huge.ply"), 1, "declares 1000000000 vertex elements", mesh_out)
+run("ply_claims_4e6_faces",
+    ["encode-mesh", write("many.ply", ply_binary(4, 4000000, quad, [(0, 1, 2), (1, 3, 2), (0, 1, 3), (0, 2, 3)])), "-o",
+     mesh_out], os.path.join(TMP, "many.ply"), 1, "declares 4000000 face elements", mesh_out)
+run("ply_nul_in_ascii", ["encode-mesh", write("nul.ply", oob.replace("element vertex 2", "element vertex 4")
+                                              .replace("1 0 0\n3", "1 0 0\n0\0 1 0\n0 0 1\n3")), "-o", mesh_out],
+    os.path.join(TMP, "nul.ply"), 1, "is not a number", mesh_out)
+run("obj_index_outside", ["encode-mesh", write("oob.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n"), "-o", mesh_out],
+    os.path.join(TMP, "oob.obj"), 1, "oob.obj", mesh_out)
+os.makedirs(os.path.join(TMP, "model"), exist_ok=True)
+gltf = ('{"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"%s"}],'
+        '"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,'
+        '"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],'
+        '"scenes":[{"nodes":[0]}],"scene":0}')
+write("secret.bin", b"\0" * 36)
+for label, uri in (("gltf_buffer_outside_folder", os.path.join(TMP, "secret.bin")), ("gltf_buffer_dotdot", "../secret.bin")):
+    path = write(os.path.join("model", label + ".gltf"), gltf % uri)
+    run(label, ["encode-mesh", path, "-o", mesh_out], path, 1, "which is not in the model's folder", mesh_out)
+# A glTF whose buffer lies beside it is read, whatever the working directory.
+with open(os.path.join(TMP, "model", "inside.bin"), "wb") as f:
+    f.write(struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0))
+inside = write(os.path.join("model", "inside.gltf"), gltf % "inside.bin")
+run("gltf_buffer_beside", ["encode-mesh", inside, "-o", mesh_out], inside, 0, output=mesh_out)
+run("draco_garbage", ["encode-mesh", write("bad.drc", b"DRACO" + bytes(range(200))), "-o", mesh_out],
+    os.path.join(TMP, "bad.drc"), 1, "Draco", mesh_out)
+run("format_not_read", ["encode-mesh", write("m.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "-o", mesh_out],
+    os.path.join(TMP, "m.off"), 1, "not a mesh format this tool reads", mesh_out)
+
+
+# --- Images ----------------------------------------------------------------------------------
+
+def png_chunk(kind, data):
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+
+def png(w, h, rows_data):
+    return (b"\x89PNG\r\n\x1a\n" + png_chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0)) +
+            png_chunk(b"IDAT", zlib.compress(rows_data)) + png_chunk(b"IEND", b""))
+
+
+img_out = os.path.join(TMP, "out_img.vds")
+small = png(4, 2, b"".join(b"\0" + bytes(range(12)) for _ in range(2)))
+run("png_valid", ["encode-image", write("ok.png", small), "-o", img_out], os.path.join(TMP, "ok.png"), 0, output=img_out)
+run("png_claims_65535", ["encode-image", write("huge.png", png(65535, 65535, b"\0" * 1000)), "-o", img_out],
+    os.path.join(TMP, "huge.png"), 1, "declares a 65535x65535 image", img_out)
+# A 12 KB PNG of 2048x2048 zeros (a thousandfold zlib expansion, within the
+# limits): decoded and coded within the budget its pixels give.
+bomb = png(2048, 2048, b"\0" * (2048 * (2048 * 3 + 1)))
+run("png_zlib_bomb_in_limits", ["encode-image", write("bomb.png", bomb), "--quality", "10", "-o", img_out],
+    os.path.join(TMP, "bomb.png"), 0, output=img_out, pixels=2048 * 2048)
+tga = bytes([0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x40, 0, 0x40, 24, 0]) + b"\x10" * 100
+run("tga_claims_16384", ["encode-image", write("huge.tga", tga), "-o", img_out], os.path.join(TMP, "huge.tga"), 1,
+    "declares a 16384x16384 image", img_out)
+tga2 = bytes([0, 0, 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0x10, 0, 0x10, 24, 0]) + b"\x10" * 100
+run("tga_claims_4096", ["encode-image", write("big.tga", tga2), "-o", img_out], os.path.join(TMP, "big.tga"), 1,
+    "follow its header", img_out)
+run("jpeg_truncated", ["encode-image", write("cut.jpg", b"\xff\xd8\xff\xe0" + b"\0" * 20), "-o", img_out],
+    os.path.join(TMP, "cut.jpg"), 1, "not a readable JPEG", img_out)
+run("bmp_refused", ["encode-image", write("x.bmp", b"BM" + b"\0" * 60), "-o", img_out], os.path.join(TMP, "x.bmp"), 1,
+    "BMP", img_out)
+run("ppm_claims_big", ["encode-image", write("huge.ppm", b"P6\n16384 16384\n255\n" + b"\0" * 100), "-o", img_out],
+    os.path.join(TMP, "huge.ppm"), 1, "declares a 16384x16384 image", img_out)
+run("ppm_claims_4096", ["encode-image", write("big.ppm", b"P6\n4096 4096\n255\n" + b"\0" * 100), "-o", img_out],
+    os.path.join(TMP, "big.ppm"), 1, "follow its header", img_out)
+run("bytes_zero", ["encode-image", os.path.join(TMP, "ok.png"), "--bytes", "0", "-o", img_out], None, 2, output=img_out)
+
+# --- Streams ---------------------------------------------------------------------------------
+# A stream declaring a 16384x16384 image, 59 KB of data: refused in memory of one band.
+imgh = write("imgh.bin", bytes([1, 1, 0, 40, 40, 4]) + struct.pack("<HHH", 16384, 16384, 0))
+imgd = write("imgd.bin", struct.pack("<IH", 0, 1000) + bytes((i * 7919) & 255 for i in range(4090)))
+big_stream = os.path.join(TMP, "big.vds")
+run("pack_big_image", ["pack", "-o", big_stream, "--size", "16384x16384", "--chunk", f"IMGH={imgh}"] +
+    [a for _ in range(14) for a in ("--chunk", f"IMGD={imgd}")], imgh, 0, output=big_stream)
+png_out = os.path.join(TMP, "big.png")
+run("decode_declares_16384", ["decode-image", big_stream, "-o", png_out], big_stream, 1, "big.vds", png_out)
+# A short cut of a valid stream is "truncated", not "workspace too small".
+ok_stream = img_out
+run("encode_for_cut", ["encode-image", os.path.join(TMP, "ok.png"), "-o", ok_stream], os.path.join(TMP, "ok.png"), 0,
+    output=ok_stream)
+with open(ok_stream, "rb") as f:
+    cut = write("cut.vds", f.read()[:100])
+run("decode_short_cut", ["decode-image", cut, "-o", png_out], cut, 1, "truncated", png_out)
+out, _ = run("info_names_image_chunks", ["info", ok_stream], ok_stream, 0)
+check("vds image header" in out and "skipped as unknown" in out and ", 0 skipped as unknown" in out,
+      "vds info names IMGH/IMGD chunks and skips none")
+run("info_garbage", ["info", write("garbage.vds", bytes(range(256)) * 8)], os.path.join(TMP, "garbage.vds"), 1,
+    "garbage.vds")
+
+if REPORT:
+    with open(REPORT, "w") as f:
+        for name, code, spent, rss in rows:
+            f.write(f"{name} {code} {spent:.2f} {rss}\n")
+print(f"{len(failures)} failure(s)")
+sys.exit(1 if failures else 0)
