@@ -168,6 +168,10 @@ with open(os.path.join(TMP, "model", "inside.bin"), "wb") as f:
     f.write(struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0))
 inside = write(os.path.join("model", "inside.gltf"), gltf % "inside.bin")
 run("gltf_buffer_beside", ["encode-mesh", inside, "-o", mesh_out], inside, 0, output=mesh_out)
+glb_json = b'{"asset":{"version":"2.0"}}    '
+glb = b"glTF" + struct.pack("<III", 2, 20 + len(glb_json), 1711276488) + b"JSON" + glb_json
+run("glb_chunk_claims_1_7_gb", ["encode-mesh", write("big.glb", glb), "-o", mesh_out], os.path.join(TMP, "big.glb"), 1,
+    "a chunk of 1711276488 bytes", mesh_out)
 run("draco_garbage", ["encode-mesh", write("bad.drc", b"DRACO" + bytes(range(200))), "-o", mesh_out],
     os.path.join(TMP, "bad.drc"), 1, "Draco", mesh_out)
 run("format_not_read", ["encode-mesh", write("m.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "-o", mesh_out],

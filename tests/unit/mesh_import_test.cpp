@@ -319,3 +319,18 @@ TEST(MeshImportHostile, OnlyTheNamedFormatIsTried) {
   EXPECT_NE(refusal(std::string("DRACO") + std::string(64, '\x01'), "m.drc").find("m.drc: not a Draco mesh"),
             std::string::npos);
 }
+
+TEST(MeshImportHostile, GlbLengthsAreCheckedBeforeAssimpAllocatesThem) {
+  // A GLB header and a JSON chunk claiming 1.7 GB (assimp allocated it).
+  auto le32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::string json = "{\"asset\":{\"version\":\"2.0\"}}    ";
+  const std::string ok = "glTF" + le32(2) + le32(static_cast<uint32_t>(20 + json.size())) +
+                         le32(static_cast<uint32_t>(json.size())) + "JSON" + json;
+  EXPECT_EQ(refusal(ok, "m.glb").find("m.glb: the header says"), std::string::npos);
+  std::string big = ok;
+  big.replace(12, 4, le32(1711276488));
+  EXPECT_NE(refusal(big, "m.glb").find("m.glb: a chunk of 1711276488 bytes where"), std::string::npos);
+  std::string lying = ok;
+  lying.replace(8, 4, le32(135168));
+  EXPECT_NE(refusal(lying, "m.glb").find("the header says the file is 135168 bytes"), std::string::npos);
+}
