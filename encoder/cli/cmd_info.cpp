@@ -2,6 +2,7 @@
 // read with the client's own parser so the answer is what a client sees.
 #include <cinttypes>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "vds/image.h"
 #include "vds/jpeg.h"
 #include "vds/enc/mesh_encoder.h"
+#include "vds/enc/scene.h"
 #include "vds/enc/stream_writer.h"
 
 namespace vds::cli {
@@ -54,7 +56,62 @@ std::string q16(int32_t v) {
   return buf;
 }
 
+// `vds info SCENE`: what a walkthrough would stream of a map.
+void run_scene_info(const InfoOptions& o) {
+  const enc::Scene s = enc::load_scene(o.file);
+  size_t lightmapped = 0, sky = 0, fog = 0, found = 0;
+  uint64_t texture_bytes = 0;
+  for (const enc::SceneSurface& f : s.surfaces) {
+    if (f.lightmap >= 0) lightmapped += f.index_count / 3;
+    if (f.kind == enc::SurfaceKind::sky) sky += f.index_count / 3;
+    if (f.kind == enc::SurfaceKind::fog) fog += f.index_count / 3;
+  }
+  std::vector<bool> used(s.textures.size(), false);
+  for (const enc::SceneSurface& f : s.surfaces) used[static_cast<size_t>(f.texture)] = true;
+  size_t used_count = 0;
+  std::vector<std::string> missing;
+  for (size_t t = 0; t < s.textures.size(); ++t) {
+    if (!used[t]) continue;
+    ++used_count;
+    if (!s.textures[t].file.empty()) {
+      ++found;
+      texture_bytes += s.textures[t].bytes;
+    } else {
+      missing.push_back(s.textures[t].name);
+    }
+  }
+  std::printf("%s: Quake III map\n", s.name.c_str());
+  std::printf("  faces              %u polygons, %u patches, %u meshes, %u billboards (dropped); %u skipped (nodraw, hint, or no model)\n",
+              s.polygons, s.patches, s.meshes, s.billboards, s.skipped);
+  std::printf("  triangles          %zu (%zu lightmapped, %zu sky, %zu in fog), %zu vertices, %zu surfaces\n", s.triangles(),
+              lightmapped, sky, fog, s.vertices.size(), s.surfaces.size());
+  std::printf("  bounds             (%.0f %.0f %.0f) .. (%.0f %.0f %.0f) map units\n", s.min[0], s.min[1], s.min[2], s.max[0],
+              s.max[1], s.max[2]);
+  std::printf("  textures           %zu used, %zu found, %" PRIu64 " bytes in their files\n", used_count, found, texture_bytes);
+  for (const std::string& m : missing) std::printf("    missing          %s\n", m.c_str());
+  std::printf("  lightmaps          %zu of %dx%d (%zu bytes)\n", s.lightmaps.size(), enc::kLightmapSide, enc::kLightmapSide,
+              s.lightmaps.size() * enc::kLightmapSide * enc::kLightmapSide * 3);
+  std::printf("  spawn points       %zu\n", s.spawns.size());
+  for (const enc::SpawnPoint& p : s.spawns)
+    std::printf("    %-22s (%.0f %.0f %.0f) yaw %.0f\n", p.classname.c_str(), p.origin[0], p.origin[1], p.origin[2], p.yaw_deg);
+}
+
+// A vds stream starts with its magic; anything else is taken for a scene.
+bool is_stream(const std::string& file) {
+  std::FILE* f = std::fopen(file.c_str(), "rb");
+  if (f == nullptr) return false;
+  uint8_t magic[sizeof kStreamMagic] = {};
+  const size_t n = std::fread(magic, 1, sizeof magic, f);
+  std::fclose(f);
+  return n == sizeof magic && std::memcmp(magic, kStreamMagic, sizeof magic) == 0;
+}
+
 void run_info(const InfoOptions& o) {
+  const std::string ext = o.file.size() > 4 ? o.file.substr(o.file.size() - 4) : "";
+  if (!is_stream(o.file) && (ext == ".bsp" || ext == ".BSP" || o.file.find_first_of("./") == std::string::npos)) {
+    run_scene_info(o);
+    return;
+  }
   const std::vector<uint8_t> bytes = enc::read_file(o.file);
   if (o.chunk_buffer < kHeaderPayloadMax) throw Failure(kExitUsage, "--chunk-buffer must be at least 256");
   if (o.workspace < o.chunk_buffer) throw Failure(kExitUsage, "--workspace must hold the chunk buffer");
@@ -170,8 +227,9 @@ void run_info(const InfoOptions& o) {
 
 void add_info(CLI::App& app) {
   auto opts = std::make_shared<InfoOptions>();
-  CLI::App* sub = app.add_subcommand("info", "Print a stream's header, budgets and chunks; checks every CRC");
-  sub->add_option("FILE", opts->file, "vds stream")->required();
+  CLI::App* sub = app.add_subcommand(
+      "info", "Print a stream's header, budgets and chunks (checks every CRC), or a scene's faces, textures and spawn points");
+  sub->add_option("FILE", opts->file, "vds stream, or a scene: a .bsp file or an OpenArena map name (oa_dm4)")->required();
   sub->add_option("--workspace", opts->workspace, "Workspace of the client to check against, bytes")
       ->capture_default_str()->check(CLI::PositiveNumber);
   sub->add_option("--chunk-buffer", opts->chunk_buffer, "Chunk buffer of the client to check against, bytes")

@@ -67,7 +67,7 @@ PngRowWriter::PngRowWriter(const std::string& path, int width, int height, int c
   s_->png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   s_->info = s_->png ? png_create_info_struct(s_->png) : nullptr;
   if (s_->png == nullptr || s_->info == nullptr) {
-    this->~PngRowWriter();
+    discard();
     throw std::runtime_error(path + ": libpng initialisation failed");
   }
   png_structp png = s_->png;
@@ -80,12 +80,14 @@ PngRowWriter::PngRowWriter(const std::string& path, int width, int height, int c
     png_write_info(png, info);
   });
   if (!ok) {
-    this->~PngRowWriter();
+    discard();
     throw std::runtime_error(path + ": PNG write failed");
   }
 }
 
-PngRowWriter::~PngRowWriter() {
+PngRowWriter::~PngRowWriter() { discard(); }
+
+void PngRowWriter::discard() {
   if (s_ == nullptr) return;
   if (s_->png != nullptr) png_destroy_write_struct(&s_->png, s_->info != nullptr ? &s_->info : nullptr);
   if (s_->f != nullptr) {

@@ -58,6 +58,7 @@ class PngRowWriter {
 
  private:
   struct State;
+  void discard();  // frees everything; removes the unfinished file
   State* s_ = nullptr;
 };
 

@@ -1,0 +1,119 @@
+// vds encoder: scenes for walkthroughs. A Quake III Arena / OpenArena map
+// (.bsp, read straight from the game's .pk3 archives when given by name)
+// becomes triangles with their textures, lightmaps and spawn points.
+//
+// What is kept, by rule:
+// - the faces of every model of the map: the world (model 0) and the brush
+//   entities (doors, lifts) where the map places them at rest;
+// - polygon and mesh faces as their triangles; Bezier patches tessellated
+//   so that no point of the tessellation is further than
+//   SceneOptions::patch_tolerance (map units) from the curved surface;
+// - billboards (flares) are dropped;
+// - a face is drawn, sky, or skipped by its texture's surface flags: nodraw
+//   (0x80) and hint/skip (0x100, 0x200) faces are skipped, sky (0x4) faces
+//   are kept as sky (drawn by the renderer's sky rule), and faces inside
+//   fog (contents 0x40) are kept as fog.
+// Every count and index the file declares is checked against the file before
+// it is used: a bad file is refused with its name, the lump and the element.
+#pragma once
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace vds::enc {
+
+struct SceneVertex {
+  std::array<float, 3> pos{};     // map units (Quake: Z up)
+  std::array<float, 2> uv{};      // texture coordinates (repeating)
+  std::array<float, 2> lm_uv{};   // lightmap coordinates, [0, 1] of its lightmap
+  std::array<float, 3> normal{};
+  std::array<uint8_t, 4> color{};  // vertex colour (RGBA)
+};
+
+enum class SurfaceKind : uint8_t { opaque, sky, fog };
+
+// A run of triangles with one texture and one lightmap.
+struct SceneSurface {
+  int texture = -1;   // into Scene::textures
+  int lightmap = -1;  // into Scene::lightmaps, -1 for none (vertex lit)
+  SurfaceKind kind = SurfaceKind::opaque;
+  uint32_t first_index = 0, index_count = 0;  // into Scene::indices (whole triangles)
+  uint8_t face_type = 0;                      // the BSP face type (1 polygon, 2 patch, 3 mesh)
+};
+
+struct SceneTexture {
+  std::string name;     // as the map names it ("textures/base_wall/concrete")
+  uint32_t flags = 0;   // surface flags
+  uint32_t contents = 0;
+  std::string file;     // the archive entry that supplies it ("" if none does)
+  std::string archive;  // the archive holding it
+  uint64_t bytes = 0;   // the file's size
+};
+
+struct SpawnPoint {
+  std::array<float, 3> origin{};
+  float yaw_deg = 0;
+  std::string classname;
+};
+
+constexpr int kLightmapSide = 128;
+
+struct Scene {
+  std::string name;
+  std::vector<SceneVertex> vertices;
+  std::vector<uint32_t> indices;  // triangles
+  std::vector<SceneSurface> surfaces;
+  std::vector<SceneTexture> textures;
+  std::vector<std::vector<uint8_t>> lightmaps;  // kLightmapSide^2 RGB each
+  std::vector<SpawnPoint> spawns;
+  // The BSP's faces by type, as read (before any is skipped).
+  uint32_t polygons = 0, patches = 0, meshes = 0, billboards = 0, skipped = 0;
+  std::array<float, 3> min{}, max{};  // bounds of the kept vertices
+
+  size_t triangles() const { return indices.size() / 3; }
+};
+
+struct SceneOptions {
+  double patch_tolerance = 1.0;  // map units
+  int patch_max_steps = 16;      // per 3x3 patch and direction
+};
+
+// Reads a .bsp held in memory. Throws std::runtime_error "NAME: what (where)".
+Scene read_bsp(const uint8_t* data, size_t size, const std::string& name, const SceneOptions& o = SceneOptions{});
+
+// A set of Quake III .pk3 archives (zip files), searched as the game does:
+// an archive later in name order overrides an earlier one.
+class Pk3Set {
+ public:
+  // Every .pk3 in `dir` (throws if there is none or one is not a zip).
+  explicit Pk3Set(const std::string& dir);
+  ~Pk3Set();
+  Pk3Set(const Pk3Set&) = delete;
+  Pk3Set& operator=(const Pk3Set&) = delete;
+  // The entry's bytes from the archive that overrides all others; false if
+  // no archive holds it. Throws on an entry larger than `max_bytes` or a
+  // damaged one (CRC).
+  bool read(const std::string& entry, std::vector<uint8_t>* out, std::string* archive = nullptr,
+            uint64_t max_bytes = uint64_t{64} << 20) const;
+  // The entry's size and archive without reading it; false if none holds it.
+  bool find(const std::string& entry, uint64_t* bytes, std::string* archive) const;
+
+ private:
+  struct Archive;
+  void close_all();
+  std::vector<Archive*> archives_;  // in override order: the last wins
+};
+
+// The directory of the installed OpenArena data: $VDS_OPENARENA_DIR, else
+// Debian's /usr/share/games/openarena/baseoa.
+std::string openarena_dir();
+
+// A scene named on the command line: a .bsp file, or a map name looked up
+// as maps/NAME.bsp in the installed OpenArena archives. Textures are
+// resolved in those archives (TGA, then JPEG, then PNG, as the game tries
+// them). Throws std::runtime_error naming the scene and the problem.
+Scene load_scene(const std::string& scene, const SceneOptions& o = SceneOptions{});
+
+}  // namespace vds::enc
