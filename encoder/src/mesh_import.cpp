@@ -148,7 +148,9 @@ Mesh load_bytes(const uint8_t* data, size_t size, const std::string& name, const
   // trusts the header's counts and list lengths.
   const bool ply = hint == "ply" || looks_like_ply(data, size);
   if (ply) check_ply(data, size, name);
-  const std::string format = ply ? "ply" : hint;
+  // Content that says PLY or GLB is checked as such whatever the name says.
+  const bool glb = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
+  const std::string format = ply ? "ply" : glb ? "glb" : hint;
   // GLB's lengths are checked by the project's own reader first: assimp
   // allocates what they say.
   if (format == "glb") check_glb(data, size, name);

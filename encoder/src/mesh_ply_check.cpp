@@ -81,8 +81,9 @@ bool digits(const std::string& t, size_t& i) {
 
 // [-]digits, at most 18 of them.
 bool plain_integer(const std::string& t) {
-  size_t i = t.size() > 0 && t[0] == '-' ? 1 : 0;
-  return digits(t, i) && i == t.size() && t.size() <= 19;
+  const size_t sign = t.size() > 0 && t[0] == '-' ? 1 : 0;
+  size_t i = sign;
+  return digits(t, i) && i == t.size() && t.size() - sign <= 18;
 }
 
 // [+-]digits[.digits][(e|E)[+-]digits], or [+-].digits...
@@ -190,15 +191,21 @@ PlyCounts check_ply(const uint8_t* data, size_t size, const std::string& name) {
       fail(name, at >= size ? "the header has no end_header line" : "the header is longer than 64 KiB");
     const uint8_t* nl = static_cast<const uint8_t*>(std::memchr(data + at, '\n', size - at));
     const size_t end = nl != nullptr ? static_cast<size_t>(nl - data) : size;
-    const std::string line(reinterpret_cast<const char*>(data + at), end - at);
-    at = end + 1;
+    std::string line(reinterpret_cast<const char*>(data + at), end - at);
+    at = nl != nullptr ? end + 1 : size;
     ++line_no;
+    // Lines end at '\n' (a '\r' before it is dropped): a lone '\r' would end
+    // a line for another reader and hide what follows from this one.
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     for (unsigned char c : line)
-      if ((c < 0x20 && c != '\t' && c != '\r') || c == 0x7F)
+      if ((c < 0x20 && c != '\t') || c == 0x7F)
         fail(name, "a control byte in the header (header line " + std::to_string(line_no) + ")");
     const std::vector<std::string> w = words(line);
     const std::string where = " (header line " + std::to_string(line_no) + ")";
-    if (line_no == 1) continue;  // "ply"
+    if (line_no == 1) {
+      if (line != "ply") fail(name, "the first line is not 'ply'");
+      continue;
+    }
     if (w.empty()) continue;
     if (w[0] == "comment" || w[0] == "obj_info") continue;
     if (w[0] == "end_header") {
@@ -215,8 +222,10 @@ PlyCounts check_ply(const uint8_t* data, size_t size, const std::string& name) {
       char* e = nullptr;
       const unsigned long long count = std::strtoull(w[2].c_str(), &e, 10);
       if (e == nullptr || *e != '\0' || w[2][0] == '-' || count > (uint64_t{1} << 32))
-        fail(name, "element '" + w[1] + "' has a bad count '" + w[2] + "'" + where);
+        fail(name, "element '" + printable(w[1].substr(0, 32)) + "' has a bad count '" + printable(w[2].substr(0, 32)) + "'" + where);
       if (elements.size() == kMaxElements) fail(name, "more than 64 elements" + where);
+      for (const Element& e : elements)
+        if (e.name == w[1]) fail(name, "a second element '" + printable(w[1].substr(0, 32)) + "'" + where);
       Element el;
       el.name = w[1];
       el.count = count;
@@ -231,12 +240,13 @@ PlyCounts check_ply(const uint8_t* data, size_t size, const std::string& name) {
         bool cf = false;
         p.count_size = type_size(w[2], &cf, &p.count_signed);
         p.size = type_size(w[3], &p.item_float, &p.item_signed);
-        if (p.count_size == 0 || cf) fail(name, "a list count of type '" + w[2] + "' (an integer type is needed)" + where);
-        if (p.size == 0) fail(name, "unknown type '" + w[3] + "'" + where);
+        if (p.count_size == 0 || cf)
+          fail(name, "a list count of type '" + printable(w[2].substr(0, 32)) + "' (an integer type is needed)" + where);
+        if (p.size == 0) fail(name, "unknown type '" + printable(w[3].substr(0, 32)) + "'" + where);
         p.name = w[4];
       } else if (w.size() == 3) {
         p.size = type_size(w[1], &f, &s);
-        if (p.size == 0) fail(name, "unknown type '" + w[1] + "'" + where);
+        if (p.size == 0) fail(name, "unknown type '" + printable(w[1].substr(0, 32)) + "'" + where);
         p.item_float = f;
         p.item_signed = s;
         p.name = w[2];
@@ -264,7 +274,8 @@ PlyCounts check_ply(const uint8_t* data, size_t size, const std::string& name) {
     if (per == 0 && e.count > 0) fail(name, "element '" + e.name + "' has no properties but a count");
     const uint64_t bytes = per * e.count;  // < 2^32 * 256 * 8
     least += bytes;
-    if (least > body)
+    // (ASCII: the very last value needs no separator after it.)
+    if (least > body + (format == Format::ascii ? 1 : 0))
       fail(name, "the header declares " + std::to_string(e.count) + " " + e.name + " elements (with those before, at least " +
                      std::to_string(least) + " bytes) but the file holds " + std::to_string(body) +
                      " bytes after its header (header line " + std::to_string(e.header_line) + ")");
@@ -282,28 +293,28 @@ PlyCounts check_ply(const uint8_t* data, size_t size, const std::string& name) {
   for (const Element& e : elements) {
     for (uint64_t i = 0; i < e.count; ++i) {
       for (const Property& p : e.props) {
-        const std::string what = e.name + " " + std::to_string(i) + " of " + std::to_string(e.count);
+        const auto what_of = [&] { return e.name + " " + std::to_string(i) + " of " + std::to_string(e.count); };
         int64_t v = 0;
         if (p.count_size == 0) {
           if (!b.read(p.size, p.item_float, p.item_signed, &v))
-            fail(name, "the file ends inside " + what + " (" + b.where() + ")");
+            fail(name, "the file ends inside " + what_of() + " (" + b.where() + ")");
           continue;
         }
         int64_t n = 0;
         if (!b.read(p.count_size, false, p.count_signed, &n))
-          fail(name, "the file ends inside " + what + " (" + b.where() + ")");
+          fail(name, "the file ends inside " + what_of() + " (" + b.where() + ")");
         const bool indices = is_face(e) && is_index_list(p);
         if (n < 0 || (indices && (n < 3 || n > kPlyMaxFaceVertices)))
-          fail(name, what + " lists " + std::to_string(n) + " items" +
+          fail(name, what_of() + " lists " + std::to_string(n) + " items" +
                          (indices ? " (a face needs 3 to " + std::to_string(kPlyMaxFaceVertices) + " vertices)" : "") +
                          " (" + b.where() + ")");
         if (format != Format::ascii && b.remaining() / static_cast<size_t>(p.size) < static_cast<uint64_t>(n))
-          fail(name, what + ": its list of " + std::to_string(n) + " items runs past the end of the file (" + b.where() + ")");
+          fail(name, what_of() + ": its list of " + std::to_string(n) + " items runs past the end of the file (" + b.where() + ")");
         for (int64_t k = 0; k < n; ++k) {
           if (!b.read(p.size, p.item_float, p.item_signed, &v))
-            fail(name, "the file ends inside " + what + " (" + b.where() + ")");
+            fail(name, "the file ends inside " + what_of() + " (" + b.where() + ")");
           if (indices && (p.item_float || v < 0 || static_cast<uint64_t>(v) >= vertices))
-            fail(name, what + ": vertex index " + std::to_string(v) + " is not one of the " + std::to_string(vertices) +
+            fail(name, what_of() + ": vertex index " + std::to_string(v) + " is not one of the " + std::to_string(vertices) +
                            " vertices (" + b.where() + ")");
         }
       }

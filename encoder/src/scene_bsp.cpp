@@ -116,8 +116,8 @@ int steps_for(const SceneVertex& a, const SceneVertex& b, const SceneVertex& c, 
     const double d = static_cast<double>(a.pos[k]) - 2.0 * b.pos[k] + c.pos[k];
     d2 += d * d;
   }
-  const double need = std::sqrt(std::sqrt(d2) / (4 * tol));
-  return std::clamp(static_cast<int>(std::ceil(need)), 1, max_steps);
+  const double need = std::ceil(std::sqrt(std::sqrt(d2) / (4 * tol)));
+  return need >= max_steps ? max_steps : std::max(1, static_cast<int>(need));
 }
 
 // A patch of w x h control points (odd, >= 3) as (w-1)/2 x (h-1)/2 biquadratic
@@ -211,8 +211,8 @@ void read_spawns(const Reader& r, Scene& s) {
 }  // namespace
 
 Scene read_bsp(const uint8_t* data, size_t size, const std::string& name, const SceneOptions& o) {
-  if (!(o.patch_tolerance > 0) || o.patch_max_steps < 1 || o.patch_max_steps > 64)
-    throw std::invalid_argument("patch tolerance must be > 0 and steps 1..64");
+  if (!(o.patch_tolerance >= 1e-3) || !std::isfinite(o.patch_tolerance) || o.patch_max_steps < 1 || o.patch_max_steps > 64)
+    throw std::invalid_argument("patch tolerance must be at least 0.001 map units and steps 1..64");
   Reader r{data, size, name, {}, {}};
   constexpr size_t kHeader = 8 + 8 * kLumps;
   if (size < kHeader || std::memcmp(data, "IBSP", 4) != 0) r.fail("not a Quake III map (it must start with 'IBSP')");
@@ -221,9 +221,12 @@ Scene read_bsp(const uint8_t* data, size_t size, const std::string& name, const 
   for (int l = 0; l < kLumps; ++l) {
     r.offset[l] = load_le32(data + 8 + 8 * l);
     r.length[l] = load_le32(data + 12 + 8 * l);
-    if (r.offset[l] > size || r.length[l] > size - r.offset[l] || r.offset[l] % 4 != 0)
+    if (r.offset[l] > size || r.length[l] > size - r.offset[l])
       r.fail(std::string("the ") + kLumpNames[l] + " lump (" + std::to_string(r.length[l]) + " bytes at byte " +
              std::to_string(r.offset[l]) + ") is not inside the " + std::to_string(size) + "-byte file");
+    if (r.offset[l] % 4 != 0)
+      r.fail(std::string("the ") + kLumpNames[l] + " lump starts at byte " + std::to_string(r.offset[l]) +
+             ", not on a 4-byte boundary");
   }
   Scene s;
   s.name = name;

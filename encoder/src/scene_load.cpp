@@ -18,6 +18,15 @@ struct Pk3Set::Archive {
   zip_t* zip = nullptr;
 };
 
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+}  // namespace
+
 Pk3Set::Pk3Set(const std::string& dir) {
   std::vector<std::string> paths;
   std::error_code ec;
@@ -42,6 +51,13 @@ Pk3Set::Pk3Set(const std::string& dir) {
       throw std::runtime_error(p + ": not a readable .pk3 (zip) archive: " + why);
     }
     archives_.push_back(new Archive{p, z});
+    // One index of every name (lower case; the game ignores case): a later
+    // archive's entry replaces an earlier one's.
+    const zip_int64_t n = zip_get_num_entries(z, 0);
+    for (zip_int64_t i = 0; i < n; ++i) {
+      const char* entry = zip_get_name(z, static_cast<zip_uint64_t>(i), 0);
+      if (entry != nullptr) index_[lower(entry)] = {archives_.size() - 1, static_cast<uint64_t>(i)};
+    }
   }
 }
 
@@ -56,34 +72,34 @@ void Pk3Set::close_all() {
 }
 
 bool Pk3Set::find(const std::string& entry, uint64_t* bytes, std::string* archive) const {
-  for (auto it = archives_.rbegin(); it != archives_.rend(); ++it) {
-    const zip_int64_t i = zip_name_locate((*it)->zip, entry.c_str(), ZIP_FL_NOCASE);
-    if (i < 0) continue;
-    zip_stat_t st;
-    zip_stat_init(&st);
-    if (zip_stat_index((*it)->zip, static_cast<zip_uint64_t>(i), 0, &st) != 0 || !(st.valid & ZIP_STAT_SIZE))
-      throw std::runtime_error((*it)->path + ": " + entry + ": no size in the archive's directory");
-    if (bytes) *bytes = st.size;
-    if (archive) *archive = (*it)->path;
-    return true;
-  }
-  return false;
+  const auto it = index_.find(lower(entry));
+  if (it == index_.end()) return false;
+  const Archive& a = *archives_[it->second.first];
+  zip_stat_t st;
+  zip_stat_init(&st);
+  if (zip_stat_index(a.zip, it->second.second, 0, &st) != 0 || !(st.valid & ZIP_STAT_SIZE))
+    throw std::runtime_error(a.path + ": " + entry + ": no size in the archive's directory");
+  if (bytes) *bytes = st.size;
+  if (archive) *archive = a.path;
+  return true;
 }
 
 bool Pk3Set::read(const std::string& entry, std::vector<uint8_t>* out, std::string* archive, uint64_t max_bytes) const {
-  for (auto it = archives_.rbegin(); it != archives_.rend(); ++it) {
-    zip_t* z = (*it)->zip;
-    const zip_int64_t i = zip_name_locate(z, entry.c_str(), ZIP_FL_NOCASE);
-    if (i < 0) continue;
-    const std::string where = (*it)->path + ": " + entry;
+  const auto found = index_.find(lower(entry));
+  if (found == index_.end()) return false;
+  {
+    const Archive& a = *archives_[found->second.first];
+    zip_t* z = a.zip;
+    const zip_uint64_t i = found->second.second;
+    const std::string where = a.path + ": " + entry;
     zip_stat_t st;
     zip_stat_init(&st);
-    if (zip_stat_index(z, static_cast<zip_uint64_t>(i), 0, &st) != 0 || !(st.valid & ZIP_STAT_SIZE))
+    if (zip_stat_index(z, i, 0, &st) != 0 || !(st.valid & ZIP_STAT_SIZE))
       throw std::runtime_error(where + ": no size in the archive's directory");
     if (st.size > max_bytes)
       throw std::runtime_error(where + ": " + std::to_string(st.size) + " bytes (the most read is " +
                                std::to_string(max_bytes) + ")");
-    zip_file_t* f = zip_fopen_index(z, static_cast<zip_uint64_t>(i), 0);
+    zip_file_t* f = zip_fopen_index(z, i, 0);
     if (f == nullptr) throw std::runtime_error(where + ": cannot open (" + zip_strerror(z) + ")");
     out->assign(st.size, 0);
     zip_int64_t got = 0;
@@ -99,10 +115,9 @@ bool Pk3Set::read(const std::string& entry, std::vector<uint8_t>* out, std::stri
     zip_fclose(f);
     if (static_cast<zip_uint64_t>(got) != st.size || more != 0)
       throw std::runtime_error(where + ": damaged in the archive (" + why + ")");
-    if (archive) *archive = (*it)->path;
-    return true;
+    if (archive) *archive = a.path;
   }
-  return false;
+  return true;
 }
 
 std::string openarena_dir() {
@@ -134,9 +149,14 @@ Scene load_scene(const std::string& scene, const SceneOptions& o) {
   } else {
     throw std::runtime_error(scene + ": not a scene this tool reads (a .bsp file or an OpenArena map name)");
   }
-  // Textures as the game finds them: TGA, then JPEG, then PNG.
+  // Textures as the game finds them: TGA, then JPEG, then PNG; only those
+  // a surface uses.
+  std::vector<bool> used(s.textures.size(), false);
+  for (const SceneSurface& f : s.surfaces) used[static_cast<size_t>(f.texture)] = true;
   if (std::filesystem::exists(openarena_dir())) {
-    for (SceneTexture& t : s.textures) {
+    for (size_t k = 0; k < s.textures.size(); ++k) {
+      if (!used[k]) continue;
+      SceneTexture& t = s.textures[k];
       for (const char* e : {".tga", ".jpg", ".png"}) {
         uint64_t bytes = 0;
         std::string archive;

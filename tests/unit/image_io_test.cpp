@@ -111,3 +111,31 @@ TEST(ImageIoHostile, TgaKindsReadAsWritten) {
   EXPECT_NE(refusal(tga(10, 2, 2, 24, {0x84, 1, 2, 3})).find("run passes the last pixel"), std::string::npos);
   EXPECT_NE(refusal(tga(10, 2, 2, 24, {0x01, 1, 2, 3, 4, 5})).find("ends inside its pixels"), std::string::npos);
 }
+
+TEST(ImageIoHostile, DeclaredSizesMustFitTheFile) {
+  // A PNG of a few dozen bytes declaring 16384 x 4096 RGBA: 256 MiB of rows.
+  std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};
+  auto chunk = [&](const char* type, std::vector<uint8_t> data) {
+    const uint32_t n = static_cast<uint32_t>(data.size());
+    for (int k = 3; k >= 0; --k) png.push_back(static_cast<uint8_t>(n >> (8 * k)));
+    std::vector<uint8_t> td(type, type + 4);
+    td.insert(td.end(), data.begin(), data.end());
+    png.insert(png.end(), td.begin(), td.end());
+    uint32_t crc = 0xFFFFFFFFu;  // the PNG CRC (ISO 3309)
+    for (uint8_t b : td) {
+      crc ^= b;
+      for (int i = 0; i < 8; ++i) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    crc ^= 0xFFFFFFFFu;
+    for (int k = 3; k >= 0; --k) png.push_back(static_cast<uint8_t>(crc >> (8 * k)));
+  };
+  chunk("IHDR", {0, 0, 0x40, 0, 0, 0, 0x10, 0, 8, 6, 0, 0, 0});
+  chunk("IDAT", {0x78, 0x9C, 0x03, 0x00, 0x00, 0x00, 0x00, 0x01});  // zlib of nothing
+  chunk("IEND", {});
+  EXPECT_NE(refusal(png).find("f: the PNG declares 16384x4096 pixels, more than its"), std::string::npos) << refusal(png);
+  // PNM: a size of more than 9 digits, and a magic not followed by whitespace.
+  const std::string long_field = "P5 0000000016 16 255\n";
+  EXPECT_NE(refusal(std::vector<uint8_t>(long_field.begin(), long_field.end())).find("more than 9 digits"), std::string::npos);
+  const std::string glued = "P516 16 255\n";
+  EXPECT_NE(refusal(std::vector<uint8_t>(glued.begin(), glued.end())).find("not a binary PNM"), std::string::npos);
+}

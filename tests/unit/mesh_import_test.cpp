@@ -334,3 +334,25 @@ TEST(MeshImportHostile, GlbLengthsAreCheckedBeforeAssimpAllocatesThem) {
   lying.replace(8, 4, le32(135168));
   EXPECT_NE(refusal(lying, "m.glb").find("the header says the file is 135168 bytes"), std::string::npos);
 }
+
+TEST(MeshImportHostile, PlyHeaderLinesEndOnlyAtLineFeeds) {
+  // end_header as the file's last bytes, with no line feed: nothing follows.
+  EXPECT_NE(refusal("ply\nformat binary_little_endian 1.0\nelement vertex 100000\nproperty float x\nend_header")
+                .find("declares 100000 vertex elements"),
+            std::string::npos);
+  // Lines ended by a lone carriage return (another reader's line ends) are refused.
+  EXPECT_NE(refusal("ply\rformat ascii 1.0\relement vertex 100000000\rproperty float x\rend_header\r\n"
+                    "format ascii 1.0\nelement vertex 0\nend_header\n")
+                .find("m.ply: "),
+            std::string::npos);
+  // CR LF line ends are fine, and the last value needs no separator after it.
+  EXPECT_EQ(refusal("ply\r\nformat ascii 1.0\r\nelement vertex 3\r\nproperty float x\r\nproperty float y\r\n"
+                    "property float z\r\nelement face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n"
+                    "0 0 0\r\n1 0 0\r\n0 1 0\r\n3 0 1 2"),
+            "");
+  // A second element of the same name.
+  EXPECT_NE(refusal("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nelement vertex 1\nproperty float x\n"
+                    "end_header\n0\n0\n")
+                .find("a second element 'vertex'"),
+            std::string::npos);
+}

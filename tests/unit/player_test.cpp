@@ -287,6 +287,26 @@ TEST(Player, AJpegInsideAVdsImageIsRefused) {
   EXPECT_EQ(seen.ended, 0u);
 }
 
+TEST(Player, AnImageHeaderInsideAnImageIsRefused) {
+  const std::vector<uint8_t> s = image_stream();
+  uint32_t head_len = 0;
+  std::memcpy(&head_len, s.data() + vds::kPreambleBytes + 4, 4);
+  const size_t at = vds::kPreambleBytes + vds::kChunkHeadBytes + head_len + vds::kChunkTailBytes;
+  uint32_t len = 0;
+  std::memcpy(&len, s.data() + at + 4, 4);
+  const std::vector<uint8_t> imgh(s.begin() + static_cast<std::ptrdiff_t>(at + 8),
+                                  s.begin() + static_cast<std::ptrdiff_t>(at + 8 + len));
+  vds::StreamHeader h = vds::enc::default_header(vds::StreamMode::images, 64, 48);
+  h.workspace_bytes = 32768;
+  h.max_chunk_payload = 4096;
+  vds::enc::StreamWriter w(h);
+  w.add_chunk(vds::chunk::kImageHeader, imgh);
+  w.add_chunk(vds::chunk::kImageHeader, imgh);
+  Seen seen;
+  EXPECT_EQ(play(w.finish(), seen, 0), Status::malformed);
+  EXPECT_EQ(seen.ended, 0u);
+}
+
 TEST(Player, Rgb888BandsShowTheSamePixelsAndModelsRefuseThem) {
   const std::vector<uint8_t> s = image_stream();
   vds::PlayerConfig c888 = vds::kClientPlayerConfig;

@@ -60,6 +60,10 @@ bool vds_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size, 
     p.fail(Status::malformed, "a vds image chunk inside a JPEG image");
     return false;
   }
+  if (type == chunk::kImageHeader && p.image_open) {
+    p.fail(Status::malformed, "an image header inside an image");
+    return false;
+  }
   if (!p.image_ready) {
     if (p.image.init(p.arena()) != Status::ok) {
       p.fail(Status::workspace_too_small, "the image decoder does not fit the workspace");

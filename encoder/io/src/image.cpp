@@ -99,13 +99,18 @@ void PngRowWriter::discard() {
 }
 
 void PngRowWriter::write_rows(const uint8_t* pixels, int rows, ptrdiff_t stride) {
-  if (s_ == nullptr || s_->f == nullptr) throw std::logic_error("PngRowWriter: write after finish");
+  if (s_ == nullptr || s_->f == nullptr) throw std::logic_error("PngRowWriter: write after finish or failure");
   if (rows < 0 || s_->written + rows > s_->height) throw std::logic_error(s_->path + ": more rows than the image has");
   png_structp png = s_->png;
   const bool ok = png_call(png, [&] {
     for (int r = 0; r < rows; ++r) png_write_row(png, const_cast<png_bytep>(pixels + r * stride));
   });
-  if (!ok) throw std::runtime_error(s_->path + ": PNG write failed");
+  if (!ok) {
+    // libpng's state is undefined now: the writer is done.
+    const std::string path = s_->path;
+    discard();
+    throw std::runtime_error(path + ": PNG write failed");
+  }
   s_->written += rows;
 }
 

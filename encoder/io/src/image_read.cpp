@@ -91,15 +91,25 @@ Image read_png(const uint8_t* data, size_t size, const std::string& what) {
   });
   // A limit on what libpng itself allocates for ancillary chunks.
   png_set_chunk_malloc_max(png, 8u << 20);
-  bool too_big = false;
+  bool too_big = false, cannot_hold = false;
   png_uint_32 w = 0, h = 0;
+  // An exception (memory exhausted) must not leave libpng's state behind.
+  struct Guard {
+    png_structp* png;
+    png_infop* info;
+    ~Guard() { png_destroy_read_struct(png, info, nullptr); }
+  } guard{&png, &info};
   if (setjmp(png_jmpbuf(png)) == 0) {
     png_read_info(png, info);
     w = png_get_image_width(png, info);
     h = png_get_image_height(png, info);
     too_big = w == 0 || h == 0 || w > static_cast<png_uint_32>(kMaxImageSide) || h > static_cast<png_uint_32>(kMaxImageSide) ||
               int64_t{w} * h > kMaxImagePixels;
-    if (!too_big) {
+    // Deflate expands at most 1032-fold: rows the file cannot hold are
+    // refused before they are allocated.
+    const int64_t raw = int64_t{h} * (1 + (int64_t{w} * png_get_channels(png, info) * png_get_bit_depth(png, info) + 7) / 8);
+    cannot_hold = !too_big && raw > 1032 * static_cast<int64_t>(size) + 4096;
+    if (!too_big && !cannot_hold) {
       // 8 bits per channel: palettes and low bit depths expanded, 16 bits
       // cut to their high byte, transparency as an alpha channel.
       png_set_expand(png);
@@ -117,11 +127,12 @@ Image read_png(const uint8_t* data, size_t size, const std::string& what) {
       png_read_end(png, nullptr);
     }
   } else {
-    png_destroy_read_struct(&png, &info, nullptr);
     refuse(what, "not a readable PNG (" + r->error + ")");
   }
-  png_destroy_read_struct(&png, &info, nullptr);
   if (too_big) check_size(what, "the PNG", w, h);
+  if (cannot_hold)
+    refuse(what, "the PNG declares " + std::to_string(w) + "x" + std::to_string(h) + " pixels, more than its " +
+                     std::to_string(size) + " bytes can hold");
   return std::move(r->img);
 }
 
@@ -136,11 +147,16 @@ Image read_jpeg(const uint8_t* data, size_t size, const std::string& what) {
     refuse(what, std::string("not a readable JPEG (") + tjGetErrorStr2(tj.get()) + ")");
   if (w <= 0 || h <= 0) refuse(what, "not a readable JPEG (no frame header)");
   check_size(what, "the JPEG", w, h);
+  // Even a flat picture takes bits for every 8x8 block: more than 1024
+  // pixels a byte of file is a declared size the file cannot hold.
+  if (int64_t{w} * h > 1024 * static_cast<int64_t>(size) + (int64_t{1} << 20))
+    refuse(what, "the JPEG declares " + std::to_string(w) + "x" + std::to_string(h) + " pixels in " +
+                     std::to_string(size) + " bytes (more than 1024 pixels a byte)");
   if (cs == TJCS_CMYK || cs == TJCS_YCCK) refuse(what, "a CMYK JPEG (RGB or grey are read)");
   const bool grey = cs == TJCS_GRAY;
   Image img(w, h, grey ? 1 : 3);
   if (tjDecompress2(tj.get(), data, static_cast<unsigned long>(size), img.pixels.data(), w, 0, h,
-                    grey ? TJPF_GRAY : TJPF_RGB, TJFLAG_ACCURATEDCT | TJFLAG_STOPONWARNING) != 0)
+                    grey ? TJPF_GRAY : TJPF_RGB, TJFLAG_ACCURATEDCT | TJFLAG_STOPONWARNING | TJFLAG_LIMITSCANS) != 0)
     refuse(what, std::string("not a readable JPEG (") + tjGetErrorStr2(tj.get()) + ")");
   return img;
 }
@@ -149,14 +165,14 @@ Image read_jpeg(const uint8_t* data, size_t size, const std::string& what) {
 
 Image read_tga(const uint8_t* data, size_t size, const std::string& what) {
   constexpr size_t kHeader = 18;
-  if (size < kHeader) refuse(what, "not an image file (PNG, JPEG or TGA): too short for a TGA header");
+  if (size < kHeader) refuse(what, "not an image file (PNG, JPEG, PNM or TGA): too short for a TGA header");
   const int id_len = data[0], map_type = data[1], type = data[2];
   const int map_len = data[5] | (data[6] << 8), map_bits = data[7];
   const int w = data[12] | (data[13] << 8), h = data[14] | (data[15] << 8);
   const int bits = data[16], desc = data[17];
   const bool rle = type == 10 || type == 11, grey = type == 3 || type == 11;
   if (type != 2 && type != 3 && type != 10 && type != 11)
-    refuse(what, "not an image file this tool reads (PNG, JPEG, or a true-colour or grey TGA; TGA image type " +
+    refuse(what, "not an image file this tool reads (PNG, JPEG, PNM, or a true-colour or grey TGA; TGA image type " +
                      std::to_string(type) + ")");
   if (map_type > 1) refuse(what, "TGA colour map type " + std::to_string(map_type) + " (byte 1)");
   check_size(what, "the TGA", w, h);
@@ -222,6 +238,8 @@ Image read_tga(const uint8_t* data, size_t size, const std::string& what) {
 Image read_pnm(const uint8_t* data, size_t size, const std::string& what) {
   const bool grey = data[1] == '5';
   size_t at = 2;
+  if (size < 3 || !(data[2] == ' ' || data[2] == '\t' || data[2] == '\r' || data[2] == '\n'))
+    refuse(what, "not a binary PNM (P5 or P6 and whitespace)");
   int64_t field[3];
   for (int k = 0; k < 3; ++k) {
     // Whitespace and comments, then a decimal number.
@@ -235,7 +253,10 @@ Image read_pnm(const uint8_t* data, size_t size, const std::string& what) {
     }
     int64_t v = 0;
     const size_t s = at;
-    while (at < size && data[at] >= '0' && data[at] <= '9' && at - s < 9) v = v * 10 + (data[at++] - '0');
+    while (at < size && data[at] >= '0' && data[at] <= '9') {
+      if (at - s == 9) refuse(what, "a PNM header field of more than 9 digits (byte " + std::to_string(s) + ")");
+      v = v * 10 + (data[at++] - '0');
+    }
     if (at == s) refuse(what, "a PNM header field is not a number (byte " + std::to_string(at) + ")");
     field[k] = v;
   }
@@ -273,7 +294,7 @@ Image decode_image(const uint8_t* data, size_t size, const std::string& what, in
   else if (size >= 3 && data[0] == 'P' && (data[1] == '5' || data[1] == '6'))
     img = read_pnm(data, size, what);
   else if (size >= 2 && data[0] == 'B' && data[1] == 'M')
-    refuse(what, "a BMP file (PNG, JPEG or TGA are read)");
+    refuse(what, "a BMP file (PNG, JPEG, PNM or TGA are read)");
   else
     img = read_tga(data, size, what);
   return convert(img, want_channels);

@@ -20,6 +20,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace vds::enc {
@@ -104,6 +106,7 @@ class Pk3Set {
   struct Archive;
   void close_all();
   std::vector<Archive*> archives_;  // in override order: the last wins
+  std::unordered_map<std::string, std::pair<size_t, uint64_t>> index_;  // lower-case name -> (archive, entry)
 };
 
 // The directory of the installed OpenArena data: $VDS_OPENARENA_DIR, else

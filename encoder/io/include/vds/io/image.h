@@ -1,4 +1,4 @@
-// Host image files: load PNG (libpng), JPEG (libjpeg-turbo) and TGA, write PNG (libpng),
+// Host image files: load PNG (libpng), JPEG (libjpeg-turbo), PNM and TGA, write PNG (libpng),
 // and the measures every benchmark uses (PSNR). A leaf library (libpng and
 // libjpeg-turbo only, nothing of vds) that the encoder and the host-native board both
 // use.
