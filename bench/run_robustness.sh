@@ -20,6 +20,7 @@ case "$REL" in /*) ;; *) REL="$ROOT/$REL" ;; esac
 LONG_SECONDS=${LONG_SECONDS:-600}
 ALL=$(cd "$SAN/tests" && ls fuzz_* | grep -v '\.' | sort)
 LONG=${LONG:-$ALL}
+export LONG
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
 export LSAN_OPTIONS=suppressions=$ROOT/tests/fuzz/lsan_suppressions.txt
@@ -43,7 +44,7 @@ echo "== host commands on hostile files ($REL)"
 python3 "$ROOT/tests/tools/host_budget.py" "$REL/encoder/vds" "$WORK/budget" 0 --report "$WORK/budget.txt" | tail -1
 
 python3 - "$WORK" "$LONG_SECONDS" "$ROOT/bench/results/robustness.md" $ALL <<'PY'
-import datetime, re, sys
+import datetime, os, re, sys
 work, long_s, out, names = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
 def stats(path):
     try: t = open(path, errors='replace').read()
@@ -56,7 +57,8 @@ L = ['# Robustness: fuzzers and hostile host inputs', '',
      f'Produced by `bench/run_robustness.sh` on {datetime.date.today()} (LONG_SECONDS={long_s}). What vds promises and '
      'how it is tested: `docs/security.md`. Fuzzers: libFuzzer with AddressSanitizer and UBSan (the `host` preset), '
      'each from a fresh corpus (the host importers write their own seed files), one allocation over 512 MiB or a '
-     'resident size over 2 GiB a failure.', '',
+     'resident size over 2 GiB a failure. The longer run this time: ' + ', '.join(os.environ['LONG'].split()) +
+     ' (every fuzzer: `LONG` unset; `make fuzz FUZZ_SECONDS=600` runs them all under ctest).', '',
      '| fuzzer | make test: executions | peak RSS (MiB) | finding | longer run: executions | peak RSS (MiB) | finding |',
      '|---|---:|---:|---|---:|---:|---|']
 for n in names:
