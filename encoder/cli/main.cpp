@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   vds::cli::add_frames(app);
   vds::cli::add_encode_image(app);
   vds::cli::add_decode_image(app);
+  vds::cli::add_path(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
