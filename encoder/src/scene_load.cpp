@@ -31,8 +31,7 @@ Pk3Set::Pk3Set(const std::string& dir) {
   std::vector<std::string> paths;
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
-    std::string ext = e.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string ext = lower(e.path().extension().string());
     if (e.is_regular_file() && ext == ".pk3") paths.push_back(e.path().string());
   }
   if (ec) throw std::runtime_error(dir + ": cannot list (" + ec.message() + ")");
@@ -126,8 +125,7 @@ std::string openarena_dir() {
 }
 
 Scene load_scene(const std::string& scene, const SceneOptions& o) {
-  std::string ext = std::filesystem::path(scene).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lower(std::filesystem::path(scene).extension().string());
   std::unique_ptr<Pk3Set> pk3;
   const auto archives = [&]() -> const Pk3Set& {
     if (!pk3) pk3 = std::make_unique<Pk3Set>(openarena_dir());

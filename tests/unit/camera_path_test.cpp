@@ -64,6 +64,26 @@ TEST(CameraPath, BadLinesAreRefusedWithTheirNumber) {
   EXPECT_EQ(refusal_keys("0 0 0 0 0 0\n80000 0 0 0 0 0\n"), "k.txt: more than 1048576 frames at 20.000000 frames/s");
 }
 
+TEST(CameraPath, EveryPrefixIsReadOrRefusedByLine) {
+  // A line-based text format cannot tell a file cut at a line end from a
+  // shorter file: such a prefix reads its whole frames. A prefix whose last
+  // line lost values is refused, naming that line.
+  const std::string path = "# hfov 75\n0 1 2 3 90 -10\n1 1.5 2 3 95.25 -9.5\n";
+  for (size_t n = 0; n <= path.size(); ++n) {
+    const std::string p = path.substr(0, n), why = refusal_path(p);
+    const size_t last = p.rfind('\n') == std::string::npos ? 0 : p.rfind('\n') + 1;
+    const std::string tail = p.substr(last);
+    size_t values = 0;
+    for (size_t k = 0; k < tail.size(); ++k) values += tail[k] != ' ' && (k == 0 || tail[k - 1] == ' ');
+    if (!tail.empty() && tail[0] != '#' && values < 6) {
+      EXPECT_NE(why.find("(line "), std::string::npos) << "prefix " << n << ": " << why;
+    } else if (tail.empty() && n >= 25) {
+      ASSERT_EQ(why, "") << "prefix " << n;
+      EXPECT_EQ(vds::enc::read_camera_path(p, "p").frames.size(), n == path.size() ? 2u : 1u) << "prefix " << n;
+    }
+  }
+}
+
 TEST(CameraPath, KeyframesArePassedSmoothlyAndTurnTheShortWay) {
   const vds::enc::CameraKeys k = vds::enc::read_camera_keys(
       "# fps 10\n0 0 0 0 350 0\n1 10 0 0 10 0\n2 10 10 0 20 10\n3 0 10 5 20 0\n", "k.txt");

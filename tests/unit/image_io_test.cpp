@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <string>
 
+#include "jpeg_sample_422.h"
 #include "vds/enc/image_io.h"
 #include "vds/enc/stream_writer.h"
 
@@ -138,4 +141,28 @@ TEST(ImageIoHostile, DeclaredSizesMustFitTheFile) {
   EXPECT_NE(refusal(std::vector<uint8_t>(long_field.begin(), long_field.end())).find("more than 9 digits"), std::string::npos);
   const std::string glued = "P516 16 255\n";
   EXPECT_NE(refusal(std::vector<uint8_t>(glued.begin(), glued.end())).find("not a binary PNM"), std::string::npos);
+}
+
+TEST(ImageIoHostile, EveryPrefixOfAPictureIsRefused) {
+  std::vector<std::vector<uint8_t>> files;
+  files.push_back(tga(2, 2, 2, 24, {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12}));
+  files.push_back(tga(10, 2, 2, 24, {0x81, 1, 2, 3, 0x01, 4, 5, 6, 7, 8, 9}));
+  const std::string pnm = "P6\n2 2\n255\n" + std::string(12, '\x40');
+  files.emplace_back(pnm.begin(), pnm.end());
+  {
+    vds::io::Image img(5, 3, 3);
+    for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = static_cast<uint8_t>(i * 17);
+    const std::string path = ::testing::TempDir() + "prefix.png";
+    vds::io::save_png(path, img);
+    std::ifstream f(path, std::ios::binary);
+    files.emplace_back((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  }
+  files.emplace_back(vds::test::kJpeg422, vds::test::kJpeg422 + sizeof vds::test::kJpeg422);
+  for (size_t k = 0; k < files.size(); ++k) {
+    const std::vector<uint8_t>& f = files[k];
+    EXPECT_EQ(refusal(f), "") << "file " << k;
+    for (size_t n = 0; n < f.size(); ++n)
+      EXPECT_NE(refusal(std::vector<uint8_t>(f.begin(), f.begin() + static_cast<std::ptrdiff_t>(n))), "")
+          << "file " << k << " prefix " << n;
+  }
 }

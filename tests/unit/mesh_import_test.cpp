@@ -356,3 +356,23 @@ TEST(MeshImportHostile, PlyHeaderLinesEndOnlyAtLineFeeds) {
                 .find("a second element 'vertex'"),
             std::string::npos);
 }
+
+TEST(MeshImportHostile, EveryPrefixOfAPlyOrGlbIsRefused) {
+  // Binary PLY: every prefix short of the whole file.
+  const std::string bin = ply_binary(4, 2, quad_body(true));
+  EXPECT_EQ(refusal(bin), "");
+  for (size_t n = 0; n < bin.size(); ++n) EXPECT_NE(refusal(bin.substr(0, n)), "") << "binary prefix " << n;
+  // ASCII PLY: every prefix that cuts a value or a line (the one dropping
+  // only the final line feed is the same file).
+  const std::string ascii =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_EQ(refusal(ascii), "");
+  for (size_t n = 0; n + 1 < ascii.size(); ++n) EXPECT_NE(refusal(ascii.substr(0, n)), "") << "ascii prefix " << n;
+  // GLB: its header states its length, so every prefix is refused.
+  auto le32 = [](uint32_t v) { return std::string(reinterpret_cast<const char*>(&v), 4); };
+  const std::string json = "{\"asset\":{\"version\":\"2.0\"}}    ";
+  const std::string glb = "glTF" + le32(2) + le32(static_cast<uint32_t>(20 + json.size())) +
+                          le32(static_cast<uint32_t>(json.size())) + "JSON" + json;
+  for (size_t n = 0; n < glb.size(); ++n) EXPECT_NE(refusal(glb.substr(0, n), "m.glb"), "") << "glb prefix " << n;
+}

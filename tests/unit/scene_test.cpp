@@ -139,6 +139,13 @@ TEST(SceneBsp, DamagedFilesAreRefusedWithTheirLumpAndElement) {
   }
 }
 
+TEST(SceneBsp, EveryPrefixIsRefused) {
+  const std::vector<uint8_t> f = vds::test::BspBuilder().build();
+  for (size_t n = 0; n < f.size(); n += (n < 256 ? 1 : 97))
+    EXPECT_NE(refusal(std::vector<uint8_t>(f.begin(), f.begin() + static_cast<std::ptrdiff_t>(n))), "") << "prefix " << n;
+  EXPECT_NE(refusal(std::vector<uint8_t>(f.begin(), f.end() - 1)), "");
+}
+
 TEST(SceneBsp, OutputIsBoundedByTheInput) {
   // 400 faces sharing one steep patch: each would become 17 x 17 vertices,
   // more than the file's bytes allow (a vertex per 4 bytes).
