@@ -3,17 +3,20 @@
 #   glmark2-data            Stanford bunny, horse, cat (OBJ) and textures
 #   openarena-081-maps      Quake III BSP maps (oa_dm4, ...)
 #   openarena-081-textures  1,600+ JPG/TGA textures and lightmapped surfaces
+#   openarena-081-misc      further textures the maps use
+#   openarena-data          the game's shader scripts (pak0), later maps and
+#                           fixes (pak6-patch085), player models
 # and prints where each lives. Idempotent.
 set -euo pipefail
 
-PACKAGES=(glmark2-data openarena-081-maps openarena-081-textures)
+PACKAGES=(glmark2-data openarena-081-maps openarena-081-textures openarena-081-misc openarena-data)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
 done
 if [ ${#missing[@]} -gt 0 ]; then
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  echo "fetch-data: installing ${missing[*]} (about 140 MB download)"
+  echo "fetch-data: installing ${missing[*]} (about 360 MB download)"
   export DEBIAN_FRONTEND=noninteractive
   $SUDO apt-get update -q
   $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
@@ -21,7 +24,7 @@ fi
 
 GLMARK2=/usr/share/glmark2
 OPENARENA=/usr/share/games/openarena/baseoa
-for f in "$GLMARK2/models/bunny.obj" "$GLMARK2/models/horse.3ds" "$OPENARENA/pak1-maps.pk3" "$OPENARENA/pak4-textures.pk3"; do
+for f in "$GLMARK2/models/bunny.obj" "$GLMARK2/models/horse.3ds" "$OPENARENA/pak1-maps.pk3" "$OPENARENA/pak4-textures.pk3" "$OPENARENA/pak0.pk3"; do
   [ -e "$f" ] || echo "fetch-data: note: $f not found" >&2
 done
 echo "fetch-data: glmark2 models:   $GLMARK2/models ($(ls "$GLMARK2/models" 2>/dev/null | wc -l) files)"

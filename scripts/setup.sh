@@ -16,6 +16,8 @@ PACKAGES=(
   libsdl2-dev
   # anchors the benchmarks and conformance tests compare against
   libjpeg-turbo-progs libturbojpeg0-dev
+  # the video codecs the walkthrough is measured against (x264, x265, SVT-AV1, libaom)
+  ffmpeg
   # measurement and plots
   valgrind python3 python3-matplotlib python3-numpy python3-pil
 )

@@ -59,12 +59,13 @@ std::string q16(int32_t v) {
 // `vds info SCENE`: what a walkthrough would stream of a map.
 void run_scene_info(const InfoOptions& o) {
   const enc::Scene s = enc::load_scene(o.file);
-  size_t lightmapped = 0, sky = 0, fog = 0, found = 0;
+  size_t lightmapped = 0, sky = 0, fog = 0, additive = 0, found = 0, scripted = 0;
   uint64_t texture_bytes = 0;
   for (const enc::SceneSurface& f : s.surfaces) {
     if (f.lightmap >= 0) lightmapped += f.index_count / 3;
     if (f.kind == enc::SurfaceKind::sky) sky += f.index_count / 3;
     if (f.kind == enc::SurfaceKind::fog) fog += f.index_count / 3;
+    if (f.kind == enc::SurfaceKind::additive) additive += f.index_count / 3;
   }
   std::vector<bool> used(s.textures.size(), false);
   for (const enc::SceneSurface& f : s.surfaces) used[static_cast<size_t>(f.texture)] = true;
@@ -73,6 +74,7 @@ void run_scene_info(const InfoOptions& o) {
   for (size_t t = 0; t < s.textures.size(); ++t) {
     if (!used[t]) continue;
     ++used_count;
+    scripted += s.textures[t].scripted;
     if (!s.textures[t].file.empty()) {
       ++found;
       texture_bytes += s.textures[t].bytes;
@@ -81,13 +83,14 @@ void run_scene_info(const InfoOptions& o) {
     }
   }
   std::printf("%s: Quake III map\n", s.name.c_str());
-  std::printf("  faces              %u polygons, %u patches, %u meshes, %u billboards (dropped); %u skipped (nodraw, hint, or no model)\n",
+  std::printf("  faces              %u polygons, %u patches, %u meshes, %u billboards (dropped); %u skipped (nodraw, hint, skip, or no model)\n",
               s.polygons, s.patches, s.meshes, s.billboards, s.skipped);
-  std::printf("  triangles          %zu (%zu lightmapped, %zu sky, %zu in fog), %zu vertices, %zu surfaces\n", s.triangles(),
-              lightmapped, sky, fog, s.vertices.size(), s.surfaces.size());
+  std::printf("  triangles          %zu (%zu lightmapped, %zu sky, %zu in fog, %zu additive), %zu vertices, %zu surfaces\n",
+              s.triangles(), lightmapped, sky, fog, additive, s.vertices.size(), s.surfaces.size());
   std::printf("  bounds             (%.0f %.0f %.0f) .. (%.0f %.0f %.0f) map units\n", s.min[0], s.min[1], s.min[2], s.max[0],
               s.max[1], s.max[2]);
-  std::printf("  textures           %zu used, %zu found, %" PRIu64 " bytes in their files\n", used_count, found, texture_bytes);
+  std::printf("  textures           %zu used (%zu by shader scripts), %zu found, %" PRIu64 " bytes in their files\n", used_count,
+              scripted, found, texture_bytes);
   for (const std::string& m : missing) std::printf("    missing          %s\n", m.c_str());
   std::printf("  lightmaps          %zu of %dx%d (%zu bytes)\n", s.lightmaps.size(), enc::kLightmapSide, enc::kLightmapSide,
               s.lightmaps.size() * enc::kLightmapSide * enc::kLightmapSide * 3);

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   vds::cli::add_encode_image(app);
   vds::cli::add_decode_image(app);
   vds::cli::add_path(app);
+  vds::cli::add_render(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -6,9 +6,12 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
 
 #include "vds/enc/scene.h"
+#include "vds/enc/scene_render.h"
+#include "vds/io/image.h"
 #include "vds/enc/stream_writer.h"
 
 namespace vds::enc {
@@ -23,6 +26,72 @@ namespace {
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
+}
+
+// The shaders of the archives applied to the scene's textures, and each
+// used texture's image resolved as the game does.
+void apply_shaders(const Pk3Set& pk3, Scene* s) {
+  std::vector<bool> used(s->textures.size(), false);
+  for (const SceneSurface& f : s->surfaces) used[static_cast<size_t>(f.texture)] = true;
+  ShaderTable shaders;
+  for (const std::string& script : pk3.entries("scripts/", ".shader")) {
+    std::vector<uint8_t> text;
+    std::string archive;
+    pk3.read(script, &text, &archive, uint64_t{8} << 20);
+    read_shader_script(std::string(text.begin(), text.end()), archive + ":" + script, &shaders);
+  }
+  for (size_t k = 0; k < s->textures.size(); ++k) {
+    if (!used[k]) continue;
+    SceneTexture& t = s->textures[k];
+    std::string image = t.name;
+    const auto it = shaders.find(lower(t.name));
+    if (it != shaders.end()) {
+      const ShaderInfo& sh = it->second;
+      t.scripted = true;
+      t.blend = sh.blend;
+      t.two_sided = sh.two_sided;
+      t.vertex_colour = sh.vertex_colour || sh.stages == 0;
+      if (sh.sky) t.flags |= 0x4;
+      if (sh.nodraw) t.flags |= 0x80;
+      if (sh.fog) t.contents |= 0x40;
+      if (!sh.image.empty()) image = sh.image;
+    } else {
+      t.vertex_colour = true;  // the game's implicit shader: lightmap, else vertex colours
+    }
+    // The image's own extension is a hint only: the game tries TGA, then JPEG, then PNG.
+    const std::filesystem::path ip(image);
+    const std::string ext = lower(ip.extension().string());
+    if (ext == ".tga" || ext == ".jpg" || ext == ".jpeg" || ext == ".png") image = image.substr(0, image.size() - ext.size());
+    for (const char* e : {".tga", ".jpg", ".png"}) {
+      uint64_t bytes = 0;
+      std::string archive;
+      if (pk3.find(image + e, &bytes, &archive)) {
+        t.file = image + e;
+        t.archive = archive;
+        t.bytes = bytes;
+        break;
+      }
+    }
+  }
+  // Surfaces by their shader: nodraw ones removed, sky, fog and additive ones marked.
+  std::vector<uint32_t> indices;
+  std::vector<SceneSurface> kept;
+  for (SceneSurface f : s->surfaces) {
+    const SceneTexture& t = s->textures[static_cast<size_t>(f.texture)];
+    if (t.flags & 0x80) {
+      ++s->skipped;
+      continue;
+    }
+    if (t.flags & 0x4) f.kind = SurfaceKind::sky;
+    else if (t.contents & 0x40) f.kind = SurfaceKind::fog;
+    else if (t.blend == ShaderBlend::additive) f.kind = SurfaceKind::additive;
+    const uint32_t first = static_cast<uint32_t>(indices.size());
+    indices.insert(indices.end(), s->indices.begin() + f.first_index, s->indices.begin() + f.first_index + f.index_count);
+    f.first_index = first;
+    kept.push_back(f);
+  }
+  s->indices.swap(indices);
+  s->surfaces.swap(kept);
 }
 
 }  // namespace
@@ -119,6 +188,17 @@ bool Pk3Set::read(const std::string& entry, std::vector<uint8_t>* out, std::stri
   return true;
 }
 
+std::vector<std::string> Pk3Set::entries(const std::string& prefix, const std::string& suffix) const {
+  const std::string p = lower(prefix), x = lower(suffix);
+  std::vector<std::string> out;
+  for (const auto& e : index_)
+    if (e.first.size() >= p.size() + x.size() && e.first.compare(0, p.size(), p) == 0 &&
+        e.first.compare(e.first.size() - x.size(), x.size(), x) == 0)
+      out.push_back(e.first);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 std::string openarena_dir() {
   const char* env = std::getenv("VDS_OPENARENA_DIR");
   return env != nullptr && env[0] != '\0' ? env : "/usr/share/games/openarena/baseoa";
@@ -147,27 +227,28 @@ Scene load_scene(const std::string& scene, const SceneOptions& o) {
   } else {
     throw std::runtime_error(scene + ": not a scene this tool reads (a .bsp file or an OpenArena map name)");
   }
-  // Textures as the game finds them: TGA, then JPEG, then PNG; only those
-  // a surface uses.
-  std::vector<bool> used(s.textures.size(), false);
-  for (const SceneSurface& f : s.surfaces) used[static_cast<size_t>(f.texture)] = true;
-  if (std::filesystem::exists(openarena_dir())) {
-    for (size_t k = 0; k < s.textures.size(); ++k) {
-      if (!used[k]) continue;
-      SceneTexture& t = s.textures[k];
-      for (const char* e : {".tga", ".jpg", ".png"}) {
-        uint64_t bytes = 0;
-        std::string archive;
-        if (archives().find(t.name + e, &bytes, &archive)) {
-          t.file = t.name + e;
-          t.archive = archive;
-          t.bytes = bytes;
-          break;
-        }
-      }
-    }
-  }
+  if (std::filesystem::exists(openarena_dir())) apply_shaders(archives(), &s);
   return s;
+}
+
+std::vector<io::Image> load_scene_images(const Scene& s) {
+  std::vector<io::Image> out(s.textures.size());
+  std::unique_ptr<Pk3Set> pk3;
+  for (size_t t = 0; t < s.textures.size(); ++t) {
+    const SceneTexture& tex = s.textures[t];
+    if (tex.file.empty()) continue;
+    if (tex.archive.empty()) {
+      out[t] = io::load_image(tex.file, 4);
+      continue;
+    }
+    if (!pk3) pk3 = std::make_unique<Pk3Set>(openarena_dir());
+    std::vector<uint8_t> bytes;
+    std::string archive;
+    if (!pk3->read(tex.file, &bytes, &archive))
+      throw std::runtime_error(s.name + ": texture " + tex.file + " is no longer in the archives of " + openarena_dir());
+    out[t] = io::decode_image(bytes.data(), bytes.size(), archive + ":" + tex.file, 4);
+  }
+  return out;
 }
 
 }  // namespace vds::enc

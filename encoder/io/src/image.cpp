@@ -176,4 +176,25 @@ Image side_by_side(const std::vector<const Image*>& images, int gap) {
   return out;
 }
 
+Image grid(const std::vector<const Image*>& images, int columns, int gap) {
+  if (images.empty() || columns < 1) throw std::invalid_argument("grid needs at least one image and one column");
+  std::vector<Image> rows;
+  for (size_t i = 0; i < images.size(); i += static_cast<size_t>(columns)) {
+    const std::vector<const Image*> row(images.begin() + static_cast<std::ptrdiff_t>(i),
+                                        images.begin() + static_cast<std::ptrdiff_t>(std::min(images.size(), i + static_cast<size_t>(columns))));
+    rows.push_back(side_by_side(row, gap));
+  }
+  int w = 0, h = 0;
+  for (const Image& r : rows) w = std::max(w, r.width), h += r.height;
+  h += gap * static_cast<int>(rows.size() - 1);
+  Image out(w, h, rows.front().channels);
+  std::fill(out.pixels.begin(), out.pixels.end(), 128);
+  int y0 = 0;
+  for (const Image& r : rows) {
+    for (int y = 0; y < r.height; ++y) std::copy(r.row(y), r.row(y) + static_cast<size_t>(r.width) * r.channels, out.row(y0 + y));
+    y0 += r.height + gap;
+  }
+  return out;
+}
+
 }  // namespace vds::io

@@ -14,7 +14,7 @@ void Y4mWriter::write(const Image& img) {
     if (!out_) throw std::runtime_error(path_ + ": cannot open for writing");
     width_ = img.width;
     height_ = img.height;
-    out_ << "YUV4MPEG2 W" << width_ << " H" << height_ << " F" << fps_ << ":1 Ip A1:1 C444\n";
+    out_ << "YUV4MPEG2 W" << width_ << " H" << height_ << " F" << fps_ << ":1 Ip A1:1 C444 XCOLORRANGE=FULL\n";
   }
   if (img.width != width_ || img.height != height_)
     throw std::invalid_argument(path_ + ": every frame must be " + std::to_string(width_) + "x" + std::to_string(height_));
@@ -30,6 +30,12 @@ void Y4mWriter::write(const Image& img) {
   }
   out_ << "FRAME\n";
   out_.write(reinterpret_cast<const char*>(planes.data()), static_cast<std::streamsize>(planes.size()));
+  if (!out_) throw std::runtime_error(path_ + ": write error");
+}
+
+void Y4mWriter::close() {
+  if (!out_.is_open()) return;
+  out_.close();
   if (!out_) throw std::runtime_error(path_ + ": write error");
 }
 

@@ -34,7 +34,10 @@ struct SceneVertex {
   std::array<uint8_t, 4> color{};  // vertex colour (RGBA)
 };
 
-enum class SurfaceKind : uint8_t { opaque, sky, fog };
+// How a surface is drawn: opaque (alpha-tested when its texture says so),
+// sky (the sky's colour), fog (a fog volume's side: not drawn), additive
+// (an effect added onto what lies behind it, no depth written).
+enum class SurfaceKind : uint8_t { opaque, sky, fog, additive };
 
 // A run of triangles with one texture and one lightmap.
 struct SceneSurface {
@@ -45,12 +48,33 @@ struct SceneSurface {
   uint8_t face_type = 0;                      // the BSP face type (1 polygon, 2 patch, 3 mesh)
 };
 
+// A shader script's definition, reduced to what a walkthrough draws (the
+// rule: encoder/src/scene_shader.cpp and docs/walkthrough.md).
+enum class ShaderBlend : uint8_t { opaque, alpha_test, additive };
+struct ShaderInfo {
+  std::string image;  // the first stage's image ("" if none)
+  ShaderBlend blend = ShaderBlend::opaque;
+  bool sky = false, fog = false, nodraw = false, two_sided = false;
+  bool lightmapped = false;    // a stage draws $lightmap
+  bool vertex_colour = false;  // the image's stage is lit by vertex colours
+  int stages = 0;
+};
+// Shaders by lower-case name.
+using ShaderTable = std::unordered_map<std::string, ShaderInfo>;
+// Adds one script's shaders to `table`, replacing earlier definitions of
+// the same name. Throws std::runtime_error "NAME: what (line N)".
+void read_shader_script(const std::string& text, const std::string& name, ShaderTable* table);
+
 struct SceneTexture {
   std::string name;     // as the map names it ("textures/base_wall/concrete")
   uint32_t flags = 0;   // surface flags
   uint32_t contents = 0;
-  std::string file;     // the archive entry that supplies it ("" if none does)
-  std::string archive;  // the archive holding it
+  bool scripted = false;  // a shader script defines it (the fields below are its)
+  ShaderBlend blend = ShaderBlend::opaque;
+  bool two_sided = false;
+  bool vertex_colour = false;  // lit by vertex colours where it has no lightmap
+  std::string file;     // the image file that supplies it ("" if none does)
+  std::string archive;  // the archive holding it ("" for a file on disk)
   uint64_t bytes = 0;   // the file's size
 };
 
@@ -101,6 +125,8 @@ class Pk3Set {
             uint64_t max_bytes = uint64_t{64} << 20) const;
   // The entry's size and archive without reading it; false if none holds it.
   bool find(const std::string& entry, uint64_t* bytes, std::string* archive) const;
+  // Every entry (lower case) that starts with `prefix` and ends with `suffix`, in name order.
+  std::vector<std::string> entries(const std::string& prefix, const std::string& suffix) const;
 
  private:
   struct Archive;
@@ -114,8 +140,10 @@ class Pk3Set {
 std::string openarena_dir();
 
 // A scene named on the command line: a .bsp file, or a map name looked up
-// as maps/NAME.bsp in the installed OpenArena archives. Textures are
-// resolved in those archives (TGA, then JPEG, then PNG, as the game tries
+// as maps/NAME.bsp in the installed OpenArena archives. The archives'
+// shader scripts (scripts/*.shader, in name order, a later definition
+// replacing an earlier) reduce each texture to one image; images are
+// resolved in the archives (TGA, then JPEG, then PNG, as the game tries
 // them). Throws std::runtime_error naming the scene and the problem.
 Scene load_scene(const std::string& scene, const SceneOptions& o = SceneOptions{});
 

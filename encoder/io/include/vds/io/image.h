@@ -79,5 +79,7 @@ inline void rgb565_to_rgb888(uint16_t p, uint8_t out[3]) {
 
 // Places images side by side in one row with a gap of `gap` pixels (grey).
 Image side_by_side(const std::vector<const Image*>& images, int gap = 4);
+// Places images in rows of `columns` (a contact sheet), `gap` pixels apart (grey).
+Image grid(const std::vector<const Image*>& images, int columns, int gap = 4);
 
 }  // namespace vds::io

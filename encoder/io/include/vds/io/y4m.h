@@ -15,6 +15,9 @@ class Y4mWriter {
   // Appends an RGB frame; every frame must have the first one's size.
   // Throws std::runtime_error naming the file.
   void write(const Image& rgb);
+  // Finishes the file (also done by the destructor, which cannot report a failure).
+  // Throws std::runtime_error naming the file if it could not be written whole.
+  void close();
 
  private:
   std::string path_;
