@@ -82,7 +82,7 @@ void run_scene_info(const InfoOptions& o) {
       missing.push_back(s.textures[t].name);
     }
   }
-  std::printf("%s: Quake III map\n", s.name.c_str());
+  std::printf("%s: %s\n", s.name.c_str(), s.kind.c_str());
   std::printf("  faces              %u polygons, %u patches, %u meshes, %u billboards (dropped); %u skipped (nodraw, hint, skip, or no model)\n",
               s.polygons, s.patches, s.meshes, s.billboards, s.skipped);
   std::printf("  triangles          %zu (%zu lightmapped, %zu sky, %zu in fog, %zu additive), %zu vertices, %zu surfaces\n",

@@ -89,12 +89,24 @@ void run_render(const RenderCmdOptions& o) {
     std::fprintf(stderr, "\rrender: %zu/%zu frames, %.1f s", done, n, s);
     std::fflush(stderr);
   };
-  enc::render_path(renderer, path, o.threads, sink, progress);
-  std::fprintf(stderr, "\n");
-  rgb.close();
-  vis.close();
-  if (!rgb || !vis) throw Failure(kExitBadInput, base + ": writing its .rgb or .vis file failed (disk full?)");
-  y4m.close();
+  // Nothing half-written is left behind: the .part files go if anything fails.
+  const auto remove_parts = [&] {
+    std::error_code ec;
+    for (const char* ext : {".y4m", ".rgb", ".vis"}) std::filesystem::remove(base + ext + ".part", ec);
+  };
+  try {
+    enc::render_path(renderer, path, o.threads, sink, progress);
+    std::fprintf(stderr, "\n");
+    rgb.close();
+    vis.close();
+    if (!rgb || !vis) throw Failure(kExitBadInput, base + ": writing its .rgb or .vis file failed (disk full?)");
+    y4m.close();
+  } catch (...) {
+    rgb.close();
+    vis.close();
+    remove_parts();
+    throw;
+  }
   for (const char* ext : {".y4m", ".rgb", ".vis"}) std::filesystem::rename(base + ext + ".part", base + ext);
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!o.sheet.empty()) {

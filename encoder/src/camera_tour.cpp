@@ -204,7 +204,20 @@ double smoothstep(double t) { return t * t * (3 - 2 * t); }
 
 }  // namespace
 
-CameraPath make_tour(const Scene& s, const SceneRays& rays, const TourOptions& o, TourReport* report) {
+CameraPath make_tour(const Scene& s, const SceneRays& rays, const TourOptions& opt, TourReport* report) {
+  // Lengths are given in Quake units (1/32 m): scaled to the scene's.
+  TourOptions o = opt;
+  const double k = (1.0 / 32) / s.metres_per_unit;
+  o.speed *= k, o.eye_height *= k, o.radius *= k, o.cell *= k;
+  // A scene without spawn points is toured from the centre of its bounds.
+  std::vector<SpawnPoint> spawns = s.spawns;
+  if (spawns.empty()) {
+    SpawnPoint c;
+    for (int a = 0; a < 3; ++a) c.origin[a] = (s.min[a] + s.max[a]) / 2;
+    c.origin[2] -= static_cast<float>(o.eye_height);
+    c.classname = "centre of the bounds";
+    spawns.push_back(c);
+  }
   TourReport rep;
   CameraPath path;
   path.fps = o.fps;
@@ -213,10 +226,10 @@ CameraPath make_tour(const Scene& s, const SceneRays& rays, const TourOptions& o
   // raised a little if that is not clear.
   std::vector<Vec3> eyes;
   std::vector<size_t> ids;
-  for (size_t i = 0; i < s.spawns.size(); ++i) {
-    const auto& sp = s.spawns[i].origin;
+  for (size_t i = 0; i < spawns.size(); ++i) {
+    const auto& sp = spawns[i].origin;
     for (double dz : {0.0, -8.0, 8.0, -16.0, 16.0}) {
-      const Vec3 e = {sp[0], sp[1], sp[2] + o.eye_height + dz};
+      const Vec3 e = {sp[0], sp[1], sp[2] + o.eye_height + dz * k};
       if (rays.clear(e, o.radius)) {
         eyes.push_back(e);
         ids.push_back(i);
@@ -228,7 +241,7 @@ CameraPath make_tour(const Scene& s, const SceneRays& rays, const TourOptions& o
   Grid grid(s, rays, o);
   const size_t frames = o.frames;
   Vec3 pos = eyes[0];
-  double yaw = s.spawns[ids[0]].yaw_deg, pitch = 0;
+  double yaw = spawns[ids[0]].yaw_deg, pitch = 0;
   const auto emit = [&](const Vec3& p, double y, double pt) {
     if (path.frames.size() >= frames) return false;
     double yy = std::fmod(y, 360.0);
@@ -276,7 +289,7 @@ CameraPath make_tour(const Scene& s, const SceneRays& rays, const TourOptions& o
           rep.unreachable.push_back(ids[cand]);
         continue;
       }
-      legs = round_corners(rays, shorten(rays, r, o.radius), o.radius, 4.0);
+      legs = round_corners(rays, shorten(rays, r, o.radius), o.radius, 4.0 * k);
       next = cand;
       break;
     }
@@ -302,7 +315,7 @@ CameraPath make_tour(const Scene& s, const SceneRays& rays, const TourOptions& o
     };
     // Turn to face the way the camera goes before it sets off.
     {
-      const Vec3 ahead = sub(at_arc(64), pos);
+      const Vec3 ahead = sub(at_arc(64 * k), pos);
       const double want = std::atan2(ahead[1], ahead[0]) * 180 / kPi, turn = wrap180(want - yaw), y1 = yaw, p1 = pitch;
       const int turn_frames = static_cast<int>(std::ceil(std::fabs(turn) / 120 * o.fps));
       for (int k = 1; k <= turn_frames; ++k) {
@@ -321,7 +334,7 @@ CameraPath make_tour(const Scene& s, const SceneRays& rays, const TourOptions& o
       else a = 0.5 * o.speed * ramp + o.speed * (t - ramp);
       pos = at_arc(a);
       // Look where the camera goes: a point ahead on the route.
-      const Vec3 ahead = sub(at_arc(a + 64), pos);
+      const Vec3 ahead = sub(at_arc(a + 64 * k), pos);
       const double h = std::hypot(ahead[0], ahead[1]);
       if (h > 1) {
         const double want = std::atan2(ahead[1], ahead[0]) * 180 / kPi;

@@ -11,8 +11,6 @@
 #include <set>
 #include <stdexcept>
 
-#include <assimp/BaseImporter.h>
-#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -21,51 +19,11 @@
 #include <draco/mesh/triangle_soup_mesh_builder.h>
 #include <draco/core/decoder_buffer.h>
 
-#include "mesh_glb_check.h"
-#include "mesh_ply_check.h"
+#include "assimp_read.h"
 #include "vds/enc/stream_writer.h"
 
 namespace vds::enc {
 namespace {
-
-// Assimp's file access confined to the model's own folder: a file that
-// references others (glTF buffers and images, OBJ materials) may open only
-// files in that folder or below it, never an absolute path elsewhere or a
-// path leading out with "..". A model held in memory may open none.
-class ConfinedIO : public Assimp::DefaultIOSystem {
- public:
-  explicit ConfinedIO(std::filesystem::path root) : root_(std::move(root)) {}
-  bool Exists(const char* file) const override {
-    const std::string p = resolve(file);
-    return !p.empty() && DefaultIOSystem::Exists(p.c_str());
-  }
-  Assimp::IOStream* Open(const char* file, const char* mode) override {
-    const std::string p = resolve(file);
-    if (p.empty() || std::strchr(mode, 'w') != nullptr || std::strchr(mode, 'a') != nullptr) return nullptr;
-    return DefaultIOSystem::Open(p.c_str(), mode);
-  }
-  // The first file the importer was not allowed to open.
-  const std::string& refused() const { return refused_; }
-
- private:
-  // A file the model names (relative to the model's folder), as an absolute
-  // path inside that folder; "" (and noted) if it lies outside.
-  std::string resolve(const char* file) const {
-    if (file == nullptr) return "";
-    std::filesystem::path p(file);
-    std::error_code ec;
-    if (!root_.empty() && p.is_relative()) p = root_ / p;
-    const std::string a = root_.empty() ? "" : std::filesystem::weakly_canonical(p, ec).string();
-    const std::string r = root_.string();
-    if (ec || a.size() <= r.size() || a.compare(0, r.size(), r) != 0 || a[r.size()] != '/') {
-      if (refused_.empty()) refused_ = file;
-      return "";
-    }
-    return a;
-  }
-  std::filesystem::path root_;
-  mutable std::string refused_;
-};
 
 // The importer set up for a mesh: positions and faces only (no normals, UVs
 // or materials are needed, and the importer must not weld: we weld by our
@@ -109,16 +67,6 @@ Mesh from_scene(const aiScene* scene, MeshRepairReport* report) {
   return m;
 }
 
-// The formats assimp reads for this tool: the ones its fuzz harness covers
-// (tests/fuzz/fuzz_mesh_import.cpp). Assimp reads dozens more, some of
-// which trust the counts a file declares.
-bool imported_format(const std::string& ext) {
-  static const char* const kFormats[] = {"obj", "ply", "gltf", "glb", "3ds"};
-  for (const char* f : kFormats)
-    if (ext == f) return true;
-  return false;
-}
-
 bool is_draco(const uint8_t* data, size_t size) { return size >= 5 && std::memcmp(data, "DRACO", 5) == 0; }
 
 // The file name's extension, lower case, without the dot ("" if none).
@@ -144,39 +92,9 @@ Mesh load_bytes(const uint8_t* data, size_t size, const std::string& name, const
     }
     return m;
   }
-  // PLY is checked by the project's own reader first: assimp's PLY loader
-  // trusts the header's counts and list lengths.
-  const bool ply = hint == "ply" || looks_like_ply(data, size);
-  if (ply) check_ply(data, size, name);
-  // Content that says PLY or GLB is checked as such whatever the name says.
-  const bool glb = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
-  const std::string format = ply ? "ply" : glb ? "glb" : hint;
-  // GLB's lengths are checked by the project's own reader first: assimp
-  // allocates what they say.
-  if (format == "glb") check_glb(data, size, name);
   Assimp::Importer importer;
   configure(importer);
-  ConfinedIO* io = new ConfinedIO(root);  // owned by the importer
-  importer.SetIOHandler(io);
-  // Only the loader of the format the name says: assimp would otherwise
-  // guess from the content (any file with "ply" in its first 200 bytes
-  // looks like a PLY to it) and hand the bytes to a loader nothing checked.
-  if (!imported_format(format) || importer.GetImporter(format.c_str()) == nullptr)
-    throw std::runtime_error(name + ": not a mesh format this tool reads ('" + format +
-                             "'; it reads .obj, .ply, .gltf, .glb, .3ds and .drc)");
-  for (size_t i = importer.GetImporterCount(); i-- > 0;) {
-    Assimp::BaseImporter* loader = importer.GetImporter(i);
-    std::set<std::string> extensions;
-    loader->GetExtensionList(extensions);
-    // Every loader that claims the extension stays (glTF 1 and 2 share one).
-    if (extensions.count(format) == 0 && importer.UnregisterLoader(loader) == aiReturn_SUCCESS)
-      delete loader;  // the importer owns its loaders only while they are registered
-  }
-  const aiScene* scene = importer.ReadFileFromMemory(data, size, kImportSteps, format.c_str());
-  if (!io->refused().empty())
-    throw std::runtime_error(name + ": refers to '" + io->refused() +
-                             "', which is not in the model's folder (only files beside the model or below it are read)");
-  if (scene == nullptr) throw std::runtime_error(name + ": cannot import: " + importer.GetErrorString());
+  const aiScene* scene = read_with_assimp(importer, data, size, name, hint, root, kImportSteps);
   return from_scene(scene, report);
 }
 

@@ -224,8 +224,10 @@ Scene load_scene(const std::string& scene, const SceneOptions& o) {
                                " (install openarena-data, or set VDS_OPENARENA_DIR)");
     s = read_bsp(bytes.data(), bytes.size(), archive + ":" + entry, o);
     s.name = scene;
+  } else if (ext == ".gltf" || ext == ".glb" || ext == ".obj") {
+    return load_model_scene(scene);
   } else {
-    throw std::runtime_error(scene + ": not a scene this tool reads (a .bsp file or an OpenArena map name)");
+    throw std::runtime_error(scene + ": not a scene this tool reads (a .bsp, .gltf, .glb or .obj file, or an OpenArena map name)");
   }
   if (std::filesystem::exists(openarena_dir())) apply_shaders(archives(), &s);
   return s;
@@ -237,6 +239,10 @@ std::vector<io::Image> load_scene_images(const Scene& s) {
   for (size_t t = 0; t < s.textures.size(); ++t) {
     const SceneTexture& tex = s.textures[t];
     if (tex.file.empty()) continue;
+    if (!tex.embedded.empty()) {
+      out[t] = io::decode_image(tex.embedded.data(), tex.embedded.size(), s.name + ":" + tex.file, 4);
+      continue;
+    }
     if (tex.archive.empty()) {
       out[t] = io::load_image(tex.file, 4);
       continue;

@@ -152,16 +152,19 @@ SceneCamera scene_camera(const CameraPose& pose, double hfov_deg, int width, int
 SceneRenderer::SceneRenderer(const Scene& scene, std::vector<io::Image> images, const RenderOptions& o)
     : opt_(o), p_(new Prepared) {
   if (o.width < 1 || o.height < 1 || o.width > 8192 || o.height > 8192 || o.supersample < 1 || o.supersample > 8 ||
-      o.max_aniso < 1 || o.max_aniso > 16 || o.overbright_bits < 0 || o.overbright_bits > 4 || !(o.near_z > 0)) {
+      o.max_aniso < 1 || o.max_aniso > 16 || o.overbright_bits < 0 || o.overbright_bits > 4 || !(o.near_m > 0) ||
+      !(scene.metres_per_unit > 0)) {
     delete p_;
     throw std::invalid_argument("render options out of range");
   }
   Prepared& P = *p_;
+  const int bits = scene.overbright ? o.overbright_bits : 0;
+  opt_.near_z = o.near_m / scene.metres_per_unit;
   for (const SceneVertex& v : scene.vertices) {
     P.pos.push_back({v.pos[0], v.pos[1], v.pos[2]});
     P.uv.push_back({v.uv[0], v.uv[1]});
     P.lm_uv.push_back({v.lm_uv[0], v.lm_uv[1]});
-    P.vcolor.push_back(overbright(v.color.data(), o.overbright_bits));
+    P.vcolor.push_back(overbright(v.color.data(), bits));
   }
   P.textures.resize(scene.textures.size());
   for (size_t t = 0; t < scene.textures.size(); ++t) {
@@ -189,7 +192,7 @@ SceneRenderer::SceneRenderer(const Scene& scene, std::vector<io::Image> images, 
   for (const auto& lm : scene.lightmaps) {
     std::vector<float> f(lm.size());
     for (size_t i = 0; i + 2 < lm.size(); i += 3) {
-      const auto c = overbright(&lm[i], o.overbright_bits);
+      const auto c = overbright(&lm[i], bits);
       f[i] = c[0], f[i + 1] = c[1], f[i + 2] = c[2];
     }
     P.lightmaps.push_back(std::move(f));

@@ -237,6 +237,37 @@ check("vds image header" in out and "skipped as unknown" in out and ", 0 skipped
 run("info_garbage", ["info", write("garbage.vds", bytes(range(256)) * 8)], os.path.join(TMP, "garbage.vds"), 1,
     "garbage.vds")
 
+# --- Scenes and camera paths -----------------------------------------------------------------
+# A Quake III map whose face lump claims 2^31 bytes; a camera path with a word for a number;
+# a scene whose texture lies outside its folder; a good scene rendered whole.
+bsp = bytearray(b"IBSP" + struct.pack("<i", 46) + b"\0" * (17 * 8))
+struct.pack_into("<II", bsp, 8 + 8 * 13, 152, 0x7FFFFFF0)
+bad_bsp = write("bad.bsp", bytes(bsp))
+run("bsp_face_lump_past_the_end", ["info", bad_bsp], bad_bsp, 1, "bad.bsp")
+path_out = os.path.join(TMP, "tour.txt")
+run("path_tour_of_a_bad_map", ["path", bad_bsp, "-o", path_out], bad_bsp, 1, "bad.bsp", path_out)
+scene_dir = os.path.join(TMP, "scene")
+os.makedirs(scene_dir, exist_ok=True)
+with open(os.path.join(scene_dir, "room.obj"), "w") as f:
+    f.write("mtllib room.mtl\nv -5 -5 -5\nv 5 -5 -5\nv 5 5 -5\nv -5 5 -5\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+            "usemtl wall\nf 1/1 2/2 3/3 4/4\n")
+with open(os.path.join(scene_dir, "room.mtl"), "w") as f:
+    f.write("newmtl wall\nmap_Kd wall.png\n")
+with open(os.path.join(scene_dir, "wall.png"), "wb") as f:
+    f.write(small)
+room = os.path.join(scene_dir, "room.obj")
+bad_path = write("bad_path.txt", "# hfov 90\n0 0 0 0 90 0\n1 0 zero 0 90 0\n")
+render_out = os.path.join(TMP, "gt")
+run("render_bad_path", ["render", room, "--path", bad_path, "-o", render_out], bad_path, 1, "line 3",
+    render_out + ".y4m")
+good_path = write("good_path.txt", "".join(f"{i} 0 0 0 {90 + i} 0\n" for i in range(20)))
+run("render_obj_scene", ["render", room, "--path", good_path, "-o", render_out], room, 0, output=render_out + ".vis")
+check(os.path.getsize(render_out + ".rgb") == 20 * 240 * 180 * 3, "vds render writes 20 frames of RGB")
+with open(os.path.join(scene_dir, "room.mtl"), "w") as f:
+    f.write("newmtl wall\nmap_Kd ../../outside.png\n")
+run("render_texture_outside_the_folder", ["render", room, "--path", good_path, "-o", render_out], room, 1,
+    "not in the scene's folder", render_out + ".y4m")
+
 if REPORT:
     with open(REPORT, "w") as f:
         for name, code, spent, rss in rows:

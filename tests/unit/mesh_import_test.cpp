@@ -5,9 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <random>
 #include <string>
+
+#include <unistd.h>
 
 #include "mesh_test_meshes.h"
 #include "vds/enc/mesh_import.h"
@@ -376,3 +380,35 @@ TEST(MeshImportHostile, EveryPrefixOfAPlyOrGlbIsRefused) {
                           le32(static_cast<uint32_t>(json.size())) + "JSON" + json;
   for (size_t n = 0; n < glb.size(); ++n) EXPECT_NE(refusal(glb.substr(0, n), "m.glb"), "") << "glb prefix " << n;
 }
+
+namespace {
+
+TEST(MeshImportHostile, AnObjIsNeverReadAsItsOwnMaterialLibrary) {
+  // The importer's fallback for a material library it cannot open is the
+  // model's own name with .mtl: read from memory, that once served the OBJ
+  // itself as its material library, whose texture statement before any
+  // material crashed the loader.
+  for (const std::string obj : {"mtllib r \nmap_Kd a\n", "mtllib x y\nmap_Kd a\n", "map_Ka\nmtllib r \n",
+                                "mtllib r \nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nmap_Kd a\n"}) {
+    const std::string r = refusal(obj, "m.obj");
+    EXPECT_TRUE(r.empty() || r.rfind("m.obj: ", 0) == 0) << r;  // read or refused by name; never a crash
+  }
+}
+
+TEST(MeshImportHostile, AMaterialLibraryWithATextureBeforeAnyMaterialIsRefused) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("vds_mtl_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "a.obj") << "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(dir / "m.mtl") << "# textures\n\nmap_Kd x.png\nnewmtl a\n";
+  try {
+    vds::enc::load_mesh_file((dir / "a.obj").string());
+    ADD_FAILURE() << "accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), (dir / "a.obj").string() + ": m.mtl: 'map_Kd' before any 'newmtl' (line 3)");
+  }
+  std::ofstream(dir / "m.mtl") << "newmtl a\nmap_Kd x.png\n";
+  EXPECT_EQ(vds::enc::load_mesh_file((dir / "a.obj").string()).triangles.size(), 1u);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace

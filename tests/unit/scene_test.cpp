@@ -16,6 +16,10 @@
 
 #include "bsp_builder.h"
 #include "vds/enc/scene.h"
+#include "vds/enc/scene_render.h"
+#include "vds/io/image.h"
+
+#include <unistd.h>
 
 namespace {
 
@@ -215,6 +219,142 @@ TEST(SceneBsp, TheInstalledMapsReadWhole) {
     EXPECT_GT(found, s.textures.size() / 2) << map;
   }
   EXPECT_THROW(vds::enc::load_scene("no_such_map"), std::runtime_error);
+}
+
+}  // namespace
+
+namespace {
+
+// A textured OBJ scene written to a temporary folder: one wall 5 m in
+// front of the origin (Y up in the file), its texture beside it.
+std::filesystem::path write_obj_scene(const std::string& texture_ref, bool write_texture) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("vds_scene_obj_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "room.obj") << "mtllib room.mtl\nv -5 -5 -5\nv 5 -5 -5\nv 5 5 -5\nv -5 5 -5\n"
+                                     "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nusemtl wall\n"
+                                     "f 1/1/1 2/2/1 3/3/1 4/4/1\n";
+  std::ofstream(dir / "room.mtl") << "newmtl wall\nKd 1 1 1\nmap_Kd " << texture_ref << "\n";
+  if (write_texture) {
+    vds::io::Image im(4, 4, 3);
+    for (size_t i = 0; i < im.pixels.size(); i += 3) im.pixels[i] = 10, im.pixels[i + 1] = 200, im.pixels[i + 2] = 30;
+    vds::io::save_png((dir / "wall.png").string(), im);
+  }
+  return dir;
+}
+
+TEST(SceneModel, ATexturedObjSceneIsReadAndDrawn) {
+  const std::filesystem::path dir = write_obj_scene("wall.png", true);
+  const Scene s = vds::enc::load_scene((dir / "room.obj").string());
+  EXPECT_EQ(s.kind, "OBJ scene");
+  EXPECT_EQ(s.triangles(), 2u);
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_FALSE(s.textures[0].file.empty());
+  // Y up in the file: the wall at z = -5 is at y = 5 here, seen looking along +Y (yaw 90).
+  EXPECT_NEAR(s.min[1], 5.0f, 1e-6f);
+  EXPECT_NEAR(s.max[2], 5.0f, 1e-6f);
+  const vds::enc::SceneRenderer r(s, vds::enc::load_scene_images(s));
+  const vds::enc::SceneFrame f = r.render({0, 0, 0, 90, 0}, 90);
+  const size_t c = 90 * 240 + 120;
+  EXPECT_NEAR(f.depth[c], 5.0f, 1e-4f);
+  EXPECT_EQ(f.rgb.at(120, 90, 0), 10);  // no lightmap, no overbright: the texture as it is
+  EXPECT_EQ(f.rgb.at(120, 90, 1), 200);
+  EXPECT_EQ(f.rgb.at(120, 90, 2), 30);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(SceneModel, TexturesOutsideTheFolderAreRefusedAndMissingOnesAreGrey) {
+  std::filesystem::path dir = write_obj_scene("../outside.png", false);
+  try {
+    vds::enc::load_scene((dir / "room.obj").string());
+    ADD_FAILURE() << "a texture outside the scene's folder was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("names texture '../outside.png', which is not in the scene's folder"), std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove_all(dir);
+  dir = write_obj_scene("missing.png", false);
+  const Scene s = vds::enc::load_scene((dir / "room.obj").string());
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_TRUE(s.textures[0].file.empty());
+  const vds::enc::SceneFrame f = vds::enc::SceneRenderer(s, vds::enc::load_scene_images(s)).render({0, 0, 0, 90, 0}, 90);
+  EXPECT_EQ(f.rgb.at(120, 90, 1), 128);
+  std::filesystem::remove_all(dir);
+  EXPECT_THROW(vds::enc::load_scene("no_such_scene.gltf"), std::runtime_error);
+  EXPECT_THROW(vds::enc::load_scene("scene.fbx"), std::runtime_error);
+}
+
+}  // namespace
+
+namespace {
+
+void put_u32(std::vector<uint8_t>& b, uint32_t v) {
+  for (int k = 0; k < 4; ++k) b.push_back(static_cast<uint8_t>(v >> (8 * k)));
+}
+void put_f32(std::vector<uint8_t>& b, float f) {
+  uint32_t v;
+  std::memcpy(&v, &f, 4);
+  put_u32(b, v);
+}
+
+TEST(SceneModel, AGlbSceneWithAnEmbeddedTextureKeepsItsOrientation) {
+  // A wall 5 m ahead (Y up), texture top half red and bottom half blue,
+  // texture coordinates from the top-left corner as glTF defines them.
+  vds::io::Image im(4, 4, 3);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) im.at(x, y, 0) = y < 2 ? 255 : 0, im.at(x, y, 1) = 0, im.at(x, y, 2) = y < 2 ? 0 : 255;
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("vds_scene_glb_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  vds::io::save_png((dir / "t.png").string(), im);
+  std::ifstream pf(dir / "t.png", std::ios::binary);
+  const std::vector<uint8_t> png((std::istreambuf_iterator<char>(pf)), std::istreambuf_iterator<char>());
+  std::vector<uint8_t> bin;
+  const float pos[4][3] = {{-5, 5, -5}, {5, 5, -5}, {5, -5, -5}, {-5, -5, -5}};
+  const float uv[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  for (const auto& p : pos)
+    for (float f : p) put_f32(bin, f);
+  for (const auto& t : uv)
+    for (float f : t) put_f32(bin, f);
+  for (uint16_t i : {0, 2, 1, 0, 3, 2}) bin.push_back(static_cast<uint8_t>(i)), bin.push_back(static_cast<uint8_t>(i >> 8));
+  const size_t png_at = bin.size();
+  bin.insert(bin.end(), png.begin(), png.end());
+  while (bin.size() % 4) bin.push_back(0);
+  std::string json =
+      "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0}],"
+      "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":1},\"indices\":2,\"material\":0}]}],"
+      "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}}],"
+      "\"textures\":[{\"source\":0}],\"images\":[{\"bufferView\":3,\"mimeType\":\"image/png\"}],"
+      "\"buffers\":[{\"byteLength\":" + std::to_string(bin.size()) + "}],"
+      "\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\"byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":32},"
+      "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":12},{\"buffer\":0,\"byteOffset\":" + std::to_string(png_at) +
+      ",\"byteLength\":" + std::to_string(png.size()) + "}],"
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\",\"min\":[-5,-5,-5],\"max\":[5,5,-5]},"
+      "{\"bufferView\":1,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"},"
+      "{\"bufferView\":2,\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"}]}";
+  while (json.size() % 4) json += ' ';
+  std::vector<uint8_t> glb;
+  put_u32(glb, 0x46546C67);  // "glTF"
+  put_u32(glb, 2);
+  put_u32(glb, static_cast<uint32_t>(12 + 8 + json.size() + 8 + bin.size()));
+  put_u32(glb, static_cast<uint32_t>(json.size()));
+  put_u32(glb, 0x4E4F534A);  // "JSON"
+  glb.insert(glb.end(), json.begin(), json.end());
+  put_u32(glb, static_cast<uint32_t>(bin.size()));
+  put_u32(glb, 0x004E4942);  // "BIN"
+  glb.insert(glb.end(), bin.begin(), bin.end());
+  std::ofstream(dir / "wall.glb", std::ios::binary).write(reinterpret_cast<const char*>(glb.data()), static_cast<std::streamsize>(glb.size()));
+
+  const Scene s = vds::enc::load_scene((dir / "wall.glb").string());
+  EXPECT_EQ(s.kind, "glTF scene");
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].embedded.size(), png.size());
+  const vds::enc::SceneFrame f = vds::enc::SceneRenderer(s, vds::enc::load_scene_images(s)).render({0, 0, 0, 90, 0}, 90);
+  // The wall fills the view: red above the middle, blue below.
+  EXPECT_GT(f.rgb.at(120, 40, 0), 200);
+  EXPECT_LT(f.rgb.at(120, 40, 2), 50);
+  EXPECT_GT(f.rgb.at(120, 140, 2), 200);
+  EXPECT_LT(f.rgb.at(120, 140, 0), 50);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -23,6 +23,8 @@
 
 namespace vds::enc {
 
+// Lengths and speeds in Quake map units (1/32 m), scaled to the scene's own
+// units by Scene::metres_per_unit.
 struct TourOptions {
   size_t frames = 600;
   double fps = 20;
@@ -43,8 +45,9 @@ struct TourReport {
   double min_clearance = 0;        // the least distance to a triangle along the 26 directions, over all frames
 };
 
-// Throws std::runtime_error when the scene has no spawn point whose eye
-// position is clear of the geometry.
+// A scene without spawn points is toured from the centre of its bounds.
+// Throws std::runtime_error when no spawn point's eye position is clear of
+// the geometry.
 CameraPath make_tour(const Scene& s, const SceneRays& rays, const TourOptions& o, TourReport* report = nullptr);
 
 }  // namespace vds::enc

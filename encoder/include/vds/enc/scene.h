@@ -76,6 +76,7 @@ struct SceneTexture {
   std::string file;     // the image file that supplies it ("" if none does)
   std::string archive;  // the archive holding it ("" for a file on disk)
   uint64_t bytes = 0;   // the file's size
+  std::vector<uint8_t> embedded;  // the image file's bytes when the scene file holds them (GLB)
 };
 
 struct SpawnPoint {
@@ -88,6 +89,9 @@ constexpr int kLightmapSide = 128;
 
 struct Scene {
   std::string name;
+  std::string kind = "Quake III map";
+  double metres_per_unit = 1.0 / 32;  // Quake: a player (56 units) is 1.75 m
+  bool overbright = true;             // lightmaps and vertex colours brightened as the game does
   std::vector<SceneVertex> vertices;
   std::vector<uint32_t> indices;  // triangles
   std::vector<SceneSurface> surfaces;
@@ -139,7 +143,20 @@ class Pk3Set {
 // Debian's /usr/share/games/openarena/baseoa.
 std::string openarena_dir();
 
-// A scene named on the command line: a .bsp file, or a map name looked up
+// A textured glTF 2.0 (.gltf, .glb) or OBJ (+ MTL) scene through assimp,
+// by rule: Y up in the file becomes Z up (x, -z, y); metres; each material's
+// base colour (glTF) or diffuse (OBJ) texture, from the file (GLB) or a
+// file beside the scene or below its folder (anything else is refused);
+// vertex colours, else the material's colour, multiply the texture; no
+// lightmaps and no overbright (the scene is drawn as its colours say);
+// faces that are not triangles dropped. Spawn points: none (a tour starts
+// at the centre of the scene's bounds). Throws naming the file.
+Scene load_model_scene(const std::string& path);
+// The same from memory (`name` gives the format by its extension); it may
+// open no other file, so a texture outside the bytes is missing.
+Scene read_model_scene(const uint8_t* data, size_t size, const std::string& name);
+
+// A scene named on the command line: a .gltf, .glb or .obj file (above), a .bsp file, or a map name looked up
 // as maps/NAME.bsp in the installed OpenArena archives. The archives'
 // shader scripts (scripts/*.shader, in name order, a later definition
 // replacing an earlier) reduce each texture to one image; images are

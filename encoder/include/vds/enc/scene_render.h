@@ -28,8 +28,10 @@ struct RenderOptions {
   int width = 240, height = 180;
   int supersample = 2;      // n x n samples per pixel, box-filtered
   int max_aniso = 8;        // samples along a stretched footprint (1: plain trilinear)
-  int overbright_bits = 2;  // lightmaps and vertex colours x 2^bits, clamped keeping their hue (the game's r_mapOverBrightBits)
-  double near_z = 1.0;      // map units
+  int overbright_bits = 2;  // lightmaps and vertex colours x 2^bits, clamped keeping their hue (the game's
+                            // r_mapOverBrightBits), for scenes with Scene::overbright
+  double near_m = 1.0 / 32;  // the near clipping plane, metres (a Quake map unit)
+  double near_z = 0;         // the same in the scene's units (set by SceneRenderer)
 };
 
 struct SceneCamera {
