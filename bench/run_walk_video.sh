@@ -18,7 +18,10 @@
 #      frames against the ground truth, luma PSNR and SSIM (BT.601 luma,
 #      11x11 Gaussian window) as second measures; each codec's PSNR at 8, 16
 #      and 32 kbit/s read off its points (linear in log-rate between the two
-#      nearest, never extrapolated).
+#      nearest, never extrapolated);
+#   4. what a client must hold (walk_visibility.md, bench/walk_visibility.py):
+#      triangles visible per frame, first seen, and hot within a window,
+#      from the ground truth's visibility buffers.
 #
 # Usage: bench/run_walk_video.sh [BUILD_DIR]     (default build/host-release)
 #   MAPS="oa_dm4 oa_dm5 oa_rpg3dm2"  the maps;  FRAMES=600  the tour's length;
@@ -40,6 +43,8 @@ done
 WORK=${WORK:-$BUILD/walk}
 RESULTS=${RESULTS:-$ROOT/bench/results}
 mkdir -p "$WORK" "$RESULTS"
-exec $PY "$ROOT/bench/walk_anchors.py" --vds "$VDS" --work "$WORK" --results "$RESULTS" \
+$PY "$ROOT/bench/walk_anchors.py" --vds "$VDS" --work "$WORK" --results "$RESULTS" \
   --maps ${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2} --frames "${FRAMES:-600}" --svt-preset "${SVT_PRESET:-1}" \
   --aom-cpu "${AOM_CPU:-2}" ${QUICK:+--quick}
+MAPS_LIST=${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2}
+$PY "$ROOT/bench/walk_visibility.py" --work "$WORK" --results "$RESULTS" --vds "$VDS" --maps $MAPS_LIST
