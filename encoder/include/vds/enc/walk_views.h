@@ -1,0 +1,66 @@
+// vds encoder: which stored view serves each polygon of a walkthrough frame,
+// and when a new view must be sent — the view schedule of the walkthrough
+// mode (Cohen-Or, Mann, Fleishman, "Deep compression for streaming texture
+// intensive animations", section 4).
+//
+// The client holds `slots` views: images rendered offline at cameras of the
+// path (past or future frames). It draws each polygon of a frame mapped from
+// the held view whose texture quality factor for it (vds/homography.h:
+// the largest magnification of the view -> screen map, here at the vertices
+// of the part of the polygon the frame's screen shows, in front of the
+// view's near plane, so that polygons reaching behind either camera have a
+// factor) is smallest; a polygon the view does not show (not in that
+// frame's visibility) cannot be served by it. When a frame shows a polygon
+// that no held view serves with a factor at most `threshold`, a view
+// update is due at that frame, into the slot whose view serves the fewest
+// of the frame's pixels: rendered at the camera of a frame up to
+// `lookahead` frames ahead — the farthest such that every frame from this
+// one to it serves, within the threshold, every polygon this frame shows
+// that the other views do not (views from the future are allowed: the
+// stream is precomputed); the frame's own camera always does. Magnifications are computed with
+// the client's own fixed-point homography (vds/homography.h); the stream
+// carries each polygon's choice, so the client need not repeat them.
+#pragma once
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "vds/enc/camera_path.h"
+#include "vds/enc/scene.h"
+#include "vds/render_camera.h"
+
+namespace vds::enc {
+
+// The client's fixed-point camera for a pose (vds/enc/scene_render.h's
+// camera model), with clip distances in scene units.
+vds::Camera client_camera(const CameraPose& pose, double hfov_deg, int width, int height, double near_z, double far_z);
+
+struct WalkViewOptions {
+  int slots = 2;
+  double threshold = 1.35;  // largest magnification a view may serve with
+  int lookahead = 20;       // frames ahead a new view's camera may be taken from
+  int width = 240, height = 180;
+  double near_z = 1, far_z = 4096;  // scene units
+};
+
+struct WalkViewPlan {
+  struct Update {
+    uint32_t slot;
+    uint32_t camera_frame;  // the path frame whose camera the view is rendered at
+  };
+  std::vector<std::vector<Update>> updates;  // per frame: views to have arrived by that frame
+  // Per frame, per visible polygon (as given): the slot that serves it, -1 for none.
+  std::vector<std::vector<int8_t>> choice;
+  size_t pixels = 0;                // visible pixels over all frames
+  size_t pixels_within = 0;         // served with a factor <= threshold
+  size_t pixels_sharp = 0;          // served with a factor <= 1 (no magnification)
+  size_t pixels_unserved = 0;       // by no held view (a hole until an update arrives)
+};
+
+// `visible[f]`: (polygon, pixels it covers) for each polygon frame f shows,
+// from the ground truth's visibility buffers.
+WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
+                             const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>& visible,
+                             const WalkViewOptions& o = WalkViewOptions{});
+
+}  // namespace vds::enc

@@ -1,0 +1,194 @@
+// vds encoder: the walkthrough's view schedule (vds/enc/walk_views.h).
+#include "vds/enc/walk_views.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <unordered_set>
+
+#include "vds/enc/scene_render.h"
+#include "vds/homography.h"
+
+namespace vds::enc {
+
+namespace {
+
+Q16_16 q16(double v) {
+  const double r = std::round(v * 65536.0);
+  if (!(std::fabs(r) < 2147483647.0)) throw std::runtime_error("a value outside the client's Q16.16 range: " + std::to_string(v));
+  return Q16_16::from_raw(static_cast<int32_t>(r));
+}
+Q2_30 q30(double v) { return Q2_30::from_raw(static_cast<int32_t>(std::lround(std::clamp(v, -1.0, 1.0) * 1073741823.0))); }
+
+}  // namespace
+
+vds::Camera client_camera(const CameraPose& pose, double hfov_deg, int width, int height, double near_z, double far_z) {
+  const SceneCamera c = scene_camera(pose, hfov_deg, width, height);
+  vds::Camera k{};
+  const std::array<double, 3>* rows[3] = {&c.right, &c.down, &c.forward};
+  for (int r = 0; r < 3; ++r)
+    for (int j = 0; j < 3; ++j) k.rotation.m[r][j] = q30((*rows[r])[static_cast<size_t>(j)]);
+  k.position = {q16(c.position[0]), q16(c.position[1]), q16(c.position[2])};
+  k.fx = k.fy = q16(c.focal);
+  k.cx = q16(c.cx);
+  k.cy = q16(c.cy);
+  k.near_z = q16(near_z);
+  k.far_z = q16(far_z);
+  return k;
+}
+
+WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
+                             const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>& visible,
+                             const WalkViewOptions& o) {
+  const size_t n = path.frames.size();
+  if (visible.size() != n) throw std::invalid_argument("plan_walk_views: one visibility list per frame");
+  if (o.slots < 1 || o.slots > 127 || o.lookahead < 0 || !(o.threshold > 0))
+    throw std::invalid_argument("plan_walk_views: options out of range");
+  std::vector<vds::Camera> cams;
+  for (const CameraPose& p : path.frames) cams.push_back(client_camera(p, path.hfov_deg, o.width, o.height, o.near_z, o.far_z));
+  // Polygons each frame shows, for "does view v show polygon p".
+  std::vector<std::unordered_set<uint32_t>> shows(n);
+  for (size_t f = 0; f < n; ++f)
+    for (const auto& [id, px] : visible[f]) shows[f].insert(id);
+  std::vector<SceneCamera> scams;
+  for (const CameraPose& p : path.frames) scams.push_back(scene_camera(p, path.hfov_deg, o.width, o.height));
+  const double inf = std::numeric_limits<double>::infinity();
+  // The factor of the view at frame g for polygon id on frame f's screen
+  // (+inf if g does not show it): the largest magnification of the
+  // view -> screen map (the client's fixed-point homography_scale) at the
+  // vertices of the part of the polygon frame f's screen shows, in front of
+  // the view's near plane.
+  const auto factor = [&](size_t f, size_t g, uint32_t id) {
+    if (!shows[g].count(id)) return inf;
+    using P3 = std::array<double, 3>;
+    std::vector<P3> poly;
+    for (int k = 0; k < 3; ++k) {
+      const auto& v = s.vertices[s.indices[3 * static_cast<size_t>(id) + static_cast<size_t>(k)]].pos;
+      poly.push_back({v[0], v[1], v[2]});
+    }
+    // Clip against planes a . (P - C) >= b of the screen's frustum and the view's near plane.
+    const SceneCamera& sc = scams[f];
+    const SceneCamera& vc = scams[g];
+    struct Plane {
+      P3 a, c;
+      double b;
+    };
+    const double l = sc.cx / sc.focal, r = (o.width - sc.cx) / sc.focal, t = sc.cy / sc.focal, btm = (o.height - sc.cy) / sc.focal;
+    const auto comb = [](const P3& u, double su, const P3& w, double sw) {
+      return P3{u[0] * su + w[0] * sw, u[1] * su + w[1] * sw, u[2] * su + w[2] * sw};
+    };
+    const Plane planes[6] = {{sc.forward, sc.position, o.near_z},
+                             {comb(sc.right, 1, sc.forward, l), sc.position, 0},
+                             {comb(sc.right, -1, sc.forward, r), sc.position, 0},
+                             {comb(sc.down, 1, sc.forward, t), sc.position, 0},
+                             {comb(sc.down, -1, sc.forward, btm), sc.position, 0},
+                             {vc.forward, vc.position, o.near_z * 1.01}};
+    for (const Plane& pl : planes) {
+      std::vector<P3> out;
+      const auto dist = [&](const P3& p) {
+        return pl.a[0] * (p[0] - pl.c[0]) + pl.a[1] * (p[1] - pl.c[1]) + pl.a[2] * (p[2] - pl.c[2]) - pl.b;
+      };
+      for (size_t i = 0; i < poly.size(); ++i) {
+        const P3& a = poly[i];
+        const P3& b = poly[(i + 1) % poly.size()];
+        const double da = dist(a), db = dist(b);
+        if (da >= 0) out.push_back(a);
+        if ((da >= 0) != (db >= 0)) out.push_back(comb(a, db / (db - da), b, -da / (db - da)));
+      }
+      poly.swap(out);
+      if (poly.empty()) return inf;
+    }
+    Vec3<Q16_16> tri[3];
+    for (int k = 0; k < 3; ++k) {
+      const auto& v = s.vertices[s.indices[3 * static_cast<size_t>(id) + static_cast<size_t>(k)]].pos;
+      tri[k] = {q16(v[0]), q16(v[1]), q16(v[2])};
+    }
+    vds::Homography vs;
+    if (vds::plane_homography(cams[g], cams[f], tri, &vs) != Status::ok) return inf;
+    double worst = 0;
+    for (const P3& p : poly) {
+      int32_t x, y;
+      if (!vds::camera_project(cams[g], vds::camera_transform(cams[g], {q16(p[0]), q16(p[1]), q16(p[2])}), &x, &y)) return inf;
+      const Q16_16 sc16 = vds::homography_scale(vs, x, y);
+      if (sc16 == Q16_16::max()) return inf;
+      worst = std::max(worst, sc16.raw() / 65536.0);
+    }
+    return worst;
+  };
+  const double limit = o.threshold;
+  WalkViewPlan plan;
+  plan.updates.resize(n);
+  plan.choice.resize(n);
+  std::vector<int64_t> held(static_cast<size_t>(o.slots), -1);  // the camera frame of each slot's view
+  for (size_t f = 0; f < n; ++f) {
+    // Which polygons no held view serves within the threshold.
+    std::vector<uint32_t> need;
+    for (const auto& [id, px] : visible[f]) {
+      bool ok = false;
+      for (int64_t g : held)
+        if (g >= 0 && factor(f, static_cast<size_t>(g), id) <= limit) {
+          ok = true;
+          break;
+        }
+      if (!ok) need.push_back(id);
+    }
+    if (!need.empty()) {
+      // The slot whose view serves the fewest of this frame's pixels goes.
+      size_t victim = 0, victim_px = std::numeric_limits<size_t>::max();
+      for (size_t k = 0; k < held.size(); ++k) {
+        size_t px_served = 0;
+        if (held[k] >= 0)
+          for (const auto& [id, px] : visible[f]) px_served += factor(f, static_cast<size_t>(held[k]), id) <= limit ? px : 0;
+        if (px_served < victim_px) victim = k, victim_px = px_served;
+        if (held[k] < 0) break;
+      }
+      held[victim] = -1;
+      // What the other views leave unserved.
+      need.clear();
+      for (const auto& [id, px] : visible[f]) {
+        bool ok = false;
+        for (int64_t g : held)
+          if (g >= 0 && factor(f, static_cast<size_t>(g), id) <= limit) {
+            ok = true;
+            break;
+          }
+        if (!ok) need.push_back(id);
+      }
+      // The farthest frame ahead whose view serves all of it (the frame itself always does).
+      size_t best = f;
+      for (size_t g = f + 1; g <= std::min(n - 1, f + static_cast<size_t>(o.lookahead)); ++g) {
+        bool all = true;
+        for (uint32_t id : need)
+          if (!(factor(f, g, id) <= limit)) {
+            all = false;
+            break;
+          }
+        if (!all) break;
+        best = g;
+      }
+      held[victim] = static_cast<int64_t>(best);
+      plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(best)});
+    }
+    // Each polygon's view: the smallest factor.
+    for (const auto& [id, px] : visible[f]) {
+      int8_t pick = -1;
+      double q = std::numeric_limits<double>::infinity();
+      for (size_t k = 0; k < held.size(); ++k) {
+        if (held[k] < 0) continue;
+        const double fk = factor(f, static_cast<size_t>(held[k]), id);
+        if (fk < q) q = fk, pick = static_cast<int8_t>(k);
+      }
+      plan.choice[f].push_back(pick);
+      plan.pixels += px;
+      if (pick < 0) plan.pixels_unserved += px;
+      if (q <= limit) plan.pixels_within += px;
+      if (q <= 1) plan.pixels_sharp += px;
+    }
+  }
+  return plan;
+}
+
+}  // namespace vds::enc

@@ -1,0 +1,105 @@
+// The walkthrough's view schedule (vds/enc/walk_views.h): the client's
+// fixed-point camera projects like the ground truth's; on a tour of oa_dm4
+// every visible polygon is served by a held view within the threshold once
+// the frame's updates have arrived, updates come at a rate that falls as
+// the threshold rises and as slots are added, and a view taken at a frame
+// serves that frame itself at a factor of 1.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <vector>
+
+#include "vds/enc/camera_tour.h"
+#include "vds/enc/scene.h"
+#include "vds/enc/scene_rays.h"
+#include "vds/enc/scene_render.h"
+#include "vds/enc/walk_views.h"
+#include "vds/homography.h"
+
+namespace {
+
+using Visible = std::vector<std::vector<std::pair<uint32_t, uint32_t>>>;
+
+TEST(WalkViews, TheClientCameraProjectsLikeTheGroundTruth) {
+  const vds::enc::CameraPose pose{100, -200, 40, 37, -12};
+  const auto c = vds::enc::scene_camera(pose, 90, 240, 180);
+  const vds::Camera k = vds::enc::client_camera(pose, 90, 240, 180, 1, 4096);
+  ASSERT_EQ(vds::validate_camera(k), vds::Status::ok);
+  for (const std::array<double, 3> w : {std::array<double, 3>{400, -100, 60}, {300, -300, 0}, {150, 50, 200}}) {
+    double d[3] = {w[0] - c.position[0], w[1] - c.position[1], w[2] - c.position[2]};
+    const double z = d[0] * c.forward[0] + d[1] * c.forward[1] + d[2] * c.forward[2];
+    const double x = c.cx + c.focal * (d[0] * c.right[0] + d[1] * c.right[1] + d[2] * c.right[2]) / z;
+    const double y = c.cy + c.focal * (d[0] * c.down[0] + d[1] * c.down[1] + d[2] * c.down[2]) / z;
+    int32_t xq, yq;
+    const vds::Vec3<vds::Q16_16> world = {vds::Q16_16::from_raw(static_cast<int32_t>(w[0] * 65536)),
+                                          vds::Q16_16::from_raw(static_cast<int32_t>(w[1] * 65536)),
+                                          vds::Q16_16::from_raw(static_cast<int32_t>(w[2] * 65536))};
+    ASSERT_TRUE(vds::camera_project(k, vds::camera_transform(k, world), &xq, &yq));
+    EXPECT_NEAR(xq / 256.0, x, 0.02);
+    EXPECT_NEAR(yq / 256.0, y, 0.02);
+  }
+}
+
+TEST(WalkViews, ATourOfOaDm4IsServedWithinTheThreshold) {
+  const vds::enc::Scene s = vds::enc::load_scene("oa_dm4");
+  const vds::enc::SceneRays rays(s);
+  vds::enc::TourOptions to;
+  to.frames = 200;
+  const auto path = vds::enc::make_tour(s, rays, to);
+  vds::enc::RenderOptions ro;
+  ro.supersample = 1;
+  ro.max_aniso = 1;
+  const vds::enc::SceneRenderer r(s, {}, ro);
+  Visible vis;
+  for (const auto& pose : path.frames) {
+    const auto f = r.render(pose, path.hfov_deg);
+    std::map<uint32_t, uint32_t> px;
+    for (uint32_t id : f.ids)
+      if (id != vds::enc::kNoTriangle) ++px[id];
+    vis.emplace_back(px.begin(), px.end());
+  }
+  std::map<std::pair<int, double>, size_t> updates;
+  for (int slots : {1, 2, 3})
+    for (double threshold : {1.0, 1.35, 2.0}) {
+      vds::enc::WalkViewOptions o;
+      o.slots = slots;
+      o.threshold = threshold;
+      const auto p = vds::enc::plan_walk_views(s, path, vis, o);
+      size_t n = 0;
+      for (const auto& u : p.updates) n += u.size();
+      updates[{slots, threshold}] = n;
+      EXPECT_EQ(p.pixels_unserved, 0u);
+      EXPECT_EQ(p.pixels_within, p.pixels);
+      ASSERT_FALSE(p.updates[0].empty());
+      EXPECT_EQ(p.updates[0][0].slot, 0u);
+      std::printf("oa_dm4, 200 frames: %d slots, threshold %.2f: %zu view updates (%.2f a second), %.1f %% of pixels unmagnified\n",
+                  slots, threshold, n, n * path.fps / path.frames.size(), 100.0 * p.pixels_sharp / p.pixels);
+    }
+  for (int slots : {1, 2, 3}) {
+    const size_t at1 = updates[{slots, 1.0}], at135 = updates[{slots, 1.35}], at2 = updates[{slots, 2.0}];
+    EXPECT_GE(at1, at135);
+    EXPECT_GE(at135, at2);
+  }
+  // A view at a frame's own camera serves it at a factor of 1 (polygons wholly in front of the camera).
+  const auto& pose = path.frames[50];
+  const vds::Camera k = vds::enc::client_camera(pose, path.hfov_deg, 240, 180, 1, 4096);
+  size_t whole = 0;
+  for (const auto& [id, px] : vis[50]) {
+    vds::Vec3<vds::Q16_16> poly[3];
+    for (int j = 0; j < 3; ++j) {
+      const auto& p = s.vertices[s.indices[3 * id + static_cast<uint32_t>(j)]].pos;
+      poly[j] = {vds::Q16_16::from_raw(static_cast<int32_t>(std::lround(p[0] * 65536))),
+                 vds::Q16_16::from_raw(static_cast<int32_t>(std::lround(p[1] * 65536))),
+                 vds::Q16_16::from_raw(static_cast<int32_t>(std::lround(p[2] * 65536)))};
+    }
+    vds::Q16_16 q;
+    if (vds::texture_quality(k, k, poly, 3, &q) != vds::Status::ok || q == vds::Q16_16::max()) continue;
+    ++whole;
+    EXPECT_NEAR(q.raw() / 65536.0, 1.0, 1e-3) << id;
+  }
+  EXPECT_GT(whole, 10u);
+}
+
+}  // namespace
