@@ -124,17 +124,18 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   plan.choice.resize(n);
   std::vector<int64_t> held(static_cast<size_t>(o.slots), -1);  // the camera frame of each slot's view
   for (size_t f = 0; f < n; ++f) {
-    // Which polygons no held view serves within the threshold.
-    std::vector<uint32_t> need;
-    for (const auto& [id, px] : visible[f]) {
-      bool ok = false;
-      for (int64_t g : held)
-        if (g >= 0 && factor(f, static_cast<size_t>(g), id) <= limit) {
-          ok = true;
-          break;
-        }
-      if (!ok) need.push_back(id);
-    }
+    // The polygons of this frame no held view serves within the threshold.
+    const auto unserved = [&] {
+      std::vector<uint32_t> out;
+      for (const auto& entry : visible[f]) {
+        const uint32_t id = entry.first;
+        if (std::none_of(held.begin(), held.end(),
+                         [&](int64_t g) { return g >= 0 && factor(f, static_cast<size_t>(g), id) <= limit; }))
+          out.push_back(id);
+      }
+      return out;
+    };
+    std::vector<uint32_t> need = unserved();
     if (!need.empty()) {
       // The slot whose view serves the fewest of this frame's pixels goes.
       size_t victim = 0, victim_px = std::numeric_limits<size_t>::max();
@@ -146,17 +147,7 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
         if (held[k] < 0) break;
       }
       held[victim] = -1;
-      // What the other views leave unserved.
-      need.clear();
-      for (const auto& [id, px] : visible[f]) {
-        bool ok = false;
-        for (int64_t g : held)
-          if (g >= 0 && factor(f, static_cast<size_t>(g), id) <= limit) {
-            ok = true;
-            break;
-          }
-        if (!ok) need.push_back(id);
-      }
+      need = unserved();  // what the other views leave
       // The farthest frame ahead whose view serves all of it (the frame itself always does).
       size_t best = f;
       for (size_t g = f + 1; g <= std::min(n - 1, f + static_cast<size_t>(o.lookahead)); ++g) {

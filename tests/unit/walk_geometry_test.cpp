@@ -19,6 +19,7 @@
 #include "vds/enc/scene_rays.h"
 #include "vds/enc/scene_render.h"
 #include "vds/enc/walk_geometry.h"
+#include "walk_tour.h"
 #include "xorshift.h"
 
 namespace {
@@ -125,24 +126,11 @@ TEST(WalkGeometry, AClientReplayingTheSendsHoldsEveryHotPolygon) {
 }
 
 TEST(WalkGeometry, TheScheduleOfATourOfOaDm4) {
-  const vds::enc::Scene s = vds::enc::load_scene("oa_dm4");
-  const vds::enc::SceneRays rays(s);
-  vds::enc::TourOptions to;
-  to.frames = 300;
-  const auto path = vds::enc::make_tour(s, rays, to);
-  vds::enc::RenderOptions ro;  // visibility only: one sample a pixel
-  ro.supersample = 1;
-  ro.max_aniso = 1;
-  const vds::enc::SceneRenderer r(s, {}, ro);
+  const vds::test::TourVisibility tv = vds::test::tour_visibility("oa_dm4", 300);
   Visible vis;
-  for (const auto& pose : path.frames) {
-    const auto f = r.render(pose, path.hfov_deg);
-    std::vector<uint32_t> ids;
-    for (uint32_t id : f.ids)
-      if (id != vds::enc::kNoTriangle) ids.push_back(id);
-    std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-    vis.push_back(ids);
+  for (const auto& frame : tv.visible) {
+    vis.emplace_back();
+    for (const auto& [id, px] : frame) vis.back().push_back(id);
   }
   const auto all = plan_walk_geometry(vis, 1u << 20, 2);
   const auto tight = plan_walk_geometry(vis, static_cast<uint32_t>(all.peak_hot), 2);

@@ -17,6 +17,7 @@
 #include "vds/enc/scene_render.h"
 #include "vds/enc/walk_views.h"
 #include "vds/homography.h"
+#include "walk_tour.h"
 
 namespace {
 
@@ -43,23 +44,10 @@ TEST(WalkViews, TheClientCameraProjectsLikeTheGroundTruth) {
 }
 
 TEST(WalkViews, ATourOfOaDm4IsServedWithinTheThreshold) {
-  const vds::enc::Scene s = vds::enc::load_scene("oa_dm4");
-  const vds::enc::SceneRays rays(s);
-  vds::enc::TourOptions to;
-  to.frames = 200;
-  const auto path = vds::enc::make_tour(s, rays, to);
-  vds::enc::RenderOptions ro;
-  ro.supersample = 1;
-  ro.max_aniso = 1;
-  const vds::enc::SceneRenderer r(s, {}, ro);
-  Visible vis;
-  for (const auto& pose : path.frames) {
-    const auto f = r.render(pose, path.hfov_deg);
-    std::map<uint32_t, uint32_t> px;
-    for (uint32_t id : f.ids)
-      if (id != vds::enc::kNoTriangle) ++px[id];
-    vis.emplace_back(px.begin(), px.end());
-  }
+  const vds::test::TourVisibility tv = vds::test::tour_visibility("oa_dm4", 200);
+  const vds::enc::Scene& s = tv.scene;
+  const vds::enc::CameraPath& path = tv.path;
+  const Visible& vis = tv.visible;
   std::map<std::pair<int, double>, size_t> updates;
   for (int slots : {1, 2, 3})
     for (double threshold : {1.0, 1.35, 2.0}) {
