@@ -91,3 +91,98 @@ WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& vi
 }
 
 }  // namespace vds::enc
+
+#include <cmath>
+
+#include "vds/enc/arith_encoder.h"
+
+namespace vds::enc {
+
+int32_t choose_walk_quantum(const Scene& s, double tolerance) {
+  for (int32_t q = 65536; q > 256; q /= 2) {
+    const double step = q / 65536.0;
+    bool fits = true;
+    for (const SceneVertex& v : s.vertices) {
+      for (float c : v.pos)
+        if (std::fabs(c - std::round(c / step) * step) > tolerance) {
+          fits = false;
+          break;
+        }
+      if (!fits) break;
+    }
+    if (fits) return q;
+  }
+  return 256;
+}
+
+WalkGeometryEncoder::WalkGeometryEncoder(uint32_t slots, int32_t quantum_raw)
+    : slots_(slots), quantum_(quantum_raw), last_slot_(slots - 1) {
+  if (slots == 0 || slots > kWalkMaxSlots || quantum_raw < 1 || quantum_raw > 65536 || (quantum_raw & (quantum_raw - 1)) != 0)
+    throw std::invalid_argument("WalkGeometryEncoder: slots or quantum out of range");
+  ctx_.reset();
+  cache_.reset();
+  for (int c = 0; c < 3; ++c)
+    for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a] = INT32_MIN;
+}
+
+std::vector<uint8_t> WalkGeometryEncoder::encode(const std::vector<Send>& sends, const std::vector<uint32_t>& hot_in) {
+  std::vector<uint32_t> hot = hot_in;
+  std::sort(hot.begin(), hot.end());
+  hot.erase(std::unique(hot.begin(), hot.end()), hot.end());
+  ArithEncoder e;
+  e.encode_ueg(ctx_.count, 4, static_cast<uint32_t>(sends.size()), 8, 2);
+  const int bits = walk_slot_bits(slots_);
+  const double q = quantum_ / 65536.0;
+  std::vector<bool> sent_hot(slots_, false);
+  for (const Send& s : sends) {
+    if (s.slot >= slots_) throw std::invalid_argument("WalkGeometryEncoder: a slot outside the budget");
+    const uint32_t next = last_slot_ + 1 == slots_ ? 0 : last_slot_ + 1;
+    e.encode_bit(ctx_.next_slot, s.slot == next);
+    if (s.slot != next) e.encode_bits_bypass(s.slot, bits);
+    last_slot_ = s.slot;
+    e.encode_bit(ctx_.hot_now, s.hot_now);
+    if (s.hot_now) sent_hot[s.slot] = true;
+    for (int c = 0; c < 3; ++c) {
+      int32_t g[3];
+      for (int a = 0; a < 3; ++a) g[a] = static_cast<int32_t>(std::lround(s.vertices[static_cast<size_t>(c)][static_cast<size_t>(a)] / q));
+      int found = -1;
+      for (int i = 0; i < cache_.size; ++i)
+        if (cache_.v[i][0] == g[0] && cache_.v[i][1] == g[1] && cache_.v[i][2] == g[2]) {
+          found = i;
+          break;
+        }
+      if (cache_.size > 0) e.encode_bit(ctx_.cached[c], found >= 0);
+      if (found >= 0) {
+        e.encode_ueg(ctx_.cache_index, 6, static_cast<uint32_t>(found), 8, 2);
+        cache_.use(found);
+      } else {
+        const int fb = walk_fraction_bits(quantum_);
+        int32_t pred[3];
+        walk_predict(cache_, prev_, cur_, c, pred);
+        for (int a = 0; a < 3; ++a) {
+          const int32_t base = pred[a];
+          const int64_t delta = static_cast<int64_t>(g[a]) - base;
+          const int64_t whole = delta >> fb;  // floor: the fraction is never negative
+          const int64_t fraction = delta - whole * (int64_t{1} << fb);
+          e.encode_signed(ctx_.delta_zero[a], ctx_.delta_mag[a], 6, static_cast<int32_t>(whole), 6, 3);
+          for (int b = fb - 1; b >= 0; --b) e.encode_bit(ctx_.fraction[fb - 1 - b], static_cast<int>((fraction >> b) & 1));
+        }
+        cache_.push(g);
+      }
+      for (int a = 0; a < 3; ++a) cur_[c][a] = g[a];
+    }
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a];
+  }
+  for (uint32_t s : prev_hot_) e.encode_bit(ctx_.stays, std::binary_search(hot.begin(), hot.end(), s));
+  std::vector<uint32_t> again;
+  for (uint32_t s : hot)
+    if (!sent_hot[s] && !std::binary_search(prev_hot_.begin(), prev_hot_.end(), s)) again.push_back(s);
+  e.encode_ueg(ctx_.again_count, 4, static_cast<uint32_t>(again.size()), 8, 2);
+  for (size_t k = 0; k < again.size(); ++k)
+    e.encode_ueg(ctx_.again_gap, 4, k == 0 ? again[0] : again[k] - again[k - 1] - 1, 8, 4);
+  prev_hot_ = hot;
+  return e.finish();
+}
+
+}  // namespace vds::enc

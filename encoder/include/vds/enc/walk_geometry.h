@@ -14,7 +14,11 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <array>
 #include <vector>
+
+#include "vds/enc/scene.h"
+#include "vds/walk_geometry.h"
 
 namespace vds::enc {
 
@@ -33,5 +37,35 @@ struct WalkGeometryPlan {
 // `visible[f]`: the polygon IDs frame f shows. Throws std::runtime_error if
 // a frame's hot set exceeds `slots`.
 WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& visible, uint32_t slots, int window);
+
+// The vertex grid for a scene: the largest power-of-two step from 1 map
+// unit down to 1/256 (raw Q16.16) that puts every vertex within `tolerance`
+// map units of a grid point (Quake maps built from whole-unit brushes: 1).
+int32_t choose_walk_quantum(const Scene& s, double tolerance);
+
+// The WGEO chunk of each frame (vds/walk_geometry.h), mirroring the
+// client's decoder state.
+class WalkGeometryEncoder {
+ public:
+  // `quantum_raw`: the vertex grid, a power of two in raw Q16.16 world
+  // units (1..65536); std::invalid_argument otherwise.
+  WalkGeometryEncoder(uint32_t slots, int32_t quantum_raw);
+  struct Send {
+    uint32_t slot;
+    bool hot_now;
+    std::array<std::array<double, 3>, 3> vertices;  // world units, rounded to the grid
+  };
+  // One frame: its sends, in order, and its hot slots (any order).
+  std::vector<uint8_t> encode(const std::vector<Send>& sends, const std::vector<uint32_t>& hot);
+
+ private:
+  uint32_t slots_;
+  int32_t quantum_;
+  WalkGeometryContexts ctx_{};
+  WalkVertexCache cache_{};
+  std::vector<uint32_t> prev_hot_;
+  uint32_t last_slot_;
+  int32_t prev_[3][3]{}, cur_[3][3]{};
+};
 
 }  // namespace vds::enc

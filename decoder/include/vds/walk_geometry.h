@@ -1,0 +1,131 @@
+// vds client library: the walkthrough's polygons. The client holds
+// triangles in a fixed number of slots (a budget the stream declares); one
+// WGEO chunk per frame puts newly needed triangles into slots and says
+// which slots are hot — the triangles to draw that frame. The client never
+// chooses a slot: the encoder plans them (vds/enc/walk_geometry.h), so the
+// client's slots mirror the encoder's at every frame by construction.
+//
+// WGEO payload: one arithmetic-coded stream (vds/arith.h) whose contexts
+// carry over from frame to frame (docs/walkthrough.md, "The geometry
+// chunk"):
+//   sends     ueg2 count; per send: slot (a "next slot" bin, else
+//             ceil(log2 slots) bypass bins), a "hot now" bin, three
+//             vertices — each a "cached" bin, then its place in a
+//             move-to-front list of the last kWalkVertexCache vertices
+//             (ueg2) or its offset from a prediction (walk_predict), per axis
+//             in whole map units (signed ueg3) and then the fraction in
+//             grid steps (one context bin per bit, most significant first:
+//             grid points on whole units cost almost nothing);
+//   hot set   per slot hot in the previous frame (ascending) a "stays" bin;
+//             then ueg2 count of slots turning hot again without a send,
+//             each as ueg4 of its distance from the last one.
+// Vertices are integer multiples of the grid quantum (the encoder's
+// choice, a power of two in Q16.16 world units).
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include "vds/arena.h"
+#include "vds/arith.h"
+#include "vds/container.h"
+#include "vds/fixed.h"
+#include "vds/status.h"
+
+namespace vds {
+
+namespace chunk {
+constexpr uint32_t kWalkGeometry = fourcc('W', 'G', 'E', 'O');  // one frame's triangle sends and hot slots
+}  // namespace chunk
+
+constexpr uint32_t kWalkMaxSlots = 16384;
+constexpr int kWalkVertexCache = 32;
+
+// The contexts of the geometry coding, shared with the encoder.
+struct WalkGeometryContexts {
+  ArithContext count[4];
+  ArithContext next_slot;
+  ArithContext hot_now;
+  ArithContext cached[3];     // by the vertex's place in its triangle
+  ArithContext cache_index[6];
+  ArithContext delta_zero[3];  // by axis
+  ArithContext delta_mag[3][6];
+  ArithContext fraction[16];   // by bit of a vertex offset's fraction of a map unit
+  ArithContext stays;
+  ArithContext again_count[4];
+  ArithContext again_gap[4];
+  void reset();
+};
+
+// The move-to-front list of recent vertices (grid units), shared with the encoder.
+struct WalkVertexCache {
+  int32_t v[kWalkVertexCache][3];
+  int size = 0;
+  void reset() { size = 0; }
+  // Moves entry i to the front.
+  void use(int i);
+  // Puts a new vertex at the front (the last entry falls off when full).
+  void push(const int32_t p[3]);
+};
+
+// The prediction of vertex c (0..2) of a triangle being sent, from what
+// both ends know: for the third vertex of a triangle that shares an edge
+// with the previous one sent, the parallelogram across that edge; else the
+// most recent vertex (or the origin). Shared with the encoder.
+void walk_predict(const WalkVertexCache& cache, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]);
+
+class WalkGeometry {
+ public:
+  static size_t workspace_bytes(uint32_t slots);
+  // invalid_argument for 0 or more than kWalkMaxSlots slots or a quantum
+  // that is not a power of two in 1..65536 (raw Q16.16: 1/65536 to 1 map
+  // unit); workspace_too_small.
+  Status init(Arena& arena, uint32_t slots, int32_t quantum_raw);
+  // One frame's WGEO payload. malformed: a slot outside the budget, a hot
+  // slot that holds no triangle, a vertex outside Q16.16, a count beyond
+  // the budget, bytes left over; truncated: the payload ends early.
+  Status consume(const uint8_t* payload, uint32_t size);
+
+  uint32_t slots() const { return slots_; }
+  uint32_t hot_count() const { return hot_count_; }
+  const uint16_t* hot() const { return hot_; }  // ascending
+  // The slot's triangle (world positions), or nullptr if it holds none.
+  const Vec3<Q16_16>* triangle(uint32_t slot) const {
+    return slot < slots_ && filled_[slot] ? &positions_[3 * static_cast<size_t>(slot)] : nullptr;
+  }
+  uint32_t frames() const { return frames_; }
+
+ private:
+  uint32_t slots_ = 0;
+  int32_t quantum_ = 0;
+  int fraction_bits_ = 0;
+  Vec3<Q16_16>* positions_ = nullptr;  // 3 per slot
+  uint8_t* filled_ = nullptr;
+  uint16_t* hot_ = nullptr;
+  uint16_t* next_hot_ = nullptr;
+  uint8_t* mark_ = nullptr;  // per slot, while a frame is decoded
+  uint32_t hot_count_ = 0;
+  uint32_t last_slot_ = 0;
+  uint32_t frames_ = 0;
+  WalkGeometryContexts ctx_{};
+  WalkVertexCache cache_{};
+  int32_t prev_[3][3]{};  // the previous triangle sent (grid units)
+  int32_t cur_[3][3]{};   // the one being read
+  bool have_prev_ = false;
+};
+
+// Grid steps in a map unit, as bits: 65536 / quantum rounded down to a
+// power of two (0 for a quantum of a whole unit or more).
+inline int walk_fraction_bits(int32_t quantum_raw) {
+  int b = 0;
+  while (b < 16 && (int32_t{65536} >> (b + 1)) >= quantum_raw) ++b;
+  return b;
+}
+
+// Bits for a slot index in a budget of `slots` (ceil(log2 slots), at least 1).
+inline int walk_slot_bits(uint32_t slots) {
+  int b = 1;
+  while ((1u << b) < slots) ++b;
+  return b;
+}
+
+}  // namespace vds

@@ -1,0 +1,167 @@
+// vds client library: the walkthrough's polygons (vds/walk_geometry.h).
+#include "vds/walk_geometry.h"
+
+#include <cstdint>
+
+namespace vds {
+
+static_assert(sizeof(WalkGeometryContexts) % sizeof(ArithContext) == 0, "the contexts are an array of ArithContext");
+
+void WalkGeometryContexts::reset() {
+  arith_init_contexts(&count[0], sizeof(*this) / sizeof(ArithContext));
+}
+
+void walk_predict(const WalkVertexCache& cache, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]) {
+  // The third vertex of a triangle sharing an edge with the one before it:
+  // the parallelogram across that edge (exact for the second half of a
+  // rectangle).
+  if (c == 2) {
+    int shared[2] = {-1, -1};
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 3; ++j)
+        if (prev[j][0] == cur[k][0] && prev[j][1] == cur[k][1] && prev[j][2] == cur[k][2]) shared[k] = j;
+    if (shared[0] >= 0 && shared[1] >= 0 && shared[0] != shared[1]) {
+      const int other = 3 - shared[0] - shared[1];
+      for (int a = 0; a < 3; ++a) {
+        const int64_t p = static_cast<int64_t>(cur[0][a]) + cur[1][a] - prev[other][a];
+        out[a] = p < -(int64_t{1} << 30) ? -(1 << 30) : p > (int64_t{1} << 30) ? (1 << 30) : static_cast<int32_t>(p);
+      }
+      return;
+    }
+  }
+  for (int a = 0; a < 3; ++a) out[a] = cache.size > 0 ? cache.v[0][a] : 0;
+}
+
+void WalkVertexCache::use(int i) {
+  int32_t t[3] = {v[i][0], v[i][1], v[i][2]};
+  for (int k = i; k > 0; --k)
+    for (int c = 0; c < 3; ++c) v[k][c] = v[k - 1][c];
+  for (int c = 0; c < 3; ++c) v[0][c] = t[c];
+}
+
+void WalkVertexCache::push(const int32_t p[3]) {
+  if (size < kWalkVertexCache) ++size;
+  for (int k = size - 1; k > 0; --k)
+    for (int c = 0; c < 3; ++c) v[k][c] = v[k - 1][c];
+  for (int c = 0; c < 3; ++c) v[0][c] = p[c];
+}
+
+size_t WalkGeometry::workspace_bytes(uint32_t slots) {
+  return 3 * static_cast<size_t>(slots) * sizeof(Vec3<Q16_16>) + alignof(Vec3<Q16_16>) + 2 * slots + 2 * 2 * slots + 8;
+}
+
+Status WalkGeometry::init(Arena& arena, uint32_t slots, int32_t quantum_raw) {
+  if (slots == 0 || slots > kWalkMaxSlots || quantum_raw < 1 || quantum_raw > 65536 || (quantum_raw & (quantum_raw - 1)) != 0)
+    return Status::invalid_argument;
+  positions_ = arena.alloc_array<Vec3<Q16_16>>(3 * static_cast<size_t>(slots));
+  filled_ = arena.alloc_array<uint8_t>(slots);
+  mark_ = arena.alloc_array<uint8_t>(slots);
+  hot_ = arena.alloc_array<uint16_t>(slots);
+  next_hot_ = arena.alloc_array<uint16_t>(slots);
+  if (!positions_ || !filled_ || !mark_ || !hot_ || !next_hot_) return Status::workspace_too_small;
+  for (uint32_t s = 0; s < slots; ++s) filled_[s] = 0, mark_[s] = 0;
+  slots_ = slots;
+  quantum_ = quantum_raw;
+  fraction_bits_ = walk_fraction_bits(quantum_raw);
+  hot_count_ = 0;
+  last_slot_ = slots - 1;
+  frames_ = 0;
+  ctx_.reset();
+  cache_.reset();
+  for (int c = 0; c < 3; ++c)
+    for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a] = INT32_MIN;
+  have_prev_ = false;
+  return Status::ok;
+}
+
+Status WalkGeometry::consume(const uint8_t* payload, uint32_t size) {
+  if (slots_ == 0) return Status::invalid_argument;
+  ArithDecoder d;
+  Status s = d.init(payload, size);
+  if (s != Status::ok) return s;
+  // Marks: 1 = hot this frame.
+  for (uint32_t i = 0; i < slots_; ++i) mark_[i] = 0;
+  const uint32_t sends = d.decode_ueg(ctx_.count, 4, 8, 2);
+  if (!d.ok()) return d.status();
+  if (sends > slots_) return Status::malformed;
+  const int bits = walk_slot_bits(slots_);
+  for (uint32_t k = 0; k < sends; ++k) {
+    uint32_t slot;
+    if (d.decode_bit(ctx_.next_slot)) {
+      slot = last_slot_ + 1 == slots_ ? 0 : last_slot_ + 1;
+    } else {
+      slot = d.decode_bits_bypass(bits);
+      if (slot >= slots_) return Status::malformed;
+    }
+    last_slot_ = slot;
+    const int hot_now = d.decode_bit(ctx_.hot_now);
+    for (int c = 0; c < 3; ++c) {
+      int32_t g[3];
+      if (cache_.size > 0 && d.decode_bit(ctx_.cached[c])) {
+        const uint32_t i = d.decode_ueg(ctx_.cache_index, 6, 8, 2);
+        if (i >= static_cast<uint32_t>(cache_.size)) return d.ok() ? Status::malformed : d.status();
+        cache_.use(static_cast<int>(i));
+        for (int a = 0; a < 3; ++a) g[a] = cache_.v[0][a];
+      } else {
+        int32_t pred[3];
+        walk_predict(cache_, prev_, cur_, c, pred);
+        for (int a = 0; a < 3; ++a) {
+          const int32_t base = pred[a];
+          // Whole map units, then the fraction in grid steps.
+          const int64_t whole = d.decode_signed(ctx_.delta_zero[a], ctx_.delta_mag[a], 6, 6, 3);
+          int64_t fraction = 0;
+          for (int b = 0; b < fraction_bits_; ++b) fraction = (fraction << 1) | d.decode_bit(ctx_.fraction[b]);
+          const int64_t v = static_cast<int64_t>(base) + whole * (int64_t{1} << fraction_bits_) + fraction;
+          if (v < -(int64_t{1} << 30) || v > (int64_t{1} << 30)) return d.ok() ? Status::malformed : d.status();
+          g[a] = static_cast<int32_t>(v);
+        }
+        cache_.push(g);
+      }
+      for (int a = 0; a < 3; ++a) cur_[c][a] = g[a];
+      for (int a = 0; a < 3; ++a) {
+        const int64_t raw = static_cast<int64_t>(g[a]) * quantum_;
+        if (raw < INT32_MIN || raw > INT32_MAX) return d.ok() ? Status::malformed : d.status();
+        (&positions_[3 * static_cast<size_t>(slot) + static_cast<size_t>(c)].x)[a] = Q16_16::from_raw(static_cast<int32_t>(raw));
+      }
+    }
+    if (!d.ok()) return d.status();
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a];
+    have_prev_ = true;
+    filled_[slot] = 1;
+    if (hot_now) mark_[slot] = 1;
+  }
+  // Slots hot before that stay hot.
+  for (uint32_t i = 0; i < hot_count_; ++i)
+    if (d.decode_bit(ctx_.stays)) mark_[hot_[i]] = 1;
+  // Slots turning hot again without a send.
+  const uint32_t again = d.decode_ueg(ctx_.again_count, 4, 8, 2);
+  if (!d.ok()) return d.status();
+  if (again > slots_) return Status::malformed;
+  uint32_t at = 0;
+  for (uint32_t k = 0; k < again; ++k) {
+    const uint32_t gap = d.decode_ueg(ctx_.again_gap, 4, 8, 4);
+    if (!d.ok()) return d.status();
+    const uint64_t slot = static_cast<uint64_t>(k == 0 ? 0 : at + 1) + gap;
+    if (slot >= slots_ || !filled_[slot]) return Status::malformed;
+    at = static_cast<uint32_t>(slot);
+    mark_[at] = 1;
+  }
+  s = d.finish();
+  if (s != Status::ok) return s;
+  // The new hot set, ascending; marks cleared for the next frame.
+  uint32_t n = 0;
+  for (uint32_t slot = 0; slot < slots_; ++slot)
+    if (mark_[slot]) {
+      if (!filled_[slot]) return Status::malformed;
+      next_hot_[n++] = static_cast<uint16_t>(slot);
+    }
+  uint16_t* t = hot_;
+  hot_ = next_hot_;
+  next_hot_ = t;
+  hot_count_ = n;
+  ++frames_;
+  return Status::ok;
+}
+
+}  // namespace vds
