@@ -35,6 +35,7 @@ struct Failure : std::runtime_error {
 void add_info(CLI::App& app);
 void add_path(CLI::App& app);
 void add_render(CLI::App& app);
+void add_encode_walk(CLI::App& app);
 void add_pack(CLI::App& app);
 void add_serve(CLI::App& app);
 void add_encode_mesh(CLI::App& app);

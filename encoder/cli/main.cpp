@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   vds::cli::add_decode_image(app);
   vds::cli::add_path(app);
   vds::cli::add_render(app);
+  vds::cli::add_encode_walk(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -123,20 +123,18 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   plan.updates.resize(n);
   plan.choice.resize(n);
   std::vector<int64_t> held(static_cast<size_t>(o.slots), -1);  // the camera frame of each slot's view
+  // Pixels of frame f that the views `v` leave unserved within the threshold.
+  const auto unserved_px = [&](size_t f, const std::vector<int64_t>& v) {
+    size_t px_out = 0;
+    for (const auto& entry : visible[f]) {
+      const uint32_t id = entry.first;
+      if (std::none_of(v.begin(), v.end(), [&](int64_t g) { return g >= 0 && factor(f, static_cast<size_t>(g), id) <= limit; }))
+        px_out += entry.second;
+    }
+    return px_out;
+  };
   for (size_t f = 0; f < n; ++f) {
-    // The polygons of this frame no held view serves within the threshold.
-    const auto unserved = [&] {
-      std::vector<uint32_t> out;
-      for (const auto& entry : visible[f]) {
-        const uint32_t id = entry.first;
-        if (std::none_of(held.begin(), held.end(),
-                         [&](int64_t g) { return g >= 0 && factor(f, static_cast<size_t>(g), id) <= limit; }))
-          out.push_back(id);
-      }
-      return out;
-    };
-    std::vector<uint32_t> need = unserved();
-    if (!need.empty()) {
+    if (unserved_px(f, held) > o.tolerance_px) {
       // The slot whose view serves the fewest of this frame's pixels goes.
       size_t victim = 0, victim_px = std::numeric_limits<size_t>::max();
       for (size_t k = 0; k < held.size(); ++k) {
@@ -146,19 +144,18 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
         if (px_served < victim_px) victim = k, victim_px = px_served;
         if (held[k] < 0) break;
       }
-      held[victim] = -1;
-      need = unserved();  // what the other views leave
-      // The farthest frame ahead whose view serves all of it (the frame itself always does).
-      size_t best = f;
-      for (size_t g = f + 1; g <= std::min(n - 1, f + static_cast<size_t>(o.lookahead)); ++g) {
-        bool all = true;
-        for (uint32_t id : need)
-          if (!(factor(f, g, id) <= limit)) {
-            all = false;
-            break;
-          }
-        if (!all) break;
-        best = g;
+      // The camera, from this frame up to `lookahead` ahead, with which the
+      // views serve the most frames from this one on (the frame itself
+      // always serves itself; ties: the later camera).
+      size_t best = f, best_run = 0;
+      const size_t last = std::min(n - 1, f + static_cast<size_t>(o.lookahead));
+      for (size_t g = f; g <= last; ++g) {
+        std::vector<int64_t> trial = held;
+        trial[victim] = static_cast<int64_t>(g);
+        if (unserved_px(f, trial) > o.tolerance_px) continue;
+        size_t run = 1;
+        while (f + run < n && run <= 2 * static_cast<size_t>(o.lookahead) && unserved_px(f + run, trial) <= o.tolerance_px) ++run;
+        if (run >= best_run) best = g, best_run = run;
       }
       held[victim] = static_cast<int64_t>(best);
       plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(best)});

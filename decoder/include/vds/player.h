@@ -61,6 +61,8 @@
 #include "vds/mesh.h"
 #include "vds/model_view.h"
 #include "vds/status.h"
+#include "vds/walk.h"
+#include "vds/walk_geometry.h"
 
 namespace vds {
 
@@ -148,6 +150,10 @@ struct PlayerMode {
   // complete (0: no limit of the mode's own).
   size_t (*feed_limit)(const Player& p, uint32_t frames_room);
 };
+// The feed limit of a mode that may complete a frame at any chunk: no
+// more bytes than can finish as many chunks (12 bytes of framing at least)
+// as frames may still complete.
+size_t chunk_per_frame_feed_limit(uint32_t frames_room);
 }  // namespace detail
 
 class Player {
@@ -157,6 +163,9 @@ class Player {
   // a stream of JPEG images, the JPEG decoder and the band buffer.
   static size_t image_workspace_bytes(uint16_t width, const PlayerConfig& config);
   static size_t jpeg_workspace_bytes(uint16_t width, const PlayerConfig& config);
+  // Workspace a walkthrough needs beyond the parser for its frame size and
+  // parameters (what its HEAD declares).
+  static size_t walk_workspace_bytes(const StreamHeader& h, const WalkParams& w, const PlayerConfig& config);
 
   Status init(Arena& arena, const PlayerConfig& config, const PlayerCallbacks& callbacks);
   Status feed(const uint8_t* data, size_t n);
@@ -224,6 +233,9 @@ class Player {
   ModelView view;
   ModelFrames model_frames;
   bool model_started = false;
+  WalkGeometry walk_geometry;
+  WalkFrameDecoder walk_frames;
+  struct WalkPlay* walk = nullptr;  // decoder/src/player/mode_walk.cpp
 
  private:
   static bool on_header(void* ctx, const StreamHeader& h);

@@ -115,13 +115,9 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
   return result;
 }
 
-// A model draws after every level and a coarse level can be one small
-// chunk: take no more bytes than can finish as many chunks (12 bytes of
-// framing at least) as frames may still complete.
-size_t feed_limit(const Player&, uint32_t frames_room) {
-  constexpr size_t kMinChunk = kChunkHeadBytes + kChunkTailBytes;
-  return frames_room == 0 ? 0 : kMinChunk * (frames_room - 1) + 1;
-}
+// A frame can complete at any chunk (a model draws after every level, and
+// a coarse level can be one small chunk; a walkthrough at each WFRM).
+size_t feed_limit(const Player&, uint32_t frames_room) { return detail::chunk_per_frame_feed_limit(frames_room); }
 
 }  // namespace
 

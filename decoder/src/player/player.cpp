@@ -10,12 +10,19 @@ namespace vds {
 namespace detail {
 extern const PlayerMode kImagesMode;
 extern const PlayerMode kModelMode;
+extern const PlayerMode kWalkMode;
+
+size_t chunk_per_frame_feed_limit(uint32_t frames_room) {
+  constexpr size_t kMinChunk = kChunkHeadBytes + kChunkTailBytes;
+  return frames_room == 0 ? 0 : kMinChunk * (frames_room - 1) + 1;
+}
+
 }  // namespace detail
 
 namespace {
 
 // The modes this build plays, by the stream header's mode.
-const detail::PlayerMode* const kModes[] = {&detail::kImagesMode, &detail::kModelMode};
+const detail::PlayerMode* const kModes[] = {&detail::kImagesMode, &detail::kModelMode, &detail::kWalkMode};
 
 const detail::PlayerMode* find_mode(StreamMode m) {
   for (const detail::PlayerMode* mode : kModes)
@@ -48,6 +55,7 @@ Status Player::init(Arena& arena, const PlayerConfig& config, const PlayerCallba
   level_mark = 0;
   model_frames = ModelFrames{};
   model_started = false;
+  walk = nullptr;
   ChunkSink sink;
   sink.ctx = this;
   sink.on_header = on_header;

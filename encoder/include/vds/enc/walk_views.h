@@ -11,13 +11,13 @@
 // view's near plane, so that polygons reaching behind either camera have a
 // factor) is smallest; a polygon the view does not show (not in that
 // frame's visibility) cannot be served by it. When a frame shows a polygon
-// that no held view serves with a factor at most `threshold`, a view
-// update is due at that frame, into the slot whose view serves the fewest
-// of the frame's pixels: rendered at the camera of a frame up to
-// `lookahead` frames ahead — the farthest such that every frame from this
-// one to it serves, within the threshold, every polygon this frame shows
-// that the other views do not (views from the future are allowed: the
-// stream is precomputed); the frame's own camera always does. Magnifications are computed with
+// that no held view serves with a factor at most `threshold` (more than
+// `tolerance_px` pixels of them), a view update is due at that frame, into
+// the slot whose view serves the fewest of the frame's pixels: rendered at
+// the camera of a frame up to `lookahead` frames ahead — the one with
+// which the views serve the longest run of frames from this one on (views
+// from the future are allowed: the stream is precomputed); the frame's own
+// camera always serves the frame itself. Magnifications are computed with
 // the client's own fixed-point homography (vds/homography.h); the stream
 // carries each polygon's choice, so the client need not repeat them.
 #pragma once
@@ -39,6 +39,7 @@ struct WalkViewOptions {
   int slots = 2;
   double threshold = 1.35;  // largest magnification a view may serve with
   int lookahead = 20;       // frames ahead a new view's camera may be taken from
+  size_t tolerance_px = 0;  // pixels of a frame that may go unserved before an update is due
   int width = 240, height = 180;
   double near_z = 1, far_z = 4096;  // scene units
 };

@@ -1,0 +1,100 @@
+// vds client library: the walkthrough stream's own chunks besides the
+// geometry (vds/walk_geometry.h): its parameters, view updates and frame
+// records, and the camera of a pose. docs/walkthrough.md, "The walkthrough
+// stream", has the layout; the encoder writes them with the same
+// functions (vds/enc/walk_stream.h), so both sides compute every camera
+// alike.
+//
+// A frame's chunks, in order: any view updates due at that frame (WVUP,
+// then the view's IMGH and IMGD chunks), its WGEO, its WFRM. The client
+// draws the frame at WFRM: every hot triangle mapped from the view WFRM
+// names for it.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+
+#include "vds/arith.h"
+#include "vds/container.h"
+#include "vds/fixed.h"
+#include "vds/render_camera.h"
+#include "vds/status.h"
+
+namespace vds {
+
+namespace chunk {
+constexpr uint32_t kWalkParams = fourcc('W', 'L', 'K', 'P');  // once, before any other walkthrough chunk
+constexpr uint32_t kWalkView = fourcc('W', 'V', 'U', 'P');    // a view update: slot and camera; its image follows
+constexpr uint32_t kWalkFrame = fourcc('W', 'F', 'R', 'M');   // a frame's camera and each hot triangle's view
+}  // namespace chunk
+
+constexpr uint8_t kWalkMaxViews = 8;
+
+// A camera pose: position (world units) and binary angles (2^-16 turn):
+// yaw about +Z from +X, pitch up from the horizon (Quake's axes).
+struct WalkPose {
+  Vec3<Q16_16> position;
+  uint16_t yaw = 0;
+  uint16_t pitch = 0;
+};
+
+// The camera of a pose with the stream's intrinsics (HEAD focal lengths,
+// principal point and clip planes): camera x right, y down, z forward.
+// invalid_argument when the result fails validate_camera().
+Status walk_camera(const StreamHeader& h, const WalkPose& pose, Camera* out);
+
+// WLKP payload (8 bytes): u16 polygon slots, u8 view slots, u8 0, i32
+// vertex grid quantum (raw Q16.16, a power of two).
+struct WalkParams {
+  uint16_t slots = 0;
+  uint8_t views = 0;
+  int32_t quantum_raw = 0;
+};
+constexpr uint32_t kWalkParamsBytes = 8;
+Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out);
+void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]);
+
+// WVUP payload (17 bytes): u8 view slot, then the pose: i32 x, y, z (raw
+// Q16.16), u16 yaw, u16 pitch.
+constexpr uint32_t kWalkViewBytes = 17;
+Status walk_view_from_bytes(const uint8_t* p, uint32_t size, uint8_t* slot, WalkPose* pose);
+void walk_view_to_bytes(uint8_t slot, const WalkPose& pose, uint8_t out[kWalkViewBytes]);
+
+// Positions in a frame record are on a grid of 1/16 world unit.
+constexpr int kWalkPoseShift = 12;  // raw Q16.16 per step: 2^12
+
+// The contexts and history of the frame records, shared with the encoder.
+struct WalkFrameState {
+  ArithContext zero[5];
+  ArithContext mag[5][6];
+  ArithContext same_view;
+  int32_t prev[2][5] = {};  // the last two poses as steps: x, y, z, yaw, pitch
+  uint32_t frames = 0;
+  void reset();
+  // The prediction of the next pose's steps (constant velocity after two frames).
+  void predict(int32_t out[5]) const;
+  void push(const int32_t steps[5]);
+};
+
+// WFRM payload, one arithmetic-coded stream: the frame's pose as five
+// signed ueg3 residuals against WalkFrameState::predict (angles wrap at a
+// turn), then per hot triangle (ascending slot) a "same view as last time"
+// bin and, when not, the view among the others in ceil(log2(views - 1))
+// bypass bits.
+class WalkFrameDecoder {
+ public:
+  void reset() { state_.reset(); }
+  // Reads one record: the pose, and `view_of[hot[i]]` for each hot slot
+  // (its last view in, its new view out; views < `views`). malformed for a
+  // view out of range or bytes left over; truncated.
+  Status consume(const uint8_t* payload, uint32_t size, const uint16_t* hot, uint32_t hot_count, uint8_t* view_of,
+                 uint8_t views, WalkPose* pose);
+
+ private:
+  WalkFrameState state_{};
+};
+
+// Pose <-> the record's steps.
+void walk_pose_to_steps(const WalkPose& p, int32_t steps[5]);
+WalkPose walk_steps_to_pose(const int32_t steps[5]);
+
+}  // namespace vds

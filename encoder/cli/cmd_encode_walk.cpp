@@ -1,0 +1,78 @@
+// `vds encode-walk SCENE --path PATH --rate KBPS -o OUT.vds`: a walkthrough
+// stream (vds/enc/walk_stream.h), played through the client library as it
+// is made, with what the client shows measured against the ground truth.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "vds/enc/camera_path.h"
+#include "vds/enc/scene.h"
+#include "vds/enc/stream_writer.h"
+#include "vds/enc/walk_stream.h"
+#include "vds/io/y4m.h"
+
+namespace vds::cli {
+namespace {
+
+struct EncodeWalkOptions {
+  std::string scene, path, out, y4m, size = "240x180";
+  double rate = 16, threshold = 1.35;
+  int views = 2, quality = -1;
+};
+
+void run_encode_walk(const EncodeWalkOptions& o) {
+  const enc::Scene scene = enc::load_scene(o.scene);
+  const std::vector<uint8_t> text = enc::read_file(o.path);
+  const enc::CameraPath path = enc::read_camera_path(std::string(text.begin(), text.end()), o.path);
+  if (path.frames.empty()) throw Failure(kExitBadInput, o.path + ": no frames");
+  enc::WalkEncodeOptions wo;
+  wo.rate_kbps = o.rate;
+  wo.views = o.views;
+  wo.threshold = o.threshold;
+  wo.quality = o.quality;
+  if (std::sscanf(o.size.c_str(), "%dx%d", &wo.width, &wo.height) != 2 || wo.width < 16 || wo.height < 16 || wo.width > 1024 ||
+      wo.height > 1024)
+    throw Failure(kExitUsage, "--size must be WIDTHxHEIGHT, each 16..1024, not '" + o.size + "'");
+  std::string last;
+  wo.progress = [&](const std::string& stage, size_t done, size_t total) {
+    std::fprintf(stderr, "\rencode-walk: %s %zu/%zu   ", stage.c_str(), done, total);
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  };
+  const enc::WalkEncodeResult r = enc::encode_walk(scene, path, wo, !o.y4m.empty());
+  enc::write_file(o.out, r.stream);
+  if (!o.y4m.empty()) {
+    io::Y4mWriter y(o.y4m, static_cast<int>(std::lround(path.fps)));
+    for (const io::Image& f : r.frames) y.write(f);
+    y.close();
+  }
+  const double secs = path.frames.size() / path.fps;
+  std::printf("%s: %zu frames (%.1f s), %zu bytes = %.2f kbit/s (target %.2f): header %zu, views %zu (%zu updates at quality %d), "
+              "geometry %zu, frames %zu\n",
+              o.out.c_str(), path.frames.size(), secs, r.stream.size(), r.kbps, o.rate, r.header_bytes, r.view_bytes,
+              r.view_updates, r.quality, r.geometry_bytes, r.frame_bytes);
+  double worst = 99;
+  for (double p : r.frame_psnr) worst = std::min(worst, p);
+  std::printf("  client: %u triangle slots, %d views, %zu bytes of workspace; PSNR R,G,B %.2f dB pooled, %.2f dB worst frame\n",
+              r.slots, o.views, r.workspace_bytes, r.psnr_rgb, worst);
+}
+
+}  // namespace
+
+void add_encode_walk(CLI::App& app) {
+  auto o = std::make_shared<EncodeWalkOptions>();
+  CLI::App* sub = app.add_subcommand("encode-walk", "Encode a walkthrough of a scene along a camera path (docs/walkthrough.md)");
+  sub->add_option("scene", o->scene, "A .bsp, .gltf, .glb or .obj file, or an OpenArena map name")->required();
+  sub->add_option("--path", o->path, "Camera path: 'frame x y z yaw_deg pitch_deg' per line")->required();
+  sub->add_option("-o,--output", o->out, "Stream to write")->required();
+  sub->add_option("--rate", o->rate, "Target rate, kbit/s (default 16)")->check(kPositive);
+  sub->add_option("--views", o->views, "Views the client holds (default 2)")->check(CLI::Range(1, 8));
+  sub->add_option("--threshold", o->threshold, "Largest magnification a view serves (default 1.35)")->check(kPositive);
+  sub->add_option("--quality", o->quality, "The views' image quality (default: the best that fits the rate)")->check(CLI::Range(0, 100));
+  sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");
+  sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 240x180)");
+  sub->callback([o] { run_encode_walk(*o); });
+}
+
+}  // namespace vds::cli

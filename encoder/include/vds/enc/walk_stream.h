@@ -1,0 +1,59 @@
+// vds encoder: a walkthrough stream (`vds encode-walk`): a scene and a
+// camera path made into the stream the walkthrough client plays
+// (vds/walk.h, vds/walk_geometry.h; docs/walkthrough.md).
+//
+// The encoder renders the ground truth of every frame (vds/enc/scene_render.h)
+// for its visibility, plans the geometry (vds/enc/walk_geometry.h) and the
+// views (vds/enc/walk_views.h), renders each view at its camera and codes
+// it as an intra vds image, at one quality for the whole stream: the best
+// whose stream fits the target rate. It then plays the stream through the
+// client library's player — what the client will show, frame by frame —
+// and measures it against the ground truth.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "vds/enc/camera_path.h"
+#include "vds/enc/scene.h"
+#include "vds/enc/scene_render.h"
+#include "vds/walk.h"
+
+namespace vds::enc {
+
+struct WalkEncodeOptions {
+  double rate_kbps = 16;  // the whole stream, header included
+  int views = 2;          // view slots the client holds
+  double threshold = 1.35;
+  int lookahead = 20;     // frames ahead a view's camera may come from
+  int window = 2;         // hot: visible within this many frames either side
+  double tolerance = 0.005;  // share of a frame's pixels that may go without a view within the threshold
+  int quality = -1;       // the views' image quality; -1: the best that fits the rate
+  int width = 240, height = 180;
+  int threads = 0;
+  std::function<void(const std::string& stage, size_t done, size_t total)> progress;
+};
+
+struct WalkEncodeResult {
+  std::vector<uint8_t> stream;
+  int quality = 0;
+  size_t view_updates = 0;
+  size_t header_bytes = 0, view_bytes = 0, geometry_bytes = 0, frame_bytes = 0;
+  uint32_t slots = 0;
+  size_t workspace_bytes = 0;       // what the client needs beyond its chunk buffer
+  double kbps = 0;                  // the whole stream over the path's duration
+  double psnr_rgb = 0;              // the client's frames against the ground truth, pooled
+  std::vector<double> frame_psnr;   // per frame
+  std::vector<uint32_t> frame_crc;  // the CRC of each frame the client displays
+  std::vector<io::Image> frames;    // what the client shows (when keep_frames)
+};
+
+// The client's pose of a path pose (1/16 unit, 2^-16 turn).
+WalkPose walk_pose(const CameraPose& p);
+// Back to a path pose (what the client's camera is).
+CameraPose from_walk_pose(const WalkPose& p);
+
+WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkEncodeOptions& o, bool keep_frames = false);
+
+}  // namespace vds::enc

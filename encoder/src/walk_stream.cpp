@@ -1,0 +1,257 @@
+// vds encoder: walkthrough streams (vds/enc/walk_stream.h).
+#include "vds/enc/walk_stream.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "vds/enc/arith_encoder.h"
+#include "vds/enc/frames.h"
+#include "vds/enc/image_codec.h"
+#include "vds/enc/stream_writer.h"
+#include "vds/enc/walk_geometry.h"
+#include "vds/enc/walk_views.h"
+#include "vds/player.h"
+
+namespace vds::enc {
+
+namespace {
+
+constexpr double kTurn = 65536.0 / 360.0;
+
+// The WFRM records, mirroring the client's WalkFrameDecoder.
+class WalkFrameEncoder {
+ public:
+  WalkFrameEncoder() { state_.reset(); }
+  // `view_of` holds each slot's last view (in) and is set to `views_now` for the hot slots (out).
+  std::vector<uint8_t> encode(const WalkPose& pose, const std::vector<uint32_t>& hot, const std::vector<uint8_t>& views_now,
+                              std::vector<uint8_t>& view_of, uint8_t views) {
+    ArithEncoder e;
+    int32_t pred[5], steps[5];
+    state_.predict(pred);
+    walk_pose_to_steps(pose, steps);
+    for (int k = 0; k < 5; ++k) {
+      int32_t r = steps[k] - pred[k];
+      if (k >= 3) r = static_cast<int16_t>(static_cast<uint16_t>(r));  // angles: the short way round
+      e.encode_signed(state_.zero[k], state_.mag[k], 6, r, 6, 3);
+    }
+    int other_bits = 0;
+    while ((1 << other_bits) < views - 1) ++other_bits;
+    for (size_t i = 0; i < hot.size(); ++i) {
+      uint8_t& v = view_of[hot[i]];
+      if (v >= views) v = 0;
+      const uint8_t want = views_now[i];
+      if (views > 1) {
+        e.encode_bit(state_.same_view, want == v);
+        if (want != v) e.encode_bits_bypass(want > v ? want - 1u : want, other_bits);
+      }
+      v = want;
+    }
+    state_.push(steps);
+    return e.finish();
+  }
+
+ private:
+  WalkFrameState state_{};
+};
+
+}  // namespace
+
+WalkPose walk_pose(const CameraPose& p) {
+  WalkPose w;
+  const auto step = [](double v) {
+    const double r = std::round(v * 16);
+    if (!(std::fabs(r) < (1 << 19))) throw std::runtime_error("a camera position outside the client's range: " + std::to_string(v));
+    return Q16_16::from_raw(static_cast<int32_t>(r) * (1 << kWalkPoseShift));
+  };
+  w.position = {step(p.x), step(p.y), step(p.z)};
+  w.yaw = static_cast<uint16_t>(static_cast<int64_t>(std::llround(p.yaw_deg * kTurn)) & 0xFFFF);
+  w.pitch = static_cast<uint16_t>(static_cast<int64_t>(std::llround(p.pitch_deg * kTurn)) & 0xFFFF);
+  return w;
+}
+
+CameraPose from_walk_pose(const WalkPose& w) {
+  CameraPose p;
+  p.x = w.position.x.raw() / 65536.0;
+  p.y = w.position.y.raw() / 65536.0;
+  p.z = w.position.z.raw() / 65536.0;
+  p.yaw_deg = w.yaw / kTurn;
+  p.pitch_deg = static_cast<int16_t>(w.pitch) / kTurn;
+  return p;
+}
+
+WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkEncodeOptions& o, bool keep_frames) {
+  const size_t n = path.frames.size();
+  if (n == 0) throw std::invalid_argument("encode_walk: an empty path");
+  if (o.views < 1 || o.views > kWalkMaxViews) throw std::invalid_argument("encode_walk: 1 to 8 views");
+  const auto progress = [&](const std::string& stage, size_t done, size_t total) {
+    if (o.progress) o.progress(stage, done, total);
+  };
+  // 1. Ground truth: the frames and what each shows.
+  RenderOptions ro;
+  ro.width = o.width;
+  ro.height = o.height;
+  const SceneRenderer renderer(s, load_scene_images(s), ro);
+  std::vector<io::Image> truth(n);
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> visible(n);
+  render_path(renderer, path, o.threads, [&](size_t f, const SceneFrame& fr) {
+    truth[f] = fr.rgb;
+    std::map<uint32_t, uint32_t> px;
+    for (uint32_t id : fr.ids)
+      if (id != kNoTriangle) ++px[id];
+    visible[f].assign(px.begin(), px.end());
+  }, [&](size_t done) { progress("ground truth", done, n); });
+  // 2. Geometry and views.
+  std::vector<std::vector<uint32_t>> ids(n);
+  for (size_t f = 0; f < n; ++f)
+    for (const auto& [id, px] : visible[f]) ids[f].push_back(id);
+  const WalkGeometryPlan probe = plan_walk_geometry(ids, kWalkMaxSlots, o.window);
+  const uint32_t slots = static_cast<uint32_t>(std::min<size_t>(kWalkMaxSlots, probe.peak_hot + 16));
+  const WalkGeometryPlan geo = plan_walk_geometry(ids, slots, o.window);
+  WalkViewOptions vo;
+  vo.slots = o.views;
+  vo.threshold = o.threshold;
+  vo.lookahead = o.lookahead;
+  vo.tolerance_px = static_cast<size_t>(o.tolerance * o.width * o.height);
+  vo.width = o.width;
+  vo.height = o.height;
+  const WalkViewPlan vp = plan_walk_views(s, path, visible, vo);
+  // 3. The views, rendered at the client's cameras.
+  std::vector<WalkPose> poses(n);
+  for (size_t f = 0; f < n; ++f) poses[f] = walk_pose(path.frames[f]);
+  std::map<uint32_t, io::Image> view_images;
+  for (const auto& ups : vp.updates)
+    for (const auto& u : ups) view_images[u.camera_frame];
+  size_t done = 0;
+  for (auto& [g, img] : view_images) {
+    img = renderer.render(from_walk_pose(poses[g]), path.hfov_deg).rgb;
+    progress("views", ++done, view_images.size());
+  }
+  // 4. The header and the parts that do not depend on the views' quality.
+  StreamHeader h = default_header(StreamMode::walkthrough, static_cast<uint16_t>(o.width), static_cast<uint16_t>(o.height));
+  const SceneCamera sc = scene_camera(path.frames[0], path.hfov_deg, o.width, o.height);
+  h.frame_period_us = static_cast<uint32_t>(std::lround(1e6 / path.fps));
+  h.frame_count = static_cast<uint32_t>(n);
+  h.focal_x_q16 = h.focal_y_q16 = static_cast<int32_t>(std::lround(sc.focal * 65536));
+  h.center_x_q16 = static_cast<int32_t>(std::lround(sc.cx * 65536));
+  h.center_y_q16 = static_cast<int32_t>(std::lround(sc.cy * 65536));
+  const double near = 1.0 / 32 / s.metres_per_unit;
+  h.near_q16 = static_cast<int32_t>(std::lround(near * 65536));
+  h.far_q16 = h.near_q16 * 4096;
+  WalkParams wp;
+  wp.slots = static_cast<uint16_t>(slots);
+  wp.views = static_cast<uint8_t>(o.views);
+  wp.quantum_raw = choose_walk_quantum(s, 1.0 / 16);
+  h.workspace_bytes = static_cast<uint32_t>(Player::walk_workspace_bytes(h, wp, kClientPlayerConfig));
+  h.max_triangles = slots;
+  WalkGeometryEncoder ge(slots, wp.quantum_raw);
+  WalkFrameEncoder fe;
+  std::vector<std::vector<uint8_t>> wgeo(n), wfrm(n);
+  std::vector<uint8_t> view_of(slots, 0);
+  std::vector<uint8_t> slot_view(slots, 0);
+  for (size_t f = 0; f < n; ++f) {
+    std::vector<WalkGeometryEncoder::Send> sends;
+    for (const auto& snd : geo.sends[f]) {
+      WalkGeometryEncoder::Send e{snd.slot, true, {}};
+      for (int c = 0; c < 3; ++c)
+        for (int a = 0; a < 3; ++a)
+          e.vertices[static_cast<size_t>(c)][static_cast<size_t>(a)] =
+              s.vertices[s.indices[3 * static_cast<size_t>(snd.id) + static_cast<size_t>(c)]].pos[static_cast<size_t>(a)];
+      sends.push_back(e);
+    }
+    wgeo[f] = ge.encode(sends, geo.hot[f]);
+    // Each hot triangle's view: the plan's for those the frame shows, else the one it had.
+    std::map<uint32_t, int8_t> choice;
+    for (size_t k = 0; k < visible[f].size(); ++k) choice[visible[f][k].first] = vp.choice[f][k];
+    std::map<uint32_t, uint32_t> id_of_slot;
+    for (size_t g = 0; g <= f; ++g)
+      for (const auto& snd : geo.sends[g]) id_of_slot[snd.slot] = snd.id;
+    std::vector<uint8_t> now;
+    for (uint32_t slot : geo.hot[f]) {
+      const auto it = choice.find(id_of_slot[slot]);
+      now.push_back(it != choice.end() && it->second >= 0 ? static_cast<uint8_t>(it->second) : slot_view[slot]);
+      slot_view[slot] = now.back();
+    }
+    wfrm[f] = fe.encode(poses[f], geo.hot[f], now, view_of, wp.views);
+    progress("geometry", f + 1, n);
+  }
+  // 5. The stream at a quality; the best that fits the rate.
+  const auto build = [&](int quality, WalkEncodeResult* r) {
+    ImageEncodeOptions io;
+    io.quality = quality;
+    io.max_chunk_payload = 4096;
+    std::map<uint32_t, EncodedImage> coded;
+    uint32_t max_payload = 4096;
+    for (const auto& [g, img] : view_images) {
+      coded[g] = encode_image(img, io);
+      max_payload = std::max(max_payload, coded[g].max_payload());
+    }
+    StreamHeader hh = h;
+    hh.max_chunk_payload = max_payload;
+    for (size_t f = 0; f < n; ++f)
+      hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(std::max(wgeo[f].size(), wfrm[f].size())));
+    StreamWriter w(hh);
+    uint8_t params[kWalkParamsBytes];
+    walk_params_to_bytes(wp, params);
+    w.add_chunk(chunk::kWalkParams, params);
+    r->header_bytes = w.size();
+    r->view_bytes = r->geometry_bytes = r->frame_bytes = 0;
+    r->view_updates = 0;
+    for (size_t f = 0; f < n; ++f) {
+      for (const auto& u : vp.updates[f]) {
+        const size_t before = w.size();
+        uint8_t vb[kWalkViewBytes];
+        walk_view_to_bytes(static_cast<uint8_t>(u.slot), poses[u.camera_frame], vb);
+        w.add_chunk(chunk::kWalkView, vb);
+        add_image_chunks(w, coded.at(u.camera_frame));
+        r->view_bytes += w.size() - before;
+        ++r->view_updates;
+      }
+      size_t before = w.size();
+      w.add_chunk(chunk::kWalkGeometry, wgeo[f]);
+      r->geometry_bytes += w.size() - before;
+      before = w.size();
+      w.add_chunk(chunk::kWalkFrame, wfrm[f]);
+      r->frame_bytes += w.size() - before;
+    }
+    r->stream = w.finish();
+    r->quality = quality;
+    r->slots = slots;
+    r->workspace_bytes = h.workspace_bytes;
+    r->kbps = r->stream.size() * 8.0 / (n / path.fps) / 1000;
+  };
+  WalkEncodeResult r;
+  if (o.quality >= 0) {
+    build(o.quality, &r);
+  } else {
+    // Bisection on the quality (sizes rise with it).
+    int lo = 0, hi = 100;
+    build(lo, &r);
+    WalkEncodeResult best = r;
+    while (hi - lo > 1) {
+      const int mid = (lo + hi) / 2;
+      build(mid, &r);
+      progress("rate control", static_cast<size_t>(7 - std::log2(hi - lo)), 7);
+      if (r.kbps <= o.rate_kbps) lo = mid, best = r;
+      else hi = mid;
+    }
+    r = std::move(best);
+  }
+  // 6. What the client shows, against the ground truth.
+  std::vector<io::Image> shown;
+  r.frame_crc = client_frame_crcs(r.stream, &shown);
+  if (shown.size() != n) throw std::logic_error("encode_walk: the client showed " + std::to_string(shown.size()) + " frames of " + std::to_string(n));
+  double se = 0;
+  for (size_t f = 0; f < n; ++f) {
+    const double m = io::mse(truth[f], shown[f]);
+    se += m;
+    r.frame_psnr.push_back(m > 0 ? 10 * std::log10(255.0 * 255.0 / m) : 99);
+  }
+  const double mse = se / n;
+  r.psnr_rgb = mse > 0 ? 10 * std::log10(255.0 * 255.0 / mse) : 99;
+  if (keep_frames) r.frames = std::move(shown);
+  return r;
+}
+
+}  // namespace vds::enc

