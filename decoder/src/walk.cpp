@@ -124,10 +124,15 @@ WalkPose walk_steps_to_pose(const int32_t steps[5]) {
 
 Status WalkFrameDecoder::consume(const uint8_t* payload, uint32_t size, const uint16_t* hot, uint32_t hot_count,
                                  uint8_t* view_of, uint8_t views, WalkPose* pose) {
-  if (views == 0 || views > kWalkMaxViews) return Status::invalid_argument;
   ArithDecoder d;
   Status s = d.init(payload, size);
-  if (s != Status::ok) return s;
+  if (s == Status::ok) s = decode(d, hot, hot_count, view_of, views, pose);
+  return s == Status::ok ? d.finish() : s;
+}
+
+Status WalkFrameDecoder::decode(ArithDecoder& d, const uint16_t* hot, uint32_t hot_count, uint8_t* view_of, uint8_t views,
+                                WalkPose* pose) {
+  if (views == 0 || views > kWalkMaxViews) return Status::invalid_argument;
   int32_t pred[5], steps[5];
   state_.predict(pred);
   for (int k = 0; k < 5; ++k) {
@@ -152,8 +157,7 @@ Status WalkFrameDecoder::consume(const uint8_t* payload, uint32_t size, const ui
       v = static_cast<uint8_t>(k >= v ? k + 1 : k);
     }
   }
-  s = d.finish();
-  if (s != Status::ok) return s;
+  if (!d.ok()) return d.status();
   state_.push(steps);
   *pose = walk_steps_to_pose(steps);
   return Status::ok;

@@ -78,7 +78,12 @@ Status WalkGeometry::consume(const uint8_t* payload, uint32_t size) {
   if (slots_ == 0) return Status::invalid_argument;
   ArithDecoder d;
   Status s = d.init(payload, size);
-  if (s != Status::ok) return s;
+  if (s == Status::ok) s = decode(d);
+  return s == Status::ok ? d.finish() : s;
+}
+
+Status WalkGeometry::decode(ArithDecoder& d) {
+  if (slots_ == 0) return Status::invalid_argument;
   // Marks: 1 = hot this frame.
   for (uint32_t i = 0; i < slots_; ++i) mark_[i] = 0;
   const uint32_t sends = d.decode_ueg(ctx_.count, 4, 8, 2);
@@ -147,9 +152,8 @@ Status WalkGeometry::consume(const uint8_t* payload, uint32_t size) {
     at = static_cast<uint32_t>(slot);
     mark_[at] = 1;
   }
-  s = d.finish();
-  if (s != Status::ok) return s;
-  // The new hot set, ascending; marks cleared for the next frame.
+  if (!d.ok()) return d.status();
+  // The new hot set, ascending.
   uint32_t n = 0;
   for (uint32_t slot = 0; slot < slots_; ++slot)
     if (mark_[slot]) {

@@ -125,11 +125,16 @@ WalkGeometryEncoder::WalkGeometryEncoder(uint32_t slots, int32_t quantum_raw)
     for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a] = INT32_MIN;
 }
 
-std::vector<uint8_t> WalkGeometryEncoder::encode(const std::vector<Send>& sends, const std::vector<uint32_t>& hot_in) {
+std::vector<uint8_t> WalkGeometryEncoder::encode(const std::vector<Send>& sends, const std::vector<uint32_t>& hot) {
+  ArithEncoder e;
+  encode(e, sends, hot);
+  return e.finish();
+}
+
+void WalkGeometryEncoder::encode(ArithEncoder& e, const std::vector<Send>& sends, const std::vector<uint32_t>& hot_in) {
   std::vector<uint32_t> hot = hot_in;
   std::sort(hot.begin(), hot.end());
   hot.erase(std::unique(hot.begin(), hot.end()), hot.end());
-  ArithEncoder e;
   e.encode_ueg(ctx_.count, 4, static_cast<uint32_t>(sends.size()), 8, 2);
   const int bits = walk_slot_bits(slots_);
   const double q = quantum_ / 65536.0;
@@ -182,7 +187,6 @@ std::vector<uint8_t> WalkGeometryEncoder::encode(const std::vector<Send>& sends,
   for (size_t k = 0; k < again.size(); ++k)
     e.encode_ueg(ctx_.again_gap, 4, k == 0 ? again[0] : again[k] - again[k - 1] - 1, 8, 4);
   prev_hot_ = hot;
-  return e.finish();
 }
 
 }  // namespace vds::enc

@@ -25,9 +25,8 @@ class WalkFrameEncoder {
  public:
   WalkFrameEncoder() { state_.reset(); }
   // `view_of` holds each slot's last view (in) and is set to `views_now` for the hot slots (out).
-  std::vector<uint8_t> encode(const WalkPose& pose, const std::vector<uint32_t>& hot, const std::vector<uint8_t>& views_now,
-                              std::vector<uint8_t>& view_of, uint8_t views) {
-    ArithEncoder e;
+  void encode(ArithEncoder& e, const WalkPose& pose, const std::vector<uint32_t>& hot, const std::vector<uint8_t>& views_now,
+              std::vector<uint8_t>& view_of, uint8_t views) {
     int32_t pred[5], steps[5];
     state_.predict(pred);
     walk_pose_to_steps(pose, steps);
@@ -49,7 +48,6 @@ class WalkFrameEncoder {
       v = want;
     }
     state_.push(steps);
-    return e.finish();
   }
 
  private:
@@ -147,7 +145,8 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   h.max_triangles = slots;
   WalkGeometryEncoder ge(slots, wp.quantum_raw);
   WalkFrameEncoder fe;
-  std::vector<std::vector<uint8_t>> wgeo(n), wfrm(n);
+  std::vector<std::vector<uint8_t>> wfrm(n);
+  std::vector<size_t> geometry_part(n);  // bytes of each record's geometry
   std::vector<uint8_t> view_of(slots, 0);
   std::vector<uint8_t> slot_view(slots, 0);
   for (size_t f = 0; f < n; ++f) {
@@ -160,7 +159,9 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
               s.vertices[s.indices[3 * static_cast<size_t>(snd.id) + static_cast<size_t>(c)]].pos[static_cast<size_t>(a)];
       sends.push_back(e);
     }
-    wgeo[f] = ge.encode(sends, geo.hot[f]);
+    ArithEncoder e;
+    ge.encode(e, sends, geo.hot[f]);
+    geometry_part[f] = e.finished_size();
     // Each hot triangle's view: the plan's for those the frame shows, else the one it had.
     std::map<uint32_t, int8_t> choice;
     for (size_t k = 0; k < visible[f].size(); ++k) choice[visible[f][k].first] = vp.choice[f][k];
@@ -173,7 +174,8 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       now.push_back(it != choice.end() && it->second >= 0 ? static_cast<uint8_t>(it->second) : slot_view[slot]);
       slot_view[slot] = now.back();
     }
-    wfrm[f] = fe.encode(poses[f], geo.hot[f], now, view_of, wp.views);
+    fe.encode(e, poses[f], geo.hot[f], now, view_of, wp.views);
+    wfrm[f] = e.finish();
     progress("geometry", f + 1, n);
   }
   // 5. The stream at a quality; the best that fits the rate.
@@ -190,7 +192,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     StreamHeader hh = h;
     hh.max_chunk_payload = max_payload;
     for (size_t f = 0; f < n; ++f)
-      hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(std::max(wgeo[f].size(), wfrm[f].size())));
+      hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(wfrm[f].size()));
     StreamWriter w(hh);
     uint8_t params[kWalkParamsBytes];
     walk_params_to_bytes(wp, params);
@@ -208,12 +210,11 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
         r->view_bytes += w.size() - before;
         ++r->view_updates;
       }
-      size_t before = w.size();
-      w.add_chunk(chunk::kWalkGeometry, wgeo[f]);
-      r->geometry_bytes += w.size() - before;
-      before = w.size();
+      const size_t before = w.size();
       w.add_chunk(chunk::kWalkFrame, wfrm[f]);
-      r->frame_bytes += w.size() - before;
+      // The record's geometry and the rest (its pose, views and the chunk's framing).
+      r->geometry_bytes += std::min(geometry_part[f], wfrm[f].size());
+      r->frame_bytes += w.size() - before - std::min(geometry_part[f], wfrm[f].size());
     }
     r->stream = w.finish();
     r->quality = quality;

@@ -2,8 +2,8 @@
 // mode_walk.cpp) on hostile streams. The first byte picks the stream: a
 // valid walkthrough of a small room (built once) whose chunk payloads the
 // input's bytes flip (CRCs recomputed, so the mode meets the damage), or a
-// valid container of walkthrough chunks (WLKP, WVUP, IMGH, IMGD, WGEO,
-// WFRM) whose payloads are the input's bytes. Invariants: no crash or
+// valid container of walkthrough chunks (WLKP, WVUP, IMGH, IMGD, WFRM)
+// whose payloads are the input's bytes. Invariants: no crash or
 // sanitizer report; every band lies inside its frame; the player ends
 // with ok, more_input or an error.
 #include <cstddef>
@@ -75,7 +75,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
   } else {
     const uint32_t types[] = {vds::chunk::kWalkParams, vds::chunk::kWalkView, vds::chunk::kImageHeader,
-                              vds::chunk::kImageData, vds::chunk::kWalkGeometry, vds::chunk::kWalkFrame};
+                              vds::chunk::kImageData, vds::chunk::kWalkFrame, vds::chunk::kWalkFrame};
     // The room's WLKP first, so the mode is set up; then the input's chunks.
     w.add_chunk(base.chunks[0].first, base.chunks[0].second);
     size_t at = 1;

@@ -149,7 +149,7 @@ TEST(WalkGeometry, TheScheduleOfATourOfOaDm4) {
 
 namespace {
 
-// The WGEO chunks of a plan, with the scene's triangles as the sends.
+// The geometry records of a plan (each a payload of its own), with the scene's triangles as the sends.
 struct CodedPlan {
   std::vector<std::vector<uint8_t>> chunks;
   std::vector<std::vector<std::array<std::array<double, 3>, 3>>> sent;  // per frame, per send
@@ -175,7 +175,7 @@ CodedPlan code_plan(const vds::enc::Scene& s, const vds::enc::WalkGeometryPlan& 
   return out;
 }
 
-TEST(WalkGeometryChunk, TheClientHoldsWhatThePlanSaysOnATourOfOaDm4) {
+TEST(WalkGeometryRecord, TheClientHoldsWhatThePlanSaysOnATourOfOaDm4) {
   const vds::test::TourVisibility tv = vds::test::tour_visibility("oa_dm4", 300);
   Visible vis;
   for (const auto& frame : tv.visible) {
@@ -210,12 +210,12 @@ TEST(WalkGeometryChunk, TheClientHoldsWhatThePlanSaysOnATourOfOaDm4) {
     }
   }
   const double kbps = bytes * 8.0 / (coded.chunks.size() / tv.path.fps) / 1000;
-  std::printf("oa_dm4, 300 frames: %zu triangles in %u slots, %zu bytes of WGEO (%.2f kbit/s, %.1f bits a triangle sent)\n",
+  std::printf("oa_dm4, 300 frames: %zu triangles in %u slots, %zu bytes of geometry (%.2f kbit/s, %.1f bits a triangle sent)\n",
               plan.first_sends + plan.resends, plan.slots, bytes, kbps, bytes * 8.0 / (plan.first_sends + plan.resends));
   EXPECT_LT(kbps, 3.0);  // measured 2.24 kbit/s (docs/walkthrough.md)
 }
 
-TEST(WalkGeometryChunk, PrefixesAndGarbageAreRefused) {
+TEST(WalkGeometryRecord, PrefixesAndGarbageAreRefused) {
   // A small plan coded, then each frame's every prefix given to a client
   // that has read the frames before it.
   kQuantum = 65536 / 8;

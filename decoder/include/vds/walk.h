@@ -6,9 +6,10 @@
 // alike.
 //
 // A frame's chunks, in order: any view updates due at that frame (WVUP,
-// then the view's IMGH and IMGD chunks), its WGEO, its WFRM. The client
-// draws the frame at WFRM: every hot triangle mapped from the view WFRM
-// names for it.
+// then the view's IMGH and IMGD chunks), then its WFRM — its geometry,
+// pose and each hot triangle's view in one arithmetic-coded record. The
+// client draws the frame at WFRM: every hot triangle mapped from the view
+// WFRM names for it.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -24,7 +25,7 @@ namespace vds {
 namespace chunk {
 constexpr uint32_t kWalkParams = fourcc('W', 'L', 'K', 'P');  // once, before any other walkthrough chunk
 constexpr uint32_t kWalkView = fourcc('W', 'V', 'U', 'P');    // a view update: slot and camera; its image follows
-constexpr uint32_t kWalkFrame = fourcc('W', 'F', 'R', 'M');   // a frame's camera and each hot triangle's view
+constexpr uint32_t kWalkFrame = fourcc('W', 'F', 'R', 'M');   // a frame: its geometry, camera and each hot triangle's view
 }  // namespace chunk
 
 constexpr uint8_t kWalkMaxViews = 8;
@@ -75,7 +76,8 @@ struct WalkFrameState {
   void push(const int32_t steps[5]);
 };
 
-// WFRM payload, one arithmetic-coded stream: the frame's pose as five
+// WFRM payload, one arithmetic-coded stream: the frame's geometry
+// (WalkGeometry::decode, vds/walk_geometry.h), then its pose as five
 // signed ueg3 residuals against WalkFrameState::predict (angles wrap at a
 // turn), then per hot triangle (ascending slot) a "same view as last time"
 // bin and, when not, the view among the others in ceil(log2(views - 1))
@@ -83,9 +85,11 @@ struct WalkFrameState {
 class WalkFrameDecoder {
  public:
   void reset() { state_.reset(); }
-  // Reads one record: the pose, and `view_of[hot[i]]` for each hot slot
-  // (its last view in, its new view out; views < `views`). malformed for a
-  // view out of range or bytes left over; truncated.
+  // Reads a record's pose and views: the pose, and `view_of[hot[i]]` for
+  // each hot slot (its last view in, its new view out; views < `views`).
+  // malformed for a view out of range; truncated.
+  Status decode(ArithDecoder& d, const uint16_t* hot, uint32_t hot_count, uint8_t* view_of, uint8_t views, WalkPose* pose);
+  // The same from a payload of its own (then the coder's end check).
   Status consume(const uint8_t* payload, uint32_t size, const uint16_t* hot, uint32_t hot_count, uint8_t* view_of,
                  uint8_t views, WalkPose* pose);
 

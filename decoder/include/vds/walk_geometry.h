@@ -1,13 +1,14 @@
 // vds client library: the walkthrough's polygons. The client holds
-// triangles in a fixed number of slots (a budget the stream declares); one
-// WGEO chunk per frame puts newly needed triangles into slots and says
-// which slots are hot — the triangles to draw that frame. The client never
+// triangles in a fixed number of slots (a budget the stream declares); each
+// frame's record (WFRM, vds/walk.h) starts with the geometry: it puts newly
+// needed triangles into slots and says which slots are hot — the
+// triangles to draw that frame. The client never
 // chooses a slot: the encoder plans them (vds/enc/walk_geometry.h), so the
 // client's slots mirror the encoder's at every frame by construction.
 //
-// WGEO payload: one arithmetic-coded stream (vds/arith.h) whose contexts
-// carry over from frame to frame (docs/walkthrough.md, "The geometry
-// chunk"):
+// The geometry, coded with the record's arithmetic decoder (vds/arith.h);
+// its contexts carry over from frame to frame (docs/walkthrough.md, "The
+// geometry record"):
 //   sends     ueg2 count; per send: slot (a "next slot" bin, else
 //             ceil(log2 slots) bypass bins), a "hot now" bin, three
 //             vertices — each a "cached" bin, then its place in a
@@ -32,10 +33,6 @@
 #include "vds/status.h"
 
 namespace vds {
-
-namespace chunk {
-constexpr uint32_t kWalkGeometry = fourcc('W', 'G', 'E', 'O');  // one frame's triangle sends and hot slots
-}  // namespace chunk
 
 constexpr uint32_t kWalkMaxSlots = 16384;
 constexpr int kWalkVertexCache = 32;
@@ -80,9 +77,13 @@ class WalkGeometry {
   // that is not a power of two in 1..65536 (raw Q16.16: 1/65536 to 1 map
   // unit); workspace_too_small.
   Status init(Arena& arena, uint32_t slots, int32_t quantum_raw);
-  // One frame's WGEO payload. malformed: a slot outside the budget, a hot
+  // One frame's geometry from an arithmetic decoder (the first part of a
+  // WFRM record, vds/walk.h). malformed: a slot outside the budget, a hot
   // slot that holds no triangle, a vertex outside Q16.16, a count beyond
-  // the budget, bytes left over; truncated: the payload ends early.
+  // the budget; truncated: the data ends early.
+  Status decode(ArithDecoder& d);
+  // The same from a payload of its own (decode, then the coder's end check:
+  // malformed if bytes are left over).
   Status consume(const uint8_t* payload, uint32_t size);
 
   uint32_t slots() const { return slots_; }

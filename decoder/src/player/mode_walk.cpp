@@ -1,8 +1,7 @@
 // Player mode "walkthrough": view-dependent texture streaming along a
 // camera script (vds/walk.h, vds/walk_geometry.h; docs/walkthrough.md).
-// Set up at WLKP for the slots and views it declares; each frame's WGEO
-// and WFRM bring its hot triangles and camera, and the frame is drawn at
-// WFRM by mapping each hot triangle from the stored view WFRM names for it
+// Set up at WLKP for the slots and views it declares; each frame's WFRM
+// brings its triangles, hot slots and camera, and the frame is drawn there by mapping each hot triangle from the stored view WFRM names for it
 // (Shading::view_mapped, the screen -> view homography of its plane).
 // Views arrive as WVUP and an intra vds image decoded into the view's
 // Y'CbCr 4:2:0 planes.
@@ -146,7 +145,7 @@ Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
 
 ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size) {
   const bool walk_chunk = type == chunk::kWalkParams || type == chunk::kWalkView || type == chunk::kWalkFrame ||
-                          type == chunk::kWalkGeometry || type == chunk::kImageHeader || type == chunk::kImageData;
+                          type == chunk::kImageHeader || type == chunk::kImageData;
   if (!walk_chunk) return ChunkResult::unknown;
   if (p.walk == nullptr) {
     if (type != chunk::kWalkParams) {
@@ -209,16 +208,17 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
         }
       }
     }
-  } else if (type == chunk::kWalkGeometry) {
-    const Status s = p.walk_geometry.consume(payload, size);
-    if (s != Status::ok) refuse(s, "WGEO was refused");
   } else {  // WFRM: the frame
     WalkPose pose;
     if (w.pending >= 0) {
       refuse(Status::malformed, "a frame while a view's image is incomplete");
     } else {
-      const Status s = p.walk_frames.consume(payload, size, p.walk_geometry.hot(), p.walk_geometry.hot_count(), w.view_of,
-                                             w.params.views, &pose);
+      ArithDecoder d;
+      Status s = d.init(payload, size);
+      if (s == Status::ok) s = p.walk_geometry.decode(d);
+      if (s == Status::ok)
+        s = p.walk_frames.decode(d, p.walk_geometry.hot(), p.walk_geometry.hot_count(), w.view_of, w.params.views, &pose);
+      if (s == Status::ok) s = d.finish();
       if (s != Status::ok) refuse(s, "WFRM was refused");
     }
     p.add_decode(p.work_clock() - t0);

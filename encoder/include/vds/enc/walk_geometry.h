@@ -17,6 +17,7 @@
 #include <array>
 #include <vector>
 
+#include "vds/enc/arith_encoder.h"
 #include "vds/enc/scene.h"
 #include "vds/walk_geometry.h"
 
@@ -43,8 +44,8 @@ WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& vi
 // map units of a grid point (Quake maps built from whole-unit brushes: 1).
 int32_t choose_walk_quantum(const Scene& s, double tolerance);
 
-// The WGEO chunk of each frame (vds/walk_geometry.h), mirroring the
-// client's decoder state.
+// The geometry of each frame's record (vds/walk_geometry.h), mirroring
+// the client's decoder state.
 class WalkGeometryEncoder {
  public:
   // `quantum_raw`: the vertex grid, a power of two in raw Q16.16 world
@@ -55,7 +56,9 @@ class WalkGeometryEncoder {
     bool hot_now;
     std::array<std::array<double, 3>, 3> vertices;  // world units, rounded to the grid
   };
-  // One frame: its sends, in order, and its hot slots (any order).
+  // One frame: its sends, in order, and its hot slots (any order), into the
+  // record's coder — or into a payload of its own.
+  void encode(ArithEncoder& e, const std::vector<Send>& sends, const std::vector<uint32_t>& hot);
   std::vector<uint8_t> encode(const std::vector<Send>& sends, const std::vector<uint32_t>& hot);
 
  private:

@@ -39,6 +39,8 @@ struct WalkEncodeResult {
   std::vector<uint8_t> stream;
   int quality = 0;
   size_t view_updates = 0;
+  // Bytes by part: header (HEAD, WLKP), views (WVUP and the images), the
+  // records' geometry, and the rest of the records (pose, views, framing).
   size_t header_bytes = 0, view_bytes = 0, geometry_bytes = 0, frame_bytes = 0;
   uint32_t slots = 0;
   size_t workspace_bytes = 0;       // what the client needs beyond its chunk buffer
