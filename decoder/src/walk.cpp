@@ -43,13 +43,20 @@ Status walk_camera(const StreamHeader& h, const WalkPose& pose, Camera* out) {
   return Status::ok;
 }
 
+Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPose& pose, Camera* out) {
+  StreamHeader v = h;
+  v.focal_x_q16 = v.focal_y_q16 = w.view_focal_q16;
+  return walk_camera(v, pose, out);
+}
+
 Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out) {
   if (size != kWalkParamsBytes) return Status::malformed;
   WalkParams w;
   w.slots = load_le16(p);
   w.views = p[2];
   w.quantum_raw = get_i32(p + 4);
-  if (p[3] != 0 || w.slots == 0 || w.views == 0 || w.views > kWalkMaxViews || w.quantum_raw < 1 || w.quantum_raw > 65536 ||
+  w.view_focal_q16 = get_i32(p + 8);
+  if (w.view_focal_q16 < (kCameraMinFocalPx << 16) || w.view_focal_q16 > (kCameraMaxFocalPx << 16) || p[3] != 0 || w.slots == 0 || w.views == 0 || w.views > kWalkMaxViews || w.quantum_raw < 1 || w.quantum_raw > 65536 ||
       (w.quantum_raw & (w.quantum_raw - 1)) != 0)
     return Status::malformed;
   *out = w;
@@ -61,6 +68,7 @@ void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]) {
   out[2] = w.views;
   out[3] = 0;
   store_le32(out + 4, static_cast<uint32_t>(w.quantum_raw));
+  store_le32(out + 8, static_cast<uint32_t>(w.view_focal_q16));
 }
 
 Status walk_view_from_bytes(const uint8_t* p, uint32_t size, uint8_t* slot, WalkPose* pose) {

@@ -17,7 +17,7 @@ namespace {
 
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, size = "240x180";
-  double rate = 16, threshold = 3;
+  double rate = 16, threshold = 12;
   int views = 2, quality = -1;
 };
 
@@ -68,7 +68,7 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("-o,--output", o->out, "Stream to write")->required();
   sub->add_option("--rate", o->rate, "Target rate, kbit/s (default 16)")->check(kPositive);
   sub->add_option("--views", o->views, "Views the client holds (default 2)")->check(CLI::Range(1, 8));
-  sub->add_option("--threshold", o->threshold, "Largest magnification a view serves (default 3)")->check(kPositive);
+  sub->add_option("--threshold", o->threshold, "Largest magnification a view serves (default 12)")->check(kPositive);
   sub->add_option("--quality", o->quality, "The views' image quality (default: the best that fits the rate)")->check(CLI::Range(0, 100));
   sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");
   sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 240x180)");

@@ -54,6 +54,10 @@ class WalkFrameEncoder {
   WalkFrameState state_{};
 };
 
+double sc0_focal(const CameraPath& path, const WalkEncodeOptions& o) {
+  return scene_camera(path.frames.front(), path.hfov_deg, o.width, o.height).focal;
+}
+
 }  // namespace
 
 WalkPose walk_pose(const CameraPose& p) {
@@ -114,7 +118,27 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vo.tolerance_px = static_cast<size_t>(o.tolerance * o.width * o.height);
   vo.width = o.width;
   vo.height = o.height;
-  const WalkViewPlan vp = plan_walk_views(s, path, visible, vo);
+  // Views see wider than the screen (a pan stays inside a view longer):
+  // what a view at each frame's camera shows.
+  const double kDeg = 3.14159265358979323846 / 180;
+  // (No wider than the client's smallest focal length allows.)
+  const double widen = std::clamp(o.view_widen, 1.0, std::max(1.0, sc0_focal(path, o) / kCameraMinFocalPx));
+  const double view_hfov = 2 * std::atan(widen * std::tan(path.hfov_deg * kDeg / 2)) / kDeg;
+  vo.view_hfov_deg = view_hfov;
+  CameraPath wide = path;
+  wide.hfov_deg = view_hfov;
+  RenderOptions vro = ro;
+  vro.supersample = 1;
+  vro.max_aniso = 1;
+  const SceneRenderer view_vis(s, {}, vro);
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> view_visible(n);
+  render_path(view_vis, wide, o.threads, [&](size_t f, const SceneFrame& fr) {
+    std::map<uint32_t, uint32_t> px;
+    for (uint32_t id : fr.ids)
+      if (id != kNoTriangle) ++px[id];
+    view_visible[f].assign(px.begin(), px.end());
+  }, [&](size_t done) { progress("view visibility", done, n); });
+  const WalkViewPlan vp = plan_walk_views(s, path, visible, vo, &view_visible);
   // 3. The views, rendered at the client's cameras.
   std::vector<WalkPose> poses(n);
   for (size_t f = 0; f < n; ++f) poses[f] = walk_pose(path.frames[f]);
@@ -123,7 +147,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     for (const auto& u : ups) view_images[u.camera_frame];
   size_t done = 0;
   for (auto& [g, img] : view_images) {
-    img = renderer.render(from_walk_pose(poses[g]), path.hfov_deg).rgb;
+    img = renderer.render(from_walk_pose(poses[g]), view_hfov).rgb;
     progress("views", ++done, view_images.size());
   }
   // 4. The header and the parts that do not depend on the views' quality.
@@ -141,6 +165,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   wp.slots = static_cast<uint16_t>(slots);
   wp.views = static_cast<uint8_t>(o.views);
   wp.quantum_raw = choose_walk_quantum(s, 1.0 / 16);
+  wp.view_focal_q16 = static_cast<int32_t>(std::lround(scene_camera(path.frames[0], view_hfov, o.width, o.height).focal * 65536));
   h.workspace_bytes = static_cast<uint32_t>(Player::walk_workspace_bytes(h, wp, kClientPlayerConfig));
   h.max_triangles = slots;
   WalkGeometryEncoder ge(slots, wp.quantum_raw);

@@ -42,17 +42,23 @@ vds::Camera client_camera(const CameraPose& pose, double hfov_deg, int width, in
 
 WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
                              const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>& visible,
-                             const WalkViewOptions& o) {
+                             const WalkViewOptions& o, const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>* view_visible) {
   const size_t n = path.frames.size();
   if (visible.size() != n) throw std::invalid_argument("plan_walk_views: one visibility list per frame");
   if (o.slots < 1 || o.slots > 127 || o.lookahead < 0 || !(o.threshold > 0))
     throw std::invalid_argument("plan_walk_views: options out of range");
-  std::vector<vds::Camera> cams;
-  for (const CameraPose& p : path.frames) cams.push_back(client_camera(p, path.hfov_deg, o.width, o.height, o.near_z, o.far_z));
-  // Polygons each frame shows, for "does view v show polygon p".
+  const double view_hfov = o.view_hfov_deg > 0 ? o.view_hfov_deg : path.hfov_deg;
+  if (view_visible != nullptr && view_visible->size() != n) throw std::invalid_argument("plan_walk_views: one view visibility list per frame");
+  std::vector<vds::Camera> cams, vcams;
+  for (const CameraPose& p : path.frames) {
+    cams.push_back(client_camera(p, path.hfov_deg, o.width, o.height, o.near_z, o.far_z));
+    vcams.push_back(client_camera(p, view_hfov, o.width, o.height, o.near_z, o.far_z));
+  }
+  // Polygons the view at each frame's camera shows, for "does view v show polygon p".
+  const auto& vv = view_visible != nullptr ? *view_visible : visible;
   std::vector<std::unordered_set<uint32_t>> shows(n);
   for (size_t f = 0; f < n; ++f)
-    for (const auto& [id, px] : visible[f]) shows[f].insert(id);
+    for (const auto& [id, px] : vv[f]) shows[f].insert(id);
   std::vector<SceneCamera> scams;
   for (const CameraPose& p : path.frames) scams.push_back(scene_camera(p, path.hfov_deg, o.width, o.height));
   const double inf = std::numeric_limits<double>::infinity();
@@ -71,7 +77,7 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     }
     // Clip against planes a . (P - C) >= b of the screen's frustum and the view's near plane.
     const SceneCamera& sc = scams[f];
-    const SceneCamera& vc = scams[g];
+    const SceneCamera vc = scene_camera(path.frames[g], view_hfov, o.width, o.height);
     struct Plane {
       P3 a, c;
       double b;
@@ -107,11 +113,13 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
       tri[k] = {q16(v[0]), q16(v[1]), q16(v[2])};
     }
     vds::Homography vs;
-    if (vds::plane_homography(cams[g], cams[f], tri, &vs) != Status::ok) return inf;
+    if (vds::plane_homography(vcams[g], cams[f], tri, &vs) != Status::ok) return inf;
     double worst = 0;
     for (const P3& p : poly) {
       int32_t x, y;
-      if (!vds::camera_project(cams[g], vds::camera_transform(cams[g], {q16(p[0]), q16(p[1]), q16(p[2])}), &x, &y)) return inf;
+      if (!vds::camera_project(vcams[g], vds::camera_transform(vcams[g], {q16(p[0]), q16(p[1]), q16(p[2])}), &x, &y)) return inf;
+      // The view must hold the point: inside its image (half a pixel of slack).
+      if (x < -128 || y < -128 || x > o.width * 256 + 128 || y > o.height * 256 + 128) return inf;
       const Q16_16 sc16 = vds::homography_scale(vs, x, y);
       if (sc16 == Q16_16::max()) return inf;
       worst = std::max(worst, sc16.raw() / 65536.0);

@@ -43,14 +43,18 @@ struct WalkPose {
 // invalid_argument when the result fails validate_camera().
 Status walk_camera(const StreamHeader& h, const WalkPose& pose, Camera* out);
 
-// WLKP payload (8 bytes): u16 polygon slots, u8 view slots, u8 0, i32
-// vertex grid quantum (raw Q16.16, a power of two).
+// WLKP payload (12 bytes): u16 polygon slots, u8 view slots, u8 0, i32
+// vertex grid quantum (raw Q16.16, a power of two), i32 the views' focal
+// length (Q16.16 pixels; views may see wider than the screen).
 struct WalkParams {
   uint16_t slots = 0;
   uint8_t views = 0;
   int32_t quantum_raw = 0;
+  int32_t view_focal_q16 = 0;
 };
-constexpr uint32_t kWalkParamsBytes = 8;
+constexpr uint32_t kWalkParamsBytes = 12;
+// The camera of a view: walk_camera with the views' focal length.
+Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPose& pose, Camera* out);
 Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out);
 void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]);
 

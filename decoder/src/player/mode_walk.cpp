@@ -173,7 +173,7 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
     if (w.pending >= 0) refuse(Status::malformed, "a view update before the last one's image is whole");
     else if (walk_view_from_bytes(payload, size, &slot, &pose) != Status::ok || slot >= w.params.views)
       refuse(Status::malformed, "WVUP is not valid");
-    else if (walk_camera(p.header(), pose, &w.pending_cam) != Status::ok)
+    else if (walk_view_camera(p.header(), w.params, pose, &w.pending_cam) != Status::ok)
       refuse(Status::malformed, "WVUP's camera is not valid");
     else {
       w.pending = slot;

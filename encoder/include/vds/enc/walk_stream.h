@@ -25,8 +25,9 @@ namespace vds::enc {
 struct WalkEncodeOptions {
   double rate_kbps = 16;  // the whole stream, header included
   int views = 2;          // view slots the client holds
-  double threshold = 3;   // largest magnification a view serves (measured best on oa_dm4: docs/walkthrough.md)
+  double threshold = 12;  // largest magnification a view serves (the sweep on oa_dm4: docs/walkthrough.md)
   int lookahead = 20;     // frames ahead a view's camera may come from
+  double view_widen = 1.5;  // tan(half the views' field of view) / tan(half the screen's)
   int window = 2;         // hot: visible within this many frames either side
   double tolerance = 0.005;  // share of a frame's pixels that may go without a view within the threshold
   int quality = -1;       // the views' image quality; -1: the best that fits the rate

@@ -10,7 +10,8 @@
 // of the part of the polygon the frame's screen shows, in front of the
 // view's near plane, so that polygons reaching behind either camera have a
 // factor) is smallest; a polygon the view does not show (not in that
-// frame's visibility) cannot be served by it. When a frame shows a polygon
+// frame's visibility), or whose part on the screen reaches outside the
+// view's image, cannot be served by it. When a frame shows a polygon
 // that no held view serves with a factor at most `threshold` (more than
 // `tolerance_px` pixels of them), a view update is due at that frame, into
 // the slot whose view serves the fewest of the frame's pixels: rendered at
@@ -42,6 +43,7 @@ struct WalkViewOptions {
   size_t tolerance_px = 0;  // pixels of a frame that may go unserved before an update is due
   int width = 240, height = 180;
   double near_z = 1, far_z = 4096;  // scene units
+  double view_hfov_deg = 0;         // the views' horizontal field of view (0: the path's)
 };
 
 struct WalkViewPlan {
@@ -59,9 +61,12 @@ struct WalkViewPlan {
 };
 
 // `visible[f]`: (polygon, pixels it covers) for each polygon frame f shows,
-// from the ground truth's visibility buffers.
+// from the ground truth's visibility buffers; `view_visible[f]` the same
+// for a view at frame f's camera when views have a wider field of view
+// (nullptr: the same as `visible`).
 WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
                              const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>& visible,
-                             const WalkViewOptions& o = WalkViewOptions{});
+                             const WalkViewOptions& o = WalkViewOptions{},
+                             const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>* view_visible = nullptr);
 
 }  // namespace vds::enc
