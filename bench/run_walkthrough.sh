@@ -7,7 +7,9 @@
 #   kbit/s (two views, threshold THRESHOLD): the stream's kbit/s with its
 #   parts (header, views, geometry, frame records), view updates, the
 #   client's PSNR over R, G, B pooled and its worst frame against the
-#   ground truth, next to each video codec's PSNR at the same rate.
+#   ground truth, next to each video codec's PSNR at the same rate; per
+#   map at 16 kbit/s a contact sheet (ground truth | vds | SVT-AV1 | x264,
+#   walkthrough_<map>_frames.jpg) and per-frame PSNR (walkthrough_<map>_psnr.png).
 #
 # Usage: bench/run_walkthrough.sh [BUILD_DIR]   (default build/host-release)
 #   MAPS="oa_dm4 oa_dm5 oa_rpg3dm2"; THRESHOLD=12; WORK (default BUILD_DIR/walk).
@@ -25,7 +27,7 @@ for map in ${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2}; do
   for rate in 8 16 32; do
     echo "== $map at $rate kbit/s"
     "$VDS" encode-walk "$map" --path "$WORK/$map/tour.txt" --rate "$rate" --threshold "${THRESHOLD:-12}" \
-      -o "$WORK/$map/walk_$rate.vds" 2>/dev/null | tee "$WORK/$map/walk_$rate.txt"
+      -o "$WORK/$map/walk_$rate.vds" --y4m "$WORK/$map/walk_$rate.y4m" 2>/dev/null | tee "$WORK/$map/walk_$rate.txt"
   done
 done
 BENCH_DIR="$ROOT/bench" $PY - "$WORK" "$RESULTS" "${THRESHOLD:-12}" ${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2} <<'PY'
@@ -78,5 +80,55 @@ for ax, m in zip(axes[0], maps):
     ax.grid(True, which="both", lw=0.3); ax.legend(fontsize=7)
 fig.tight_layout()
 fig.savefig(os.path.join(results, "walkthrough_rd.png"), dpi=110)
+
+# At 16 kbit/s: what each shows, side by side, and PSNR frame by frame.
+import subprocess
+import numpy as np
+from PIL import Image
+W, H = 240, 180
+
+def y4m_rgb(path):
+    raw = open(path, "rb").read()
+    pos, n, out = raw.index(b"\n") + 1, W * H, []
+    while pos < len(raw):
+        pos = raw.index(b"\n", pos) + 1
+        p = np.frombuffer(raw, np.uint8, 3 * n, pos).reshape(3, H, W).astype(np.float32)
+        y, cb, cr = p[0], p[1] - 128, p[2] - 128
+        out.append(np.stack([y + 1.402 * cr, y - 0.344136 * cb - 0.714136 * cr, y + 1.772 * cb], -1).clip(0, 255).round())
+        pos += 3 * n
+    return np.array(out, np.uint8)
+
+def decoded(path, fmt):
+    raw = subprocess.run(["ffmpeg", "-hide_banner", "-loglevel", "error", "-f", fmt, "-i", path, "-fps_mode", "passthrough",
+                          "-sws_flags", "bicubic+accurate_rnd+full_chroma_int", "-f", "rawvideo", "-pix_fmt", "rgb24", "-"],
+                         check=True, stdout=subprocess.PIPE).stdout
+    return np.frombuffer(raw, np.uint8).reshape(-1, H, W, 3)
+
+def psnr(a, b):
+    m = ((a.astype(np.float32) - b.astype(np.float32)) ** 2).mean(axis=(1, 2, 3))
+    return 10 * np.log10(255 ** 2 / np.maximum(m, 1e-9))
+
+for m in maps:
+    d = os.path.join(work, m)
+    gt = np.fromfile(os.path.join(d, "gt.rgb"), np.uint8).reshape(-1, H, W, 3)
+    rows = {"ground truth": gt, "vds walkthrough": y4m_rgb(os.path.join(d, "walk_16.y4m")),
+            "SVT-AV1": decoded(os.path.join(d, "svt-av1_rate16.obu"), "obu"), "x264": decoded(os.path.join(d, "x264_rate16.h264"), "h264")}
+    picks = [int(i) for i in np.linspace(0, len(gt) - 1, 5)[1:]]
+    sheet = Image.new("RGB", (W * len(picks) + 4 * (len(picks) - 1), H * len(rows) + 4 * (len(rows) - 1)), (128, 128, 128))
+    for r, (name, frames) in enumerate(rows.items()):
+        for c, f in enumerate(picks):
+            sheet.paste(Image.fromarray(frames[f]), (c * (W + 4), r * (H + 4)))
+    sheet.save(os.path.join(results, f"walkthrough_{m}_frames.jpg"), quality=88)
+    fig, ax = plt.subplots(figsize=(9, 3.2))
+    for name, frames in list(rows.items())[1:]:
+        ax.plot(psnr(frames, gt), lw=0.8, label=name)
+    ax.set_xlabel("frame"); ax.set_ylabel("PSNR R,G,B (dB)"); ax.set_title(f"{m} at 16 kbit/s, frame by frame")
+    ax.grid(True, lw=0.3); ax.legend(fontsize=7)
+    fig.tight_layout(); fig.savefig(os.path.join(results, f"walkthrough_{m}_psnr.png"), dpi=100)
+    L.append(f"## {m} at 16 kbit/s\n")
+    L.append(f"Rows: ground truth, vds walkthrough, SVT-AV1, x264; columns: frames {', '.join(map(str, picks))}.\n")
+    L.append(f"![{m} frames](walkthrough_{m}_frames.jpg)\n")
+    L.append(f"![{m} per-frame PSNR](walkthrough_{m}_psnr.png)\n")
+open(os.path.join(results, "walkthrough.md"), "w").write("\n".join(L))
 print("\n".join(L))
 PY
