@@ -18,7 +18,7 @@ namespace {
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, size = "240x180";
   double rate = 16, threshold = 12;
-  int views = 2, quality = -1;
+  int views = 2, quality = -1, refine_delta = -1, refine_after = -1;
 };
 
 void run_encode_walk(const EncodeWalkOptions& o) {
@@ -31,6 +31,8 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.views = o.views;
   wo.threshold = o.threshold;
   wo.quality = o.quality;
+  if (o.refine_delta >= 0) wo.refine_delta = o.refine_delta;
+  if (o.refine_after >= 0) wo.refine_after = o.refine_after;
   if (std::sscanf(o.size.c_str(), "%dx%d", &wo.width, &wo.height) != 2 || wo.width < 16 || wo.height < 16 || wo.width > 1024 ||
       wo.height > 1024)
     throw Failure(kExitUsage, "--size must be WIDTHxHEIGHT, each 16..1024, not '" + o.size + "'");
@@ -48,10 +50,10 @@ void run_encode_walk(const EncodeWalkOptions& o) {
     y.close();
   }
   const double secs = path.frames.size() / path.fps;
-  std::printf("%s: %zu frames (%.1f s), %zu bytes = %.2f kbit/s (target %.2f): header %zu, views %zu (%zu updates at quality %d), "
-              "geometry %zu, frames %zu\n",
+  std::printf("%s: %zu frames (%.1f s), %zu bytes = %.2f kbit/s (target %.2f): header %zu, views %zu (%zu updates at quality %d, "
+              "%zu refinements), geometry %zu, frames %zu\n",
               o.out.c_str(), path.frames.size(), secs, r.stream.size(), r.kbps, o.rate, r.header_bytes, r.view_bytes,
-              r.view_updates, r.quality, r.geometry_bytes, r.frame_bytes);
+              r.view_updates, r.quality, r.view_refinements, r.geometry_bytes, r.frame_bytes);
   double worst = 99;
   for (double p : r.frame_psnr) worst = std::min(worst, p);
   std::printf("  client: %u triangle slots, %d views, %zu bytes of workspace; PSNR R,G,B %.2f dB pooled, %.2f dB worst frame\n",
@@ -72,6 +74,8 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--quality", o->quality, "The views' image quality (default: the best that fits the rate)")->check(CLI::Range(0, 100));
   sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");
   sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 240x180)");
+  sub->add_option("--refine-delta", o->refine_delta, "A refinement's image quality above the views' (0: none)")->check(CLI::Range(0, 100));
+  sub->add_option("--refine-after", o->refine_after, "Frames after a view arrives that it is refined")->check(CLI::Range(1, 1000));
   sub->callback([o] { run_encode_walk(*o); });
 }
 

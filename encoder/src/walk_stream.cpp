@@ -203,17 +203,45 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     wfrm[f] = e.finish();
     progress("geometry", f + 1, n);
   }
+  // Refinements: a view that serves at least 2 * refine_after frames gets,
+  // refine_after frames after it arrives, a residual image at a higher
+  // quality against what the client holds of it.
+  struct Refine {
+    uint32_t slot, camera_frame;
+  };
+  std::vector<std::vector<Refine>> refines(n);
+  if (o.refine_delta > 0) {
+    for (size_t f = 0; f < n; ++f)
+      for (const auto& u : vp.updates[f]) {
+        size_t next = n;
+        for (size_t g = f + 1; g < n && next == n; ++g)
+          for (const auto& v : vp.updates[g])
+            if (v.slot == u.slot) next = g;
+        const size_t at = f + static_cast<size_t>(o.refine_after);
+        if (next - f >= 2 * static_cast<size_t>(o.refine_after) && at < n) refines[at].push_back({u.slot, u.camera_frame});
+      }
+  }
   // 5. The stream at a quality; the best that fits the rate.
   const auto build = [&](int quality, WalkEncodeResult* r) {
     ImageEncodeOptions io;
     io.quality = quality;
     io.max_chunk_payload = 4096;
-    std::map<uint32_t, EncodedImage> coded;
+    std::map<uint32_t, EncodedImage> coded, refined;
     uint32_t max_payload = 4096;
     for (const auto& [g, img] : view_images) {
       coded[g] = encode_image(img, io);
       max_payload = std::max(max_payload, coded[g].max_payload());
     }
+    for (const auto& rs : refines)
+      for (const Refine& rf : rs) {
+        if (refined.count(rf.camera_frame)) continue;
+        ImageEncodeOptions ro2 = io;
+        ro2.quality = std::min(100, quality + o.refine_delta);
+        ro2.mode = ImageMode::residual;
+        ro2.prediction = &coded.at(rf.camera_frame).recon;
+        refined[rf.camera_frame] = encode_planes(rgb_to_planes(view_images.at(rf.camera_frame), ChromaFormat::yuv420), ro2);
+        max_payload = std::max(max_payload, refined[rf.camera_frame].max_payload());
+      }
     StreamHeader hh = h;
     hh.max_chunk_payload = max_payload;
     for (size_t f = 0; f < n; ++f)
@@ -224,7 +252,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     w.add_chunk(chunk::kWalkParams, params);
     r->header_bytes = w.size();
     r->view_bytes = r->geometry_bytes = r->frame_bytes = 0;
-    r->view_updates = 0;
+    r->view_updates = r->view_refinements = 0;
     for (size_t f = 0; f < n; ++f) {
       for (const auto& u : vp.updates[f]) {
         const size_t before = w.size();
@@ -234,6 +262,15 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
         add_image_chunks(w, coded.at(u.camera_frame));
         r->view_bytes += w.size() - before;
         ++r->view_updates;
+      }
+      for (const Refine& rf : refines[f]) {
+        const size_t before = w.size();
+        uint8_t vb[kWalkViewBytes];
+        walk_view_to_bytes(static_cast<uint8_t>(rf.slot), poses[rf.camera_frame], vb);
+        w.add_chunk(chunk::kWalkView, vb);
+        add_image_chunks(w, refined.at(rf.camera_frame));
+        r->view_bytes += w.size() - before;
+        ++r->view_refinements;
       }
       const size_t before = w.size();
       w.add_chunk(chunk::kWalkFrame, wfrm[f]);

@@ -31,6 +31,8 @@ Stream valid_walk() {
   o.quality = 20;
   o.width = 64;
   o.height = 48;
+  o.refine_delta = 30;  // residual refinements too
+  o.refine_after = 2;
   const auto r = vds::enc::encode_walk(vds::test::walk_room(), vds::test::walk_room_path(8), o);
   Stream s;
   // Split the stream into its chunks by the container layout.

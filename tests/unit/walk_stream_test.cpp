@@ -38,6 +38,24 @@ TEST(WalkStream, ARoomPlaysEndToEndWithinItsRate) {
               r.psnr_rgb);
 }
 
+TEST(WalkStream, RefinementsAddToTheViewsTheClientHolds) {
+  // Residual images refining held views: the client adds them to what its
+  // slots hold, and shows what the encoder's replay shows; at a fixed
+  // quality they make the pictures better.
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
+  vds::enc::WalkEncodeOptions o;
+  o.quality = 20;
+  const auto plain = vds::enc::encode_walk(room, path, o);
+  o.refine_delta = 30;
+  o.refine_after = 5;
+  const auto refined = vds::enc::encode_walk(room, path, o);
+  ASSERT_GT(refined.view_refinements, 0u);
+  EXPECT_EQ(vds::enc::client_frame_crcs(refined.stream), refined.frame_crc);
+  EXPECT_GT(refined.psnr_rgb, plain.psnr_rgb + 0.5) << plain.psnr_rgb << " " << refined.psnr_rgb;
+  EXPECT_GT(refined.stream.size(), plain.stream.size());
+}
+
 TEST(WalkStream, DamagedStreamsAreRefusedNotCrashed) {
   const vds::enc::Scene room = vds::test::walk_room();
   vds::enc::WalkEncodeOptions o;

@@ -4,7 +4,8 @@
 // brings its triangles, hot slots and camera, and the frame is drawn there by mapping each hot triangle from the stored view WFRM names for it
 // (Shading::view_mapped, the screen -> view homography of its plane).
 // Views arrive as WVUP and an intra vds image decoded into the view's
-// Y'CbCr 4:2:0 planes.
+// Y'CbCr 4:2:0 planes; a WVUP naming a slot's own camera again may carry a
+// residual image that refines what the slot holds.
 #include "vds/homography.h"
 #include "vds/player.h"
 #include "vds/render.h"
@@ -19,6 +20,7 @@ struct WalkPlay {
   Texture view_tex[kWalkMaxViews];
   int pending = -1;  // the view slot a WVUP opened, until its image is whole
   Camera pending_cam;
+  bool pending_refines = false;  // the WVUP names the slot's own camera: its image may be a residual
   bool image_open = false;
   Mesh* meshes = nullptr;
   Vec3<Q16_16>* positions = nullptr;
@@ -43,6 +45,14 @@ RenderConfig render_config(const StreamHeader& h, const WalkParams& w, const Pla
   rc.vertex_cache = 3u * w.slots;
   rc.triangle_cache = w.slots;
   return rc;
+}
+
+bool cameras_equal(const Camera& a, const Camera& b) {
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c)
+      if (a.rotation.m[r][c].raw() != b.rotation.m[r][c].raw()) return false;
+  return a.position.x.raw() == b.position.x.raw() && a.position.y.raw() == b.position.y.raw() &&
+         a.position.z.raw() == b.position.z.raw() && a.fx.raw() == b.fx.raw() && a.fy.raw() == b.fy.raw();
 }
 
 bool render_band(void* ctx, const Band& b) {
@@ -178,7 +188,9 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
     else {
       w.pending = slot;
       w.image_open = false;
-      w.view_ready[slot] = false;
+      // The slot's own camera again: a refinement, added to what the slot holds.
+      w.pending_refines = w.view_ready[slot] && cameras_equal(w.view_cam[slot], w.pending_cam);
+      if (!w.pending_refines) w.view_ready[slot] = false;
     }
   } else if (type == chunk::kImageHeader || type == chunk::kImageData) {
     if (w.pending < 0) {
@@ -188,8 +200,8 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
       if (type == chunk::kImageHeader) {
         ImageHeader ih;
         if (w.image_open || image_header_from_bytes(payload, size, &ih) != Status::ok || ih.width != t.width ||
-            ih.height != t.height || ih.chroma != ChromaFormat::yuv420 || ih.residual() || ih.region())
-          refuse(Status::malformed, "a view's image must be an intra 4:2:0 image of the frame's size");
+            ih.height != t.height || ih.chroma != ChromaFormat::yuv420 || ih.region() || (ih.residual() && !w.pending_refines))
+          refuse(Status::malformed, "a view's image must be a 4:2:0 image of the frame's size, a residual only refining its own view");
         else
           w.image_open = true;
       }

@@ -28,6 +28,8 @@ struct WalkEncodeOptions {
   double threshold = 12;  // largest magnification a view serves (the sweep on oa_dm4: docs/walkthrough.md)
   int lookahead = 20;     // frames ahead a view's camera may come from
   double view_widen = 1.5;  // tan(half the views' field of view) / tan(half the screen's)
+  int refine_delta = 0;     // a refinement's quality above the views' (0: none; they did not pay on oa_dm4: docs/walkthrough.md)
+  int refine_after = 10;    // frames after a view arrives; views serving at least twice that are refined
   int window = 2;         // hot: visible within this many frames either side
   double tolerance = 0.005;  // share of a frame's pixels that may go without a view within the threshold
   int quality = -1;       // the views' image quality; -1: the best that fits the rate
@@ -39,7 +41,7 @@ struct WalkEncodeOptions {
 struct WalkEncodeResult {
   std::vector<uint8_t> stream;
   int quality = 0;
-  size_t view_updates = 0;
+  size_t view_updates = 0, view_refinements = 0;
   // Bytes by part: header (HEAD, WLKP), views (WVUP and the images), the
   // records' geometry, and the rest of the records (pose, views, framing).
   size_t header_bytes = 0, view_bytes = 0, geometry_bytes = 0, frame_bytes = 0;
