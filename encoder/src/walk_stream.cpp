@@ -253,23 +253,22 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     r->header_bytes = w.size();
     r->view_bytes = r->geometry_bytes = r->frame_bytes = 0;
     r->view_updates = r->view_refinements = 0;
+    // A view into a slot: WVUP with its camera's pose, then its image.
+    const auto put_view = [&](uint32_t slot, uint32_t camera_frame, const EncodedImage& image) {
+      const size_t before = w.size();
+      uint8_t vb[kWalkViewBytes];
+      walk_view_to_bytes(static_cast<uint8_t>(slot), poses[camera_frame], vb);
+      w.add_chunk(chunk::kWalkView, vb);
+      add_image_chunks(w, image);
+      r->view_bytes += w.size() - before;
+    };
     for (size_t f = 0; f < n; ++f) {
       for (const auto& u : vp.updates[f]) {
-        const size_t before = w.size();
-        uint8_t vb[kWalkViewBytes];
-        walk_view_to_bytes(static_cast<uint8_t>(u.slot), poses[u.camera_frame], vb);
-        w.add_chunk(chunk::kWalkView, vb);
-        add_image_chunks(w, coded.at(u.camera_frame));
-        r->view_bytes += w.size() - before;
+        put_view(u.slot, u.camera_frame, coded.at(u.camera_frame));
         ++r->view_updates;
       }
       for (const Refine& rf : refines[f]) {
-        const size_t before = w.size();
-        uint8_t vb[kWalkViewBytes];
-        walk_view_to_bytes(static_cast<uint8_t>(rf.slot), poses[rf.camera_frame], vb);
-        w.add_chunk(chunk::kWalkView, vb);
-        add_image_chunks(w, refined.at(rf.camera_frame));
-        r->view_bytes += w.size() - before;
+        put_view(rf.slot, rf.camera_frame, refined.at(rf.camera_frame));
         ++r->view_refinements;
       }
       const size_t before = w.size();
