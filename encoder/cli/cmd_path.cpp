@@ -67,7 +67,7 @@ void run_tour(const PathOptions& o) {
   enc::CameraPath picks;
   picks.hfov_deg = p.hfov_deg;
   const size_t tiles = std::min<size_t>(12, p.frames.size());
-  for (size_t k = 0; k < tiles; ++k) picks.frames.push_back(p.frames[tiles < 2 ? 0 : k * (p.frames.size() - 1) / (tiles - 1)]);
+  for (size_t k = 0; k < tiles; ++k) picks.frames.push_back(p.frames[sheet_frame(k, tiles, p.frames.size())]);
   const enc::SceneRenderer renderer(scene, enc::load_scene_images(scene));
   std::vector<io::Image> tilesv;
   enc::render_path(renderer, picks, 0, [&](size_t, const enc::SceneFrame& f) { tilesv.push_back(f.rgb); });

@@ -69,7 +69,6 @@ void run_render(const RenderCmdOptions& o) {
   // The contact sheet: 12 frames evenly spread.
   const size_t n = path.frames.size(), tiles = std::min<size_t>(12, n);
   std::vector<io::Image> sheet;
-  const auto sheet_frame = [&](size_t k) { return tiles < 2 ? 0 : k * (n - 1) / (tiles - 1); };
   const auto t0 = std::chrono::steady_clock::now();
   const auto sink = [&](size_t i, const enc::SceneFrame& f) {
     y4m.write(f.rgb);
@@ -82,7 +81,7 @@ void run_render(const RenderCmdOptions& o) {
       std::snprintf(name, sizeof name, "/%05zu.png", i);
       io::save_png(o.png_dir + name, f.rgb);
     }
-    if (sheet.size() < tiles && i == sheet_frame(sheet.size())) sheet.push_back(f.rgb);
+    if (sheet.size() < tiles && i == sheet_frame(sheet.size(), tiles, n)) sheet.push_back(f.rgb);
   };
   const auto progress = [&](size_t done) {
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

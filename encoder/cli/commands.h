@@ -27,6 +27,10 @@ inline const CLI::Validator kPositive(
     },
     "POSITIVE");
 
+// The frames of a contact sheet: the k-th of `tiles` frames spread evenly
+// over `n` (the first and the last included).
+inline size_t sheet_frame(size_t k, size_t tiles, size_t n) { return tiles < 2 ? 0 : k * (n - 1) / (tiles - 1); }
+
 struct Failure : std::runtime_error {
   Failure(int code, const std::string& what) : std::runtime_error(what), exit_code(code) {}
   int exit_code;

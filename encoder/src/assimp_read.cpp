@@ -12,6 +12,7 @@
 
 #include "mesh_glb_check.h"
 #include "mesh_ply_check.h"
+#include "text.h"
 
 namespace vds::enc {
 
@@ -72,9 +73,7 @@ class ConfinedIO : public Assimp::DefaultIOSystem {
     if (file != nullptr && main_ == file) return new Assimp::MemoryIOStream(data_, size_, false);
     const std::string p = resolve(file);
     if (p.empty()) return nullptr;
-    std::string ext = std::filesystem::path(p).extension().string();
-    for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (ext != ".mtl") return DefaultIOSystem::Open(p.c_str(), mode);
+    if (extension_of(p) != "mtl") return DefaultIOSystem::Open(p.c_str(), mode);
     std::unique_ptr<Assimp::IOStream> in(DefaultIOSystem::Open(p.c_str(), mode));
     if (!in) return nullptr;
     const size_t n = in->FileSize();

@@ -356,14 +356,7 @@ CameraPath make_tour(const Scene& s, const SceneRays& rays, const TourOptions& o
   // The clearance actually kept, frame by frame.
   rep.min_clearance = o.radius * 4;
   for (const CameraPose& f : path.frames) {
-    const Vec3 p = {f.x, f.y, f.z};
-    for (int x = -1; x <= 1; ++x)
-      for (int y = -1; y <= 1; ++y)
-        for (int z = -1; z <= 1; ++z) {
-          if (x == 0 && y == 0 && z == 0) continue;
-          const double l = std::sqrt(static_cast<double>(x * x + y * y + z * z));
-          rep.min_clearance = std::min(rep.min_clearance, rays.cast(p, {x / l, y / l, z / l}, rep.min_clearance));
-        }
+    rep.min_clearance = rays.clearance({f.x, f.y, f.z}, rep.min_clearance);
   }
   if (report) *report = rep;
   return path;

@@ -20,6 +20,7 @@
 #include <draco/core/decoder_buffer.h>
 
 #include "assimp_read.h"
+#include "text.h"
 #include "vds/enc/stream_writer.h"
 
 namespace vds::enc {
@@ -68,16 +69,6 @@ Mesh from_scene(const aiScene* scene, MeshRepairReport* report) {
 }
 
 bool is_draco(const uint8_t* data, size_t size) { return size >= 5 && std::memcmp(data, "DRACO", 5) == 0; }
-
-// The file name's extension, lower case, without the dot ("" if none).
-std::string extension_of(const std::string& name) {
-  const size_t dot = name.find_last_of('.');
-  const size_t slash = name.find_last_of('/');
-  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-  std::string e = name.substr(dot + 1);
-  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return e;
-}
 
 // A mesh file's bytes, checked and imported. `root` is the folder whose
 // files the importer may open besides these bytes (empty: none).

@@ -9,6 +9,7 @@
 #include <assimp/postprocess.h>
 
 #include "assimp_read.h"
+#include "text.h"
 #include "vds/enc/scene.h"
 #include "vds/enc/stream_writer.h"
 
@@ -20,9 +21,7 @@ uint8_t unit_to_byte(float v) { return static_cast<uint8_t>(std::lround(std::cla
 
 Scene read_scene(const uint8_t* data, size_t size, const std::string& path, const std::filesystem::path& root) {
   std::error_code ec;
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (!ext.empty()) ext.erase(0, 1);
+  const std::string ext = extension_of(path);
   Assimp::Importer importer;
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_TANGENTS_AND_BITANGENTS | aiComponent_BONEWEIGHTS |
                                                           aiComponent_ANIMATIONS | aiComponent_LIGHTS | aiComponent_CAMERAS);

@@ -9,6 +9,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "text.h"
 #include "vds/enc/scene.h"
 #include "vds/enc/scene_render.h"
 #include "vds/io/image.h"
@@ -22,11 +23,6 @@ struct Pk3Set::Archive {
 };
 
 namespace {
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 // The shaders of the archives applied to the scene's textures, and each
 // used texture's image resolved as the game does.
@@ -44,7 +40,7 @@ void apply_shaders(const Pk3Set& pk3, Scene* s) {
     if (!used[k]) continue;
     SceneTexture& t = s->textures[k];
     std::string image = t.name;
-    const auto it = shaders.find(lower(t.name));
+    const auto it = shaders.find(ascii_lower(t.name));
     if (it != shaders.end()) {
       const ShaderInfo& sh = it->second;
       t.scripted = true;
@@ -60,7 +56,7 @@ void apply_shaders(const Pk3Set& pk3, Scene* s) {
     }
     // The image's own extension is a hint only: the game tries TGA, then JPEG, then PNG.
     const std::filesystem::path ip(image);
-    const std::string ext = lower(ip.extension().string());
+    const std::string ext = ascii_lower(ip.extension().string());
     if (ext == ".tga" || ext == ".jpg" || ext == ".jpeg" || ext == ".png") image = image.substr(0, image.size() - ext.size());
     for (const char* e : {".tga", ".jpg", ".png"}) {
       uint64_t bytes = 0;
@@ -100,7 +96,7 @@ Pk3Set::Pk3Set(const std::string& dir) {
   std::vector<std::string> paths;
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
-    const std::string ext = lower(e.path().extension().string());
+    const std::string ext = ascii_lower(e.path().extension().string());
     if (e.is_regular_file() && ext == ".pk3") paths.push_back(e.path().string());
   }
   if (ec) throw std::runtime_error(dir + ": cannot list (" + ec.message() + ")");
@@ -124,7 +120,7 @@ Pk3Set::Pk3Set(const std::string& dir) {
     const zip_int64_t n = zip_get_num_entries(z, 0);
     for (zip_int64_t i = 0; i < n; ++i) {
       const char* entry = zip_get_name(z, static_cast<zip_uint64_t>(i), 0);
-      if (entry != nullptr) index_[lower(entry)] = {archives_.size() - 1, static_cast<uint64_t>(i)};
+      if (entry != nullptr) index_[ascii_lower(entry)] = {archives_.size() - 1, static_cast<uint64_t>(i)};
     }
   }
 }
@@ -140,7 +136,7 @@ void Pk3Set::close_all() {
 }
 
 bool Pk3Set::find(const std::string& entry, uint64_t* bytes, std::string* archive) const {
-  const auto it = index_.find(lower(entry));
+  const auto it = index_.find(ascii_lower(entry));
   if (it == index_.end()) return false;
   const Archive& a = *archives_[it->second.first];
   zip_stat_t st;
@@ -153,7 +149,7 @@ bool Pk3Set::find(const std::string& entry, uint64_t* bytes, std::string* archiv
 }
 
 bool Pk3Set::read(const std::string& entry, std::vector<uint8_t>* out, std::string* archive, uint64_t max_bytes) const {
-  const auto found = index_.find(lower(entry));
+  const auto found = index_.find(ascii_lower(entry));
   if (found == index_.end()) return false;
   {
     const Archive& a = *archives_[found->second.first];
@@ -189,7 +185,7 @@ bool Pk3Set::read(const std::string& entry, std::vector<uint8_t>* out, std::stri
 }
 
 std::vector<std::string> Pk3Set::entries(const std::string& prefix, const std::string& suffix) const {
-  const std::string p = lower(prefix), x = lower(suffix);
+  const std::string p = ascii_lower(prefix), x = ascii_lower(suffix);
   std::vector<std::string> out;
   for (const auto& e : index_)
     if (e.first.size() >= p.size() + x.size() && e.first.compare(0, p.size(), p) == 0 &&
@@ -205,7 +201,7 @@ std::string openarena_dir() {
 }
 
 Scene load_scene(const std::string& scene, const SceneOptions& o) {
-  const std::string ext = lower(std::filesystem::path(scene).extension().string());
+  const std::string ext = ascii_lower(std::filesystem::path(scene).extension().string());
   std::unique_ptr<Pk3Set> pk3;
   const auto archives = [&]() -> const Pk3Set& {
     if (!pk3) pk3 = std::make_unique<Pk3Set>(openarena_dir());

@@ -133,16 +133,20 @@ double SceneRays::cast(const Vec3& o, const Vec3& d, double tmax) const {
   return best;
 }
 
-bool SceneRays::clear(const Vec3& p, double radius) const {
+double SceneRays::clearance(const Vec3& p, double limit, double enough) const {
+  double nearest = limit;
   for (int x = -1; x <= 1; ++x)
     for (int y = -1; y <= 1; ++y)
       for (int z = -1; z <= 1; ++z) {
         if (x == 0 && y == 0 && z == 0) continue;
         const double l = std::sqrt(static_cast<double>(x * x + y * y + z * z));
-        if (cast(p, {x / l, y / l, z / l}, radius) < radius) return false;
+        nearest = std::min(nearest, cast(p, {x / l, y / l, z / l}, nearest));
+        if (nearest < enough) return nearest;
       }
-  return true;
+  return nearest;
 }
+
+bool SceneRays::clear(const Vec3& p, double radius) const { return clearance(p, radius, radius) >= radius; }
 
 bool SceneRays::segment_clear(const Vec3& a, const Vec3& b, double radius) const {
   if (!clear(a, radius) || !clear(b, radius)) return false;

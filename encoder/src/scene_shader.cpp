@@ -19,15 +19,11 @@
 #include <string>
 #include <vector>
 
+#include "text.h"
 #include "vds/enc/scene.h"
 
 namespace vds::enc {
 namespace {
-
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
 // Tokens of a script with the line each starts on; comments (// and /* */)
 // removed, quotes kept together.
@@ -99,7 +95,7 @@ void read_shader_script(const std::string& text, const std::string& name, Shader
     return a;
   };
   while (i < t.size()) {
-    const std::string shader = lower(t[i].text);
+    const std::string shader = ascii_lower(t[i].text);
     const int at = t[i].line;
     if (shader == "{" || shader == "}") fail("a brace where a shader name should be", at);
     if (i + 1 >= t.size() || t[i + 1].text != "{") fail("shader '" + t[i].text + "' has no body", at);
@@ -109,7 +105,7 @@ void read_shader_script(const std::string& text, const std::string& name, Shader
     std::vector<Stage> stages;
     bool closed = false;
     while (i < t.size()) {
-      const std::string key = lower(t[i].text);
+      const std::string key = ascii_lower(t[i].text);
       if (key == "}") {
         ++i;
         closed = true;
@@ -122,7 +118,7 @@ void read_shader_script(const std::string& text, const std::string& name, Shader
         Stage st;
         bool stage_closed = false;
         while (i < t.size()) {
-          const std::string k = lower(t[i].text);
+          const std::string k = ascii_lower(t[i].text);
           if (k == "}") {
             ++i;
             stage_closed = true;
@@ -131,18 +127,18 @@ void read_shader_script(const std::string& text, const std::string& name, Shader
           if (k == "{") fail("a stage inside a stage", t[i].line);
           const std::vector<std::string> a = args(i);
           if ((k == "map" || k == "clampmap") && !a.empty()) {
-            if (lower(a[0]) == "$lightmap") st.lightmap = true;
+            if (ascii_lower(a[0]) == "$lightmap") st.lightmap = true;
             else if (is_image(a[0]) && st.image.empty()) st.image = a[0];
           } else if (k == "animmap" && a.size() >= 2 && is_image(a[1]) && st.image.empty()) {
             st.image = a[1];
           } else if (k == "blendfunc" && !a.empty()) {
-            const std::string b0 = lower(a[0]), b1 = a.size() > 1 ? lower(a[1]) : "";
+            const std::string b0 = ascii_lower(a[0]), b1 = a.size() > 1 ? ascii_lower(a[1]) : "";
             st.additive = b0 == "add" || (b0 == "gl_one" && b1 == "gl_one");
             st.alpha = st.alpha || b0 == "blend" || (b0 == "gl_src_alpha" && b1 == "gl_one_minus_src_alpha");
           } else if (k == "alphafunc") {
             st.alpha = true;
           } else if (k == "rgbgen" && !a.empty()) {
-            const std::string g = lower(a[0]);
+            const std::string g = ascii_lower(a[0]);
             st.vertex = g == "vertex" || g == "exactvertex" || g == "lightingdiffuse";
           }
           i += 1 + a.size();
@@ -153,12 +149,12 @@ void read_shader_script(const std::string& text, const std::string& name, Shader
       }
       const std::vector<std::string> a = args(i);
       if (key == "surfaceparm" && !a.empty()) {
-        const std::string p = lower(a[0]);
+        const std::string p = ascii_lower(a[0]);
         info.sky = info.sky || p == "sky";
         info.fog = info.fog || p == "fog";
         info.nodraw = info.nodraw || p == "nodraw";
       } else if (key == "cull" && !a.empty()) {
-        const std::string c = lower(a[0]);
+        const std::string c = ascii_lower(a[0]);
         info.two_sided = c == "none" || c == "disable" || c == "twosided";
       } else if (key == "qer_editorimage" && !a.empty()) {
         editor_image = a[0];

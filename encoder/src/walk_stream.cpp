@@ -174,6 +174,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   std::vector<size_t> geometry_part(n);  // bytes of each record's geometry
   std::vector<uint8_t> view_of(slots, 0);
   std::vector<uint8_t> slot_view(slots, 0);
+  std::vector<uint32_t> id_of_slot(slots, 0);  // the triangle each slot holds, as the sends so far put them
   for (size_t f = 0; f < n; ++f) {
     std::vector<WalkGeometryEncoder::Send> sends;
     for (const auto& snd : geo.sends[f]) {
@@ -190,9 +191,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     // Each hot triangle's view: the plan's for those the frame shows, else the one it had.
     std::map<uint32_t, int8_t> choice;
     for (size_t k = 0; k < visible[f].size(); ++k) choice[visible[f][k].first] = vp.choice[f][k];
-    std::map<uint32_t, uint32_t> id_of_slot;
-    for (size_t g = 0; g <= f; ++g)
-      for (const auto& snd : geo.sends[g]) id_of_slot[snd.slot] = snd.id;
+    for (const auto& snd : geo.sends[f]) id_of_slot[snd.slot] = snd.id;
     std::vector<uint8_t> now;
     for (uint32_t slot : geo.hot[f]) {
       const auto it = choice.find(id_of_slot[slot]);

@@ -59,8 +59,11 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   std::vector<std::unordered_set<uint32_t>> shows(n);
   for (size_t f = 0; f < n; ++f)
     for (const auto& [id, px] : vv[f]) shows[f].insert(id);
-  std::vector<SceneCamera> scams;
-  for (const CameraPose& p : path.frames) scams.push_back(scene_camera(p, path.hfov_deg, o.width, o.height));
+  std::vector<SceneCamera> scams, vscams;  // each frame's camera as the screen and as a view
+  for (const CameraPose& p : path.frames) {
+    scams.push_back(scene_camera(p, path.hfov_deg, o.width, o.height));
+    vscams.push_back(scene_camera(p, view_hfov, o.width, o.height));
+  }
   const double inf = std::numeric_limits<double>::infinity();
   // The factor of the view at frame g for polygon id on frame f's screen
   // (+inf if g does not show it): the largest magnification of the
@@ -77,7 +80,7 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     }
     // Clip against planes a . (P - C) >= b of the screen's frustum and the view's near plane.
     const SceneCamera& sc = scams[f];
-    const SceneCamera vc = scene_camera(path.frames[g], view_hfov, o.width, o.height);
+    const SceneCamera& vc = vscams[g];
     struct Plane {
       P3 a, c;
       double b;

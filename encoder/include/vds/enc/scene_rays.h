@@ -19,8 +19,11 @@ class SceneRays {
   // Distance along `dir` (unit length) from `origin` to the first triangle,
   // or `tmax` if none is nearer.
   double cast(const Vec3& origin, const Vec3& dir, double tmax) const;
-  // True when no triangle lies within `radius` of `p` along the 26
-  // directions of a cube's faces, edges and corners.
+  // The distance from `p` to the nearest triangle along the 26 directions
+  // of a cube's faces, edges and corners, or `limit` if none is nearer;
+  // it stops looking once it has found one nearer than `enough`.
+  double clearance(const Vec3& p, double limit, double enough = 0) const;
+  // True when no triangle lies within `radius` of `p` along those directions.
   bool clear(const Vec3& p, double radius) const;
   // True when the segment a-b and four segments beside it (offset by
   // `radius` left, right, up and down of its direction) cross no triangle,
