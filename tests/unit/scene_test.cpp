@@ -358,3 +358,27 @@ TEST(SceneModel, AGlbSceneWithAnEmbeddedTextureKeepsItsOrientation) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(SceneModel, EveryPrefixOfAnObjSceneIsReadOrRefusedByName) {
+  // (From memory a scene may open no other file: no material library.)
+  const std::string obj =
+      "v -5 -5 -5\nv 5 -5 -5\nv 5 5 -5\nv -5 5 -5\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n"
+      "usemtl wall\nf 1/1/1 2/2/1 3/3/1 4/4/1\n";
+  size_t read = 0;
+  for (size_t n = 0; n <= obj.size(); ++n) {
+    try {
+      const Scene s = vds::enc::read_model_scene(reinterpret_cast<const uint8_t*>(obj.data()), n, "room.obj");
+      for (uint32_t i : s.indices) ASSERT_LT(i, s.vertices.size());
+      ++read;
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("room.obj: ", 0), 0u) << e.what();
+    }
+  }
+  // The whole file reads, with its two triangles.
+  EXPECT_EQ(vds::enc::read_model_scene(reinterpret_cast<const uint8_t*>(obj.data()), obj.size(), "room.obj").triangles(), 2u);
+  EXPECT_GT(read, 0u);
+}
+
+}  // namespace
