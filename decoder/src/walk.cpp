@@ -56,8 +56,10 @@ Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out) 
   w.views = p[2];
   w.quantum_raw = get_i32(p + 4);
   w.view_focal_q16 = get_i32(p + 8);
-  if (w.view_focal_q16 < (kCameraMinFocalPx << 16) || w.view_focal_q16 > (kCameraMaxFocalPx << 16) || p[3] != 0 || w.slots == 0 || w.views == 0 || w.views > kWalkMaxViews || w.quantum_raw < 1 || w.quantum_raw > 65536 ||
-      (w.quantum_raw & (w.quantum_raw - 1)) != 0)
+  w.frames_per_record = p[3];
+  if (w.view_focal_q16 < (kCameraMinFocalPx << 16) || w.view_focal_q16 > (kCameraMaxFocalPx << 16) || w.slots == 0 ||
+      w.views == 0 || w.views > kWalkMaxViews || w.frames_per_record == 0 || w.frames_per_record > kWalkMaxFramesPerRecord ||
+      w.quantum_raw < 1 || w.quantum_raw > 65536 || (w.quantum_raw & (w.quantum_raw - 1)) != 0)
     return Status::malformed;
   *out = w;
   return Status::ok;
@@ -66,7 +68,7 @@ Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out) 
 void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]) {
   store_le16(out, w.slots);
   out[2] = w.views;
-  out[3] = 0;
+  out[3] = w.frames_per_record;
   store_le32(out + 4, static_cast<uint32_t>(w.quantum_raw));
   store_le32(out + 8, static_cast<uint32_t>(w.view_focal_q16));
 }
@@ -93,6 +95,7 @@ void WalkFrameState::reset() {
   arith_init_contexts(&zero[0], 5);
   arith_init_contexts(&mag[0][0], 5 * 6);
   arith_init_contexts(&same_view, 1);
+  arith_init_contexts(&record_frames[0], kWalkMaxFramesPerRecord - 1);
   for (auto& r : prev)
     for (int32_t& v : r) v = 0;
   frames = 0;
@@ -128,6 +131,12 @@ WalkPose walk_steps_to_pose(const int32_t steps[5]) {
   p.yaw = static_cast<uint16_t>(steps[3]);
   p.pitch = static_cast<uint16_t>(steps[4]);
   return p;
+}
+
+uint32_t WalkFrameDecoder::read_count(ArithDecoder& d, uint8_t max_frames) {
+  if (max_frames == 0 || max_frames > kWalkMaxFramesPerRecord) return 0;
+  const uint32_t n = d.decode_unary(state_.record_frames, kWalkMaxFramesPerRecord - 1, max_frames - 1u) + 1u;
+  return d.ok() ? n : 0;
 }
 
 Status WalkFrameDecoder::consume(const uint8_t* payload, uint32_t size, const uint16_t* hot, uint32_t hot_count,

@@ -11,7 +11,7 @@ void WalkGeometryContexts::reset() {
   arith_init_contexts(&count[0], sizeof(*this) / sizeof(ArithContext));
 }
 
-void walk_predict(const WalkVertexCache& cache, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]) {
+void walk_predict(const WalkVertexRing& ring, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]) {
   // The third vertex of a triangle sharing an edge with the one before it:
   // the parallelogram across that edge (exact for the second half of a
   // rectangle).
@@ -29,25 +29,19 @@ void walk_predict(const WalkVertexCache& cache, const int32_t prev[3][3], const 
       return;
     }
   }
-  for (int a = 0; a < 3; ++a) out[a] = cache.size > 0 ? cache.v[0][a] : 0;
+  for (int a = 0; a < 3; ++a) out[a] = ring.size > 0 ? ring.at(0)[a] : 0;
 }
 
-void WalkVertexCache::use(int i) {
-  int32_t t[3] = {v[i][0], v[i][1], v[i][2]};
-  for (int k = i; k > 0; --k)
-    for (int c = 0; c < 3; ++c) v[k][c] = v[k - 1][c];
-  for (int c = 0; c < 3; ++c) v[0][c] = t[c];
-}
-
-void WalkVertexCache::push(const int32_t p[3]) {
-  if (size < kWalkVertexCache) ++size;
-  for (int k = size - 1; k > 0; --k)
-    for (int c = 0; c < 3; ++c) v[k][c] = v[k - 1][c];
-  for (int c = 0; c < 3; ++c) v[0][c] = p[c];
+uint32_t walk_get_ring_index(ArithDecoder& d, ArithContext* ring_bucket) {
+  const uint32_t b = d.decode_unary(ring_bucket, static_cast<int>(kWalkRingBits + 1), kWalkRingBits);
+  if (!d.ok()) return kWalkVertexRing;
+  if (b <= 1) return b;
+  return (1u << (b - 1)) | d.decode_bits_bypass(static_cast<int>(b - 1));
 }
 
 size_t WalkGeometry::workspace_bytes(uint32_t slots) {
-  return 3 * static_cast<size_t>(slots) * sizeof(Vec3<Q16_16>) + alignof(Vec3<Q16_16>) + 2 * slots + 2 * 2 * slots + 8;
+  return 3 * static_cast<size_t>(slots) * sizeof(Vec3<Q16_16>) + alignof(Vec3<Q16_16>) + 2 * slots + 2 * 2 * slots + 8 +
+         kWalkVertexRing * 3 * sizeof(int32_t) + alignof(int32_t);
 }
 
 Status WalkGeometry::init(Arena& arena, uint32_t slots, int32_t quantum_raw) {
@@ -58,7 +52,8 @@ Status WalkGeometry::init(Arena& arena, uint32_t slots, int32_t quantum_raw) {
   mark_ = arena.alloc_array<uint8_t>(slots);
   hot_ = arena.alloc_array<uint16_t>(slots);
   next_hot_ = arena.alloc_array<uint16_t>(slots);
-  if (!positions_ || !filled_ || !mark_ || !hot_ || !next_hot_) return Status::workspace_too_small;
+  int32_t(*ring)[3] = static_cast<int32_t(*)[3]>(arena.alloc(kWalkVertexRing * 3 * sizeof(int32_t), alignof(int32_t)));
+  if (!positions_ || !filled_ || !mark_ || !hot_ || !next_hot_ || !ring) return Status::workspace_too_small;
   for (uint32_t s = 0; s < slots; ++s) filled_[s] = 0, mark_[s] = 0;
   slots_ = slots;
   quantum_ = quantum_raw;
@@ -67,7 +62,7 @@ Status WalkGeometry::init(Arena& arena, uint32_t slots, int32_t quantum_raw) {
   last_slot_ = slots - 1;
   frames_ = 0;
   ctx_.reset();
-  cache_.reset();
+  ring_.reset(ring);
   for (int c = 0; c < 3; ++c)
     for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a] = INT32_MIN;
   have_prev_ = false;
@@ -102,14 +97,13 @@ Status WalkGeometry::decode(ArithDecoder& d) {
     const int hot_now = d.decode_bit(ctx_.hot_now);
     for (int c = 0; c < 3; ++c) {
       int32_t g[3];
-      if (cache_.size > 0 && d.decode_bit(ctx_.cached[c])) {
-        const uint32_t i = d.decode_ueg(ctx_.cache_index, 6, 8, 2);
-        if (i >= static_cast<uint32_t>(cache_.size)) return d.ok() ? Status::malformed : d.status();
-        cache_.use(static_cast<int>(i));
-        for (int a = 0; a < 3; ++a) g[a] = cache_.v[0][a];
+      if (ring_.size > 0 && d.decode_bit(ctx_.cached[c])) {
+        const uint32_t i = walk_get_ring_index(d, ctx_.ring_bucket);
+        if (i >= ring_.size) return d.ok() ? Status::malformed : d.status();
+        for (int a = 0; a < 3; ++a) g[a] = ring_.at(i)[a];
       } else {
         int32_t pred[3];
-        walk_predict(cache_, prev_, cur_, c, pred);
+        walk_predict(ring_, prev_, cur_, c, pred);
         for (int a = 0; a < 3; ++a) {
           const int32_t base = pred[a];
           // Whole map units, then the fraction in grid steps.
@@ -120,8 +114,8 @@ Status WalkGeometry::decode(ArithDecoder& d) {
           if (v < -(int64_t{1} << 30) || v > (int64_t{1} << 30)) return d.ok() ? Status::malformed : d.status();
           g[a] = static_cast<int32_t>(v);
         }
-        cache_.push(g);
       }
+      ring_.push(g);
       for (int a = 0; a < 3; ++a) cur_[c][a] = g[a];
       for (int a = 0; a < 3; ++a) {
         const int64_t raw = static_cast<int64_t>(g[a]) * quantum_;

@@ -18,7 +18,7 @@ namespace {
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, size = "240x180";
   double rate = 16, threshold = 12;
-  int views = 2, quality = -1, refine_delta = -1, refine_after = -1;
+  int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
 };
 
 void run_encode_walk(const EncodeWalkOptions& o) {
@@ -31,6 +31,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.views = o.views;
   wo.threshold = o.threshold;
   wo.quality = o.quality;
+  wo.frames_per_record = o.frames_per_record;
   if (o.refine_delta >= 0) wo.refine_delta = o.refine_delta;
   if (o.refine_after >= 0) wo.refine_after = o.refine_after;
   if (std::sscanf(o.size.c_str(), "%dx%d", &wo.width, &wo.height) != 2 || wo.width < 16 || wo.height < 16 || wo.width > 1024 ||
@@ -72,6 +73,8 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--views", o->views, "Views the client holds (default 2)")->check(CLI::Range(1, 8));
   sub->add_option("--threshold", o->threshold, "Largest magnification a view serves (default 12)")->check(kPositive);
   sub->add_option("--quality", o->quality, "The views' image quality (default: the best that fits the rate)")->check(CLI::Range(0, 100));
+  sub->add_option("--frames-per-record", o->frames_per_record, "Most frames a WFRM record holds (default 8)")
+      ->check(CLI::Range(1, static_cast<int>(kWalkMaxFramesPerRecord)));
   sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");
   sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 240x180)");
   sub->add_option("--refine-delta", o->refine_delta, "A refinement's image quality above the views' (0: none)")->check(CLI::Range(0, 100));

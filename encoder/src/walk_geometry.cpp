@@ -116,11 +116,11 @@ int32_t choose_walk_quantum(const Scene& s, double tolerance) {
 }
 
 WalkGeometryEncoder::WalkGeometryEncoder(uint32_t slots, int32_t quantum_raw)
-    : slots_(slots), quantum_(quantum_raw), last_slot_(slots - 1) {
+    : slots_(slots), quantum_(quantum_raw), ring_storage_(kWalkVertexRing), last_slot_(slots - 1) {
   if (slots == 0 || slots > kWalkMaxSlots || quantum_raw < 1 || quantum_raw > 65536 || (quantum_raw & (quantum_raw - 1)) != 0)
     throw std::invalid_argument("WalkGeometryEncoder: slots or quantum out of range");
   ctx_.reset();
-  cache_.reset();
+  ring_.reset(reinterpret_cast<int32_t(*)[3]>(ring_storage_.data()));
   for (int c = 0; c < 3; ++c)
     for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a] = INT32_MIN;
 }
@@ -150,20 +150,25 @@ void WalkGeometryEncoder::encode(ArithEncoder& e, const std::vector<Send>& sends
     for (int c = 0; c < 3; ++c) {
       int32_t g[3];
       for (int a = 0; a < 3; ++a) g[a] = static_cast<int32_t>(std::lround(s.vertices[static_cast<size_t>(c)][static_cast<size_t>(a)] / q));
-      int found = -1;
-      for (int i = 0; i < cache_.size; ++i)
-        if (cache_.v[i][0] == g[0] && cache_.v[i][1] == g[1] && cache_.v[i][2] == g[2]) {
+      // The newest copy in the ring, if any.
+      uint32_t found = kWalkVertexRing;
+      for (uint32_t i = 0; i < ring_.size; ++i) {
+        const int32_t* r = ring_.at(i);
+        if (r[0] == g[0] && r[1] == g[1] && r[2] == g[2]) {
           found = i;
           break;
         }
-      if (cache_.size > 0) e.encode_bit(ctx_.cached[c], found >= 0);
-      if (found >= 0) {
-        e.encode_ueg(ctx_.cache_index, 6, static_cast<uint32_t>(found), 8, 2);
-        cache_.use(found);
+      }
+      if (ring_.size > 0) e.encode_bit(ctx_.cached[c], found < kWalkVertexRing);
+      if (found < kWalkVertexRing) {
+        uint32_t b = 0;
+        while ((found >> b) != 0) ++b;
+        e.encode_unary(ctx_.ring_bucket, static_cast<int>(kWalkRingBits + 1), b, kWalkRingBits);
+        if (b >= 2) e.encode_bits_bypass(found & ((1u << (b - 1)) - 1u), static_cast<int>(b - 1));
       } else {
         const int fb = walk_fraction_bits(quantum_);
         int32_t pred[3];
-        walk_predict(cache_, prev_, cur_, c, pred);
+        walk_predict(ring_, prev_, cur_, c, pred);
         for (int a = 0; a < 3; ++a) {
           const int32_t base = pred[a];
           const int64_t delta = static_cast<int64_t>(g[a]) - base;
@@ -172,8 +177,8 @@ void WalkGeometryEncoder::encode(ArithEncoder& e, const std::vector<Send>& sends
           e.encode_signed(ctx_.delta_zero[a], ctx_.delta_mag[a], 6, static_cast<int32_t>(whole), 6, 3);
           for (int b = fb - 1; b >= 0; --b) e.encode_bit(ctx_.fraction[fb - 1 - b], static_cast<int>((fraction >> b) & 1));
         }
-        cache_.push(g);
       }
+      ring_.push(g);
       for (int a = 0; a < 3; ++a) cur_[c][a] = g[a];
     }
     for (int c = 0; c < 3; ++c)

@@ -24,6 +24,10 @@ constexpr double kTurn = 65536.0 / 360.0;
 class WalkFrameEncoder {
  public:
   WalkFrameEncoder() { state_.reset(); }
+  // A record's frame count, first in its coder.
+  void encode_count(ArithEncoder& e, uint32_t frames, uint8_t max_frames) {
+    e.encode_unary(state_.record_frames, kWalkMaxFramesPerRecord - 1, frames - 1, max_frames - 1u);
+  }
   // `view_of` holds each slot's last view (in) and is set to `views_now` for the hot slots (out).
   void encode(ArithEncoder& e, const WalkPose& pose, const std::vector<uint32_t>& hot, const std::vector<uint8_t>& views_now,
               std::vector<uint8_t>& view_of, uint8_t views) {
@@ -164,44 +168,13 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   WalkParams wp;
   wp.slots = static_cast<uint16_t>(slots);
   wp.views = static_cast<uint8_t>(o.views);
+  if (o.frames_per_record < 1 || o.frames_per_record > kWalkMaxFramesPerRecord)
+    throw std::invalid_argument("encode_walk: 1 to 8 frames a record");
+  wp.frames_per_record = static_cast<uint8_t>(o.frames_per_record);
   wp.quantum_raw = choose_walk_quantum(s, 1.0 / 16);
   wp.view_focal_q16 = static_cast<int32_t>(std::lround(scene_camera(path.frames[0], view_hfov, o.width, o.height).focal * 65536));
   h.workspace_bytes = static_cast<uint32_t>(Player::walk_workspace_bytes(h, wp, kClientPlayerConfig));
   h.max_triangles = slots;
-  WalkGeometryEncoder ge(slots, wp.quantum_raw);
-  WalkFrameEncoder fe;
-  std::vector<std::vector<uint8_t>> wfrm(n);
-  std::vector<size_t> geometry_part(n);  // bytes of each record's geometry
-  std::vector<uint8_t> view_of(slots, 0);
-  std::vector<uint8_t> slot_view(slots, 0);
-  std::vector<uint32_t> id_of_slot(slots, 0);  // the triangle each slot holds, as the sends so far put them
-  for (size_t f = 0; f < n; ++f) {
-    std::vector<WalkGeometryEncoder::Send> sends;
-    for (const auto& snd : geo.sends[f]) {
-      WalkGeometryEncoder::Send e{snd.slot, true, {}};
-      for (int c = 0; c < 3; ++c)
-        for (int a = 0; a < 3; ++a)
-          e.vertices[static_cast<size_t>(c)][static_cast<size_t>(a)] =
-              s.vertices[s.indices[3 * static_cast<size_t>(snd.id) + static_cast<size_t>(c)]].pos[static_cast<size_t>(a)];
-      sends.push_back(e);
-    }
-    ArithEncoder e;
-    ge.encode(e, sends, geo.hot[f]);
-    geometry_part[f] = e.finished_size();
-    // Each hot triangle's view: the plan's for those the frame shows, else the one it had.
-    std::map<uint32_t, int8_t> choice;
-    for (size_t k = 0; k < visible[f].size(); ++k) choice[visible[f][k].first] = vp.choice[f][k];
-    for (const auto& snd : geo.sends[f]) id_of_slot[snd.slot] = snd.id;
-    std::vector<uint8_t> now;
-    for (uint32_t slot : geo.hot[f]) {
-      const auto it = choice.find(id_of_slot[slot]);
-      now.push_back(it != choice.end() && it->second >= 0 ? static_cast<uint8_t>(it->second) : slot_view[slot]);
-      slot_view[slot] = now.back();
-    }
-    fe.encode(e, poses[f], geo.hot[f], now, view_of, wp.views);
-    wfrm[f] = e.finish();
-    progress("geometry", f + 1, n);
-  }
   // Refinements: a view that serves at least 2 * refine_after frames gets,
   // refine_after frames after it arrives, a residual image at a higher
   // quality against what the client holds of it.
@@ -220,8 +193,55 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
         if (next - f >= 2 * static_cast<size_t>(o.refine_after) && at < n) refines[at].push_back({u.slot, u.camera_frame});
       }
   }
+  // Records: a frame with view updates or refinements starts one (they
+  // must arrive before it, and after every frame the record before it
+  // draws); a record holds up to frames_per_record frames.
+  std::vector<size_t> record_start;
+  for (size_t f = 0; f < n; ++f)
+    if (f == 0 || !vp.updates[f].empty() || !refines[f].empty() ||
+        f - record_start.back() >= static_cast<size_t>(wp.frames_per_record))
+      record_start.push_back(f);
+  WalkGeometryEncoder ge(slots, wp.quantum_raw);
+  WalkFrameEncoder fe;
+  std::vector<std::vector<uint8_t>> wfrm(record_start.size());  // by record
+  std::vector<size_t> geometry_part(record_start.size());       // bytes of each record's geometry
+  std::vector<uint8_t> view_of(slots, 0);
+  std::vector<uint8_t> slot_view(slots, 0);
+  std::vector<uint32_t> id_of_slot(slots, 0);  // the triangle each slot holds, as the sends so far put them
+  for (size_t r = 0; r < record_start.size(); ++r) {
+    const size_t end = r + 1 < record_start.size() ? record_start[r + 1] : n;
+    ArithEncoder e;
+    fe.encode_count(e, static_cast<uint32_t>(end - record_start[r]), wp.frames_per_record);
+    for (size_t f = record_start[r]; f < end; ++f) {
+      std::vector<WalkGeometryEncoder::Send> sends;
+      for (const auto& snd : geo.sends[f]) {
+        WalkGeometryEncoder::Send gs{snd.slot, true, {}};
+        for (int c = 0; c < 3; ++c)
+          for (int a = 0; a < 3; ++a)
+            gs.vertices[static_cast<size_t>(c)][static_cast<size_t>(a)] =
+                s.vertices[s.indices[3 * static_cast<size_t>(snd.id) + static_cast<size_t>(c)]].pos[static_cast<size_t>(a)];
+        sends.push_back(gs);
+      }
+      const size_t g0 = e.finished_size();
+      ge.encode(e, sends, geo.hot[f]);
+      geometry_part[r] += e.finished_size() - g0;
+      // Each hot triangle's view: the plan's for those the frame shows, else the one it had.
+      std::map<uint32_t, int8_t> choice;
+      for (size_t k = 0; k < visible[f].size(); ++k) choice[visible[f][k].first] = vp.choice[f][k];
+      for (const auto& snd : geo.sends[f]) id_of_slot[snd.slot] = snd.id;
+      std::vector<uint8_t> now;
+      for (uint32_t slot : geo.hot[f]) {
+        const auto it = choice.find(id_of_slot[slot]);
+        now.push_back(it != choice.end() && it->second >= 0 ? static_cast<uint8_t>(it->second) : slot_view[slot]);
+        slot_view[slot] = now.back();
+      }
+      fe.encode(e, poses[f], geo.hot[f], now, view_of, wp.views);
+      progress("geometry", f + 1, n);
+    }
+    wfrm[r] = e.finish();
+  }
   // 5. The stream at a quality; the best that fits the rate.
-  const auto build = [&](int quality, WalkEncodeResult* r) {
+  const auto build = [&](int quality, WalkEncodeResult* res) {
     ImageEncodeOptions io;
     io.quality = quality;
     io.max_chunk_payload = 4096;
@@ -243,15 +263,14 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       }
     StreamHeader hh = h;
     hh.max_chunk_payload = max_payload;
-    for (size_t f = 0; f < n; ++f)
-      hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(wfrm[f].size()));
+    for (const auto& rec : wfrm) hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(rec.size()));
     StreamWriter w(hh);
     uint8_t params[kWalkParamsBytes];
     walk_params_to_bytes(wp, params);
     w.add_chunk(chunk::kWalkParams, params);
-    r->header_bytes = w.size();
-    r->view_bytes = r->geometry_bytes = r->frame_bytes = 0;
-    r->view_updates = r->view_refinements = 0;
+    res->header_bytes = w.size();
+    res->view_bytes = res->geometry_bytes = res->frame_bytes = 0;
+    res->view_updates = res->view_refinements = 0;
     // A view into a slot: WVUP with its camera's pose, then its image.
     const auto put_view = [&](uint32_t slot, uint32_t camera_frame, const EncodedImage& image) {
       const size_t before = w.size();
@@ -259,28 +278,29 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       walk_view_to_bytes(static_cast<uint8_t>(slot), poses[camera_frame], vb);
       w.add_chunk(chunk::kWalkView, vb);
       add_image_chunks(w, image);
-      r->view_bytes += w.size() - before;
+      res->view_bytes += w.size() - before;
     };
-    for (size_t f = 0; f < n; ++f) {
+    for (size_t r = 0; r < record_start.size(); ++r) {
+      const size_t f = record_start[r];
       for (const auto& u : vp.updates[f]) {
         put_view(u.slot, u.camera_frame, coded.at(u.camera_frame));
-        ++r->view_updates;
+        ++res->view_updates;
       }
       for (const Refine& rf : refines[f]) {
         put_view(rf.slot, rf.camera_frame, refined.at(rf.camera_frame));
-        ++r->view_refinements;
+        ++res->view_refinements;
       }
       const size_t before = w.size();
-      w.add_chunk(chunk::kWalkFrame, wfrm[f]);
-      // The record's geometry and the rest (its pose, views and the chunk's framing).
-      r->geometry_bytes += std::min(geometry_part[f], wfrm[f].size());
-      r->frame_bytes += w.size() - before - std::min(geometry_part[f], wfrm[f].size());
+      w.add_chunk(chunk::kWalkFrame, wfrm[r]);
+      // The record's geometry and the rest (its poses, views and the chunk's framing).
+      res->geometry_bytes += std::min(geometry_part[r], wfrm[r].size());
+      res->frame_bytes += w.size() - before - std::min(geometry_part[r], wfrm[r].size());
     }
-    r->stream = w.finish();
-    r->quality = quality;
-    r->slots = slots;
-    r->workspace_bytes = h.workspace_bytes;
-    r->kbps = r->stream.size() * 8.0 / (n / path.fps) / 1000;
+    res->stream = w.finish();
+    res->quality = quality;
+    res->slots = slots;
+    res->workspace_bytes = h.workspace_bytes;
+    res->kbps = res->stream.size() * 8.0 / (n / path.fps) / 1000;
   };
   WalkEncodeResult r;
   if (o.quality >= 0) {

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <limits>
@@ -263,6 +264,64 @@ TEST(WalkGeometryRecord, PrefixesAndGarbageAreRefused) {
       for (uint32_t i = 0; i < client.hot_count(); ++i) ASSERT_NE(client.triangle(client.hot()[i]), nullptr);
     }
   }
+}
+
+TEST(WalkGeometryRecord, AVertexNamedAgainComesFromTheRingUpToItsSize) {
+  // A frame of 400 triangles with distinct random vertices, then, a
+  // triangle whose vertices are those of triangle k (sent 3 * (399 - k)
+  // vertices back): from the ring while they are within it — far fewer
+  // bits than new positions — and always at the right place.
+  constexpr int32_t kQ = 65536 / 8;
+  vds::test::Xorshift32 rng;
+  std::vector<vds::enc::WalkGeometryEncoder::Send> base;
+  for (uint32_t i = 0; i < 400; ++i) {
+    vds::enc::WalkGeometryEncoder::Send snd{i, true, {}};
+    for (auto& v : snd.vertices)
+      for (double& c : v) c = static_cast<double>(rng.next() % 4096) - 2048 + (rng.next() % 8) / 8.0;
+    base.push_back(snd);
+  }
+  const auto cost = [&](uint32_t k, bool check) {
+    auto sends = base;
+    auto again = base[k];
+    again.slot = 400;
+    sends.push_back(again);
+    vds::enc::WalkGeometryEncoder enc(401, kQ);
+    std::vector<uint32_t> hot(401);
+    for (uint32_t i = 0; i < 401; ++i) hot[i] = i;
+    const auto head = vds::enc::WalkGeometryEncoder(401, kQ).encode(base, std::vector<uint32_t>(hot.begin(), hot.end() - 1));
+    const auto all = enc.encode(sends, hot);
+    if (check) {
+      std::vector<uint8_t> work(vds::WalkGeometry::workspace_bytes(401));
+      vds::Arena arena(work.data(), work.size());
+      vds::WalkGeometry client;
+      EXPECT_EQ(client.init(arena, 401, kQ), vds::Status::ok);
+      EXPECT_EQ(client.consume(all.data(), static_cast<uint32_t>(all.size())), vds::Status::ok);
+      const auto* t = client.triangle(400);
+      EXPECT_NE(t, nullptr);
+      if (t != nullptr)
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(t[c].x.raw(), static_cast<int32_t>(std::lround(again.vertices[static_cast<size_t>(c)][0] * 65536)));
+    }
+    return static_cast<double>(all.size()) - static_cast<double>(head.size());
+  };
+  const double fresh = [&] {
+    // A triangle of new vertices, for comparison.
+    auto sends = base;
+    vds::enc::WalkGeometryEncoder::Send snd{400, true, {}};
+    for (auto& v : snd.vertices)
+      for (double& c : v) c = static_cast<double>(rng.next() % 4096) - 2048;
+    sends.push_back(snd);
+    std::vector<uint32_t> hot(401);
+    for (uint32_t i = 0; i < 401; ++i) hot[i] = i;
+    const auto head = vds::enc::WalkGeometryEncoder(401, kQ).encode(base, std::vector<uint32_t>(hot.begin(), hot.end() - 1));
+    return static_cast<double>(vds::enc::WalkGeometryEncoder(401, kQ).encode(sends, hot).size()) - static_cast<double>(head.size());
+  }();
+  // Triangle 399 is 3 vertices back, 100 is 900 back (inside the ring of
+  // 1024), 10 is 1170 back (fallen out of it).
+  const double near = cost(399, true), inside = cost(100, true), outside = cost(10, true);
+  std::printf("a triangle named again: 3 back %.0f bytes, 900 back %.0f, 1170 back %.0f; new vertices %.0f\n", near, inside, outside, fresh);
+  EXPECT_LE(inside * 2, fresh);
+  EXPECT_LE(near, inside);
+  EXPECT_GT(outside, inside * 2);
 }
 
 }  // namespace

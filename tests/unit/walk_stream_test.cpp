@@ -5,12 +5,14 @@
 // the client's frames measured against the ground truth.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <vector>
 
 #include "vds/enc/frames.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/enc/walk_stream.h"
+#include "vds/player.h"
 #include "vds/walk.h"
 #include "walk_room.h"
 #include "xorshift.h"
@@ -56,6 +58,62 @@ TEST(WalkStream, RefinementsAddToTheViewsTheClientHolds) {
   EXPECT_GT(refined.stream.size(), plain.stream.size());
 }
 
+TEST(WalkStream, RecordsOfSeveralFramesShowWhatRecordsOfOneShow) {
+  // The same views and decisions in records of up to 8 frames and of one:
+  // the same pictures, fewer chunks, fewer bytes.
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
+  vds::enc::WalkEncodeOptions o;
+  o.quality = 30;
+  o.frames_per_record = 1;
+  const auto one = vds::enc::encode_walk(room, path, o);
+  o.frames_per_record = 8;
+  const auto eight = vds::enc::encode_walk(room, path, o);
+  EXPECT_EQ(eight.frame_crc, one.frame_crc);
+  EXPECT_EQ(vds::enc::client_frame_crcs(eight.stream), eight.frame_crc);
+  // At least 12 bytes of framing saved per record merged away (60 records
+  // of one frame; the records of eight break at each view update).
+  const size_t records = (60 + 7) / 8 + one.view_updates;
+  EXPECT_LE(eight.stream.size() + 12 * (60 - records), one.stream.size()) << one.stream.size() << " " << eight.stream.size();
+}
+
+TEST(WalkStream, TheFeedLimitKeepsABoundedQueueOfFramesFromOverflowing) {
+  // A client with room for `room` frame records feeds no more than the
+  // player's feed limit: however the records drain, no feed completes more
+  // frames than there was room for, and every frame is shown.
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
+  vds::enc::WalkEncodeOptions o;
+  o.quality = 30;
+  const auto r = vds::enc::encode_walk(room, path, o);
+  std::vector<uint8_t> ws(1u << 22);
+  vds::Arena arena(ws.data(), ws.size());
+  vds::PlayerConfig cfg = vds::kClientPlayerConfig;
+  cfg.max_chunk_bytes = 1u << 16;
+  vds::Player player;
+  ASSERT_EQ(player.init(arena, cfg, vds::PlayerCallbacks{}), vds::Status::ok);
+  vds::test::Xorshift32 rng;
+  constexpr uint32_t kQueue = 8;
+  uint32_t pending = 0, most = 0;
+  size_t at = 0;
+  vds::Status s = vds::Status::more_input;
+  while (s == vds::Status::more_input && at < r.stream.size()) {
+    if (pending > 0 && rng.next() % 32 == 0) --pending;  // records leave slowly
+    const size_t limit = player.feed_limit(kQueue - pending);
+    const size_t n = std::min({limit, r.stream.size() - at, size_t{1} + rng.next() % 300});
+    if (n == 0) continue;
+    const uint32_t before = player.frames_shown();
+    s = player.feed(r.stream.data() + at, n);
+    at += n;
+    ASSERT_LE(player.frames_shown() - before, kQueue - pending) << "at byte " << at;
+    pending += player.frames_shown() - before;
+    most = std::max(most, player.frames_shown() - before);
+  }
+  std::printf("room, 60 frames: %zu view updates; at most %u frames completed by one feed\n", r.view_updates, most);
+  EXPECT_EQ(s, vds::Status::ok);
+  EXPECT_EQ(player.frames_shown(), 60u);
+}
+
 TEST(WalkStream, DamagedStreamsAreRefusedNotCrashed) {
   const vds::enc::Scene room = vds::test::walk_room();
   vds::enc::WalkEncodeOptions o;
@@ -87,7 +145,7 @@ TEST(WalkStream, RecordsRoundTripAndRefuseBadFields) {
   EXPECT_NEAR(q.yaw_deg, p.yaw_deg, 360.0 / 65536);
   EXPECT_NEAR(q.pitch_deg, p.pitch_deg, 360.0 / 65536);
   uint8_t b[vds::kWalkParamsBytes];
-  vds::WalkParams w{300, 2, 8192, 80 << 16};
+  vds::WalkParams w{300, 2, 5, 8192, 80 << 16};
   vds::walk_params_to_bytes(w, b);
   vds::WalkParams back;
   ASSERT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::ok);
@@ -95,6 +153,12 @@ TEST(WalkStream, RecordsRoundTripAndRefuseBadFields) {
   EXPECT_EQ(back.views, 2);
   EXPECT_EQ(back.quantum_raw, 8192);
   EXPECT_EQ(back.view_focal_q16, 80 << 16);
+  EXPECT_EQ(back.frames_per_record, 5);
+  b[3] = 0;  // records of no frames
+  EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
+  b[3] = vds::kWalkMaxFramesPerRecord + 1;
+  EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
+  b[3] = 5;
   b[2] = 9;  // more views than a client holds
   EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
   b[2] = 2;

@@ -5,11 +5,13 @@
 // functions (vds/enc/walk_stream.h), so both sides compute every camera
 // alike.
 //
-// A frame's chunks, in order: any view updates due at that frame (WVUP,
-// then the view's IMGH and IMGD chunks), then its WFRM — its geometry,
-// pose and each hot triangle's view in one arithmetic-coded record. The
-// client draws the frame at WFRM: every hot triangle mapped from the view
-// WFRM names for it.
+// The chunks, in order: any view updates due at a frame (WVUP, then the
+// view's IMGH and IMGD chunks), then a WFRM record of that frame and up to
+// WLKP's frames-per-record - 1 frames after it (a record ends before a
+// frame that has view updates) — per frame its geometry, pose and each hot
+// triangle's view, all in one arithmetic-coded record. The client draws
+// each frame as it reads it from the record: every hot triangle mapped
+// from the view the record names for it.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -43,12 +45,15 @@ struct WalkPose {
 // invalid_argument when the result fails validate_camera().
 Status walk_camera(const StreamHeader& h, const WalkPose& pose, Camera* out);
 
-// WLKP payload (12 bytes): u16 polygon slots, u8 view slots, u8 0, i32
-// vertex grid quantum (raw Q16.16, a power of two), i32 the views' focal
-// length (Q16.16 pixels; views may see wider than the screen).
+// WLKP payload (12 bytes): u16 polygon slots, u8 view slots, u8 the most
+// frames a WFRM record holds (1..kWalkMaxFramesPerRecord), i32 vertex grid
+// quantum (raw Q16.16, a power of two), i32 the views' focal length
+// (Q16.16 pixels; views may see wider than the screen).
+constexpr uint8_t kWalkMaxFramesPerRecord = 8;
 struct WalkParams {
   uint16_t slots = 0;
   uint8_t views = 0;
+  uint8_t frames_per_record = 1;
   int32_t quantum_raw = 0;
   int32_t view_focal_q16 = 0;
 };
@@ -72,6 +77,7 @@ struct WalkFrameState {
   ArithContext zero[5];
   ArithContext mag[5][6];
   ArithContext same_view;
+  ArithContext record_frames[kWalkMaxFramesPerRecord - 1];  // a record's frame count - 1, truncated unary
   int32_t prev[2][5] = {};  // the last two poses as steps: x, y, z, yaw, pitch
   uint32_t frames = 0;
   void reset();
@@ -80,15 +86,18 @@ struct WalkFrameState {
   void push(const int32_t steps[5]);
 };
 
-// WFRM payload, one arithmetic-coded stream: the frame's geometry
-// (WalkGeometry::decode, vds/walk_geometry.h), then its pose as five
-// signed ueg3 residuals against WalkFrameState::predict (angles wrap at a
-// turn), then per hot triangle (ascending slot) a "same view as last time"
-// bin and, when not, the view among the others in ceil(log2(views - 1))
-// bypass bits.
+// WFRM payload, one arithmetic-coded stream: the number of frames it
+// holds less one (truncated unary, at most WLKP's frames-per-record - 1;
+// read_count), then per frame: its geometry (WalkGeometry::decode,
+// vds/walk_geometry.h), its pose as five signed ueg3 residuals against
+// WalkFrameState::predict (angles wrap at a turn), then per hot triangle
+// (ascending slot) a "same view as last time" bin and, when not, the view
+// among the others in ceil(log2(views - 1)) bypass bins.
 class WalkFrameDecoder {
  public:
   void reset() { state_.reset(); }
+  // A record's frame count (1..max_frames); 0 when the data is bad.
+  uint32_t read_count(ArithDecoder& d, uint8_t max_frames);
   // Reads a record's pose and views: the pose, and `view_of[hot[i]]` for
   // each hot slot (its last view in, its new view out; views < `views`).
   // malformed for a view out of range; truncated.

@@ -11,9 +11,9 @@
 // geometry record"):
 //   sends     ueg2 count; per send: slot (a "next slot" bin, else
 //             ceil(log2 slots) bypass bins), a "hot now" bin, three
-//             vertices — each a "cached" bin, then its place in a
-//             move-to-front list of the last kWalkVertexCache vertices
-//             (ueg2) or its offset from a prediction (walk_predict), per axis
+//             vertices — each a "cached" bin, then its place among the
+//             last kWalkVertexRing vertices named (walk_get_ring_index)
+//             or its offset from a prediction (walk_predict), per axis
 //             in whole map units (signed ueg3) and then the fraction in
 //             grid steps (one context bin per bit, most significant first:
 //             grid points on whole units cost almost nothing);
@@ -35,7 +35,12 @@
 namespace vds {
 
 constexpr uint32_t kWalkMaxSlots = 16384;
-constexpr int kWalkVertexCache = 32;
+// Vertices the client remembers for reuse (a triangle's vertex may name
+// one of them instead of its position): 12 bytes each.
+constexpr uint32_t kWalkVertexRing = 1024;
+static_assert((kWalkVertexRing & (kWalkVertexRing - 1u)) == 0, "the ring's size is a power of two");
+constexpr uint32_t kWalkRingBits = 10;  // log2(kWalkVertexRing): the longest bit length of a place
+static_assert((1u << kWalkRingBits) == kWalkVertexRing, "kWalkRingBits is the ring's log2");
 
 // The contexts of the geometry coding, shared with the encoder.
 struct WalkGeometryContexts {
@@ -43,7 +48,7 @@ struct WalkGeometryContexts {
   ArithContext next_slot;
   ArithContext hot_now;
   ArithContext cached[3];     // by the vertex's place in its triangle
-  ArithContext cache_index[6];
+  ArithContext ring_bucket[kWalkRingBits + 1];  // the bit length of a vertex's place in the ring
   ArithContext delta_zero[3];  // by axis
   ArithContext delta_mag[3][6];
   ArithContext fraction[16];   // by bit of a vertex offset's fraction of a map unit
@@ -53,22 +58,40 @@ struct WalkGeometryContexts {
   void reset();
 };
 
-// The move-to-front list of recent vertices (grid units), shared with the encoder.
-struct WalkVertexCache {
-  int32_t v[kWalkVertexCache][3];
-  int size = 0;
-  void reset() { size = 0; }
-  // Moves entry i to the front.
-  void use(int i);
-  // Puts a new vertex at the front (the last entry falls off when full).
-  void push(const int32_t p[3]);
+// The vertices named most recently (grid units), newest first: a ring
+// that every vertex a triangle names is pushed into, a new one or one used
+// again (whose older copy stays behind it; the encoder names the newest
+// copy). Pushing costs the same whatever the ring holds. The storage is
+// the owner's: kWalkVertexRing entries.
+struct WalkVertexRing {
+  int32_t (*v)[3] = nullptr;
+  uint32_t size = 0;  // entries held, up to kWalkVertexRing
+  uint32_t head = 0;  // where the next push goes
+  void reset(int32_t (*storage)[3]) {
+    v = storage;
+    size = head = 0;
+  }
+  // Entry i, 0 the newest (i < size).
+  const int32_t* at(uint32_t i) const { return v[(head - 1u - i) & (kWalkVertexRing - 1u)]; }
+  void push(const int32_t p[3]) {
+    int32_t* e = v[head & (kWalkVertexRing - 1u)];
+    e[0] = p[0], e[1] = p[1], e[2] = p[2];
+    head = (head + 1u) & (kWalkVertexRing - 1u);
+    if (size < kWalkVertexRing) ++size;
+  }
 };
+
+// A place in the ring: its bit length (0 for place 0, b for 2^(b-1) ..
+// 2^b - 1) as truncated unary in ring_bucket's contexts, then the bits
+// below the leading one, bypass. Returns the place, or kWalkVertexRing
+// (and the decoder's error) when the data is bad.
+uint32_t walk_get_ring_index(ArithDecoder& d, ArithContext* ring_bucket);
 
 // The prediction of vertex c (0..2) of a triangle being sent, from what
 // both ends know: for the third vertex of a triangle that shares an edge
 // with the previous one sent, the parallelogram across that edge; else the
 // most recent vertex (or the origin). Shared with the encoder.
-void walk_predict(const WalkVertexCache& cache, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]);
+void walk_predict(const WalkVertexRing& ring, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]);
 
 class WalkGeometry {
  public:
@@ -108,7 +131,7 @@ class WalkGeometry {
   uint32_t last_slot_ = 0;
   uint32_t frames_ = 0;
   WalkGeometryContexts ctx_{};
-  WalkVertexCache cache_{};
+  WalkVertexRing ring_{};
   int32_t prev_[3][3]{};  // the previous triangle sent (grid units)
   int32_t cur_[3][3]{};   // the one being read
   bool have_prev_ = false;

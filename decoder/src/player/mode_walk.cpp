@@ -1,8 +1,10 @@
 // Player mode "walkthrough": view-dependent texture streaming along a
 // camera script (vds/walk.h, vds/walk_geometry.h; docs/walkthrough.md).
-// Set up at WLKP for the slots and views it declares; each frame's WFRM
-// brings its triangles, hot slots and camera, and the frame is drawn there by mapping each hot triangle from the stored view WFRM names for it
-// (Shading::view_mapped, the screen -> view homography of its plane).
+// Set up at WLKP for the slots and views it declares; a WFRM record brings
+// one or more frames' triangles, hot slots and cameras, and each frame is
+// drawn as it is read by mapping each hot triangle from the stored view
+// the record names for it (Shading::view_mapped, the screen -> view
+// homography of its plane).
 // Views arrive as WVUP and an intra vds image decoded into the view's
 // Y'CbCr 4:2:0 planes; a WVUP naming a slot's own camera again may carry a
 // residual image that refines what the slot holds.
@@ -220,29 +222,32 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
         }
       }
     }
-  } else {  // WFRM: the frame
-    WalkPose pose;
+  } else {  // WFRM: frames, each drawn as it is read
+    ArithDecoder d;
+    uint32_t frames = 0;
     if (w.pending >= 0) {
       refuse(Status::malformed, "a frame while a view's image is incomplete");
-    } else {
-      ArithDecoder d;
-      Status s = d.init(payload, size);
-      if (s == Status::ok) s = p.walk_geometry.decode(d);
+    } else if (d.init(payload, size) != Status::ok || (frames = p.walk_frames.read_count(d, w.params.frames_per_record)) == 0) {
+      refuse(d.ok() ? Status::malformed : d.status(), "WFRM was refused");
+    }
+    for (uint32_t k = 0; k < frames && result == ChunkResult::consumed; ++k) {
+      const uint64_t f0 = k == 0 ? t0 : p.work_clock();
+      WalkPose pose;
+      Status s = p.walk_geometry.decode(d);
       if (s == Status::ok)
         s = p.walk_frames.decode(d, p.walk_geometry.hot(), p.walk_geometry.hot_count(), w.view_of, w.params.views, &pose);
-      if (s == Status::ok) s = d.finish();
-      if (s != Status::ok) refuse(s, "WFRM was refused");
-    }
-    p.add_decode(p.work_clock() - t0);
-    if (result == ChunkResult::consumed) {
-      if (!p.begin_frame()) {
+      if (s == Status::ok && k + 1 == frames) s = d.finish();
+      p.add_decode(p.work_clock() - f0);
+      if (s != Status::ok) {
+        refuse(s, "WFRM was refused");
+      } else if (!p.begin_frame()) {
         result = ChunkResult::abort;
       } else {
         const uint64_t display_before = p.display_total();
         const uint64_t d0 = p.work_clock();
-        const Status d = draw(p, w, pose);
+        const Status ds = draw(p, w, pose);
         p.add_display((p.work_clock() - d0) - (p.display_total() - display_before));
-        if (d != Status::ok) refuse(d, "the frame could not be drawn");
+        if (ds != Status::ok) refuse(ds, "the frame could not be drawn");
         else if (!p.end_frame()) result = ChunkResult::abort;
       }
     }
@@ -254,9 +259,12 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
   return result;
 }
 
-// A frame can complete at any chunk (a model draws after every level, and
-// a coarse level can be one small chunk; a walkthrough at each WFRM).
-size_t feed_limit(const Player&, uint32_t frames_room) { return detail::chunk_per_frame_feed_limit(frames_room); }
+// Frames complete at WFRM chunks, up to WLKP's frames-per-record each (one
+// a chunk until WLKP is read): no more chunks than that many fit the room.
+size_t feed_limit(const Player& p, uint32_t frames_room) {
+  const uint32_t per_chunk = p.walk != nullptr ? p.walk->params.frames_per_record : 1u;
+  return detail::chunk_per_frame_feed_limit(frames_room / per_chunk);
+}
 
 }  // namespace
 

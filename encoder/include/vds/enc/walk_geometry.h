@@ -51,6 +51,8 @@ class WalkGeometryEncoder {
   // `quantum_raw`: the vertex grid, a power of two in raw Q16.16 world
   // units (1..65536); std::invalid_argument otherwise.
   WalkGeometryEncoder(uint32_t slots, int32_t quantum_raw);
+  WalkGeometryEncoder(const WalkGeometryEncoder&) = delete;  // the ring points into ring_storage_
+  WalkGeometryEncoder& operator=(const WalkGeometryEncoder&) = delete;
   struct Send {
     uint32_t slot;
     bool hot_now;
@@ -65,7 +67,8 @@ class WalkGeometryEncoder {
   uint32_t slots_;
   int32_t quantum_;
   WalkGeometryContexts ctx_{};
-  WalkVertexCache cache_{};
+  std::vector<std::array<int32_t, 3>> ring_storage_;
+  WalkVertexRing ring_{};
   std::vector<uint32_t> prev_hot_;
   uint32_t last_slot_;
   int32_t prev_[3][3]{}, cur_[3][3]{};

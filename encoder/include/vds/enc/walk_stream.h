@@ -31,6 +31,7 @@ struct WalkEncodeOptions {
   int refine_delta = 0;     // a refinement's quality above the views' (0: none; they did not pay on oa_dm4: docs/walkthrough.md)
   int refine_after = 10;    // frames after a view arrives; views serving at least twice that are refined
   int window = 2;         // hot: visible within this many frames either side
+  int frames_per_record = kWalkMaxFramesPerRecord;  // most frames a WFRM record holds
   double tolerance = 0.005;  // share of a frame's pixels that may go without a view within the threshold
   int quality = -1;       // the views' image quality; -1: the best that fits the rate
   int width = 240, height = 180;
