@@ -73,22 +73,23 @@ void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]) {
   store_le32(out + 8, static_cast<uint32_t>(w.view_focal_q16));
 }
 
-Status walk_view_from_bytes(const uint8_t* p, uint32_t size, uint8_t* slot, WalkPose* pose) {
+Status walk_view_from_bytes(const uint8_t* p, uint32_t size, WalkViewUpdate* out) {
   if (size != kWalkViewBytes) return Status::malformed;
-  *slot = p[0];
-  pose->position = {Q16_16::from_raw(get_i32(p + 1)), Q16_16::from_raw(get_i32(p + 5)), Q16_16::from_raw(get_i32(p + 9))};
-  pose->yaw = load_le16(p + 13);
-  pose->pitch = load_le16(p + 15);
+  out->slot = p[0] & static_cast<uint8_t>(~kWalkViewPredict);
+  out->predict = (p[0] & kWalkViewPredict) != 0;
+  out->pose.position = {Q16_16::from_raw(get_i32(p + 1)), Q16_16::from_raw(get_i32(p + 5)), Q16_16::from_raw(get_i32(p + 9))};
+  out->pose.yaw = load_le16(p + 13);
+  out->pose.pitch = load_le16(p + 15);
   return Status::ok;
 }
 
-void walk_view_to_bytes(uint8_t slot, const WalkPose& pose, uint8_t out[kWalkViewBytes]) {
-  out[0] = slot;
-  store_le32(out + 1, static_cast<uint32_t>(pose.position.x.raw()));
-  store_le32(out + 5, static_cast<uint32_t>(pose.position.y.raw()));
-  store_le32(out + 9, static_cast<uint32_t>(pose.position.z.raw()));
-  store_le16(out + 13, pose.yaw);
-  store_le16(out + 15, pose.pitch);
+void walk_view_to_bytes(const WalkViewUpdate& u, uint8_t out[kWalkViewBytes]) {
+  out[0] = static_cast<uint8_t>(u.slot | (u.predict ? kWalkViewPredict : 0));
+  store_le32(out + 1, static_cast<uint32_t>(u.pose.position.x.raw()));
+  store_le32(out + 5, static_cast<uint32_t>(u.pose.position.y.raw()));
+  store_le32(out + 9, static_cast<uint32_t>(u.pose.position.z.raw()));
+  store_le16(out + 13, u.pose.yaw);
+  store_le16(out + 15, u.pose.pitch);
 }
 
 void WalkFrameState::reset() {

@@ -17,7 +17,9 @@ namespace {
 
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, size = "240x180";
-  double rate = 16, threshold = 12;
+  double rate = 16, threshold = 12, widen = -1;
+  int lookahead = -1;
+  bool predict = false;
   int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
 };
 
@@ -32,6 +34,9 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.threshold = o.threshold;
   wo.quality = o.quality;
   wo.frames_per_record = o.frames_per_record;
+  wo.predict = o.predict;
+  if (o.lookahead >= 0) wo.lookahead = o.lookahead;
+  if (o.widen > 0) wo.view_widen = o.widen;
   if (o.refine_delta >= 0) wo.refine_delta = o.refine_delta;
   if (o.refine_after >= 0) wo.refine_after = o.refine_after;
   if (std::sscanf(o.size.c_str(), "%dx%d", &wo.width, &wo.height) != 2 || wo.width < 16 || wo.height < 16 || wo.width > 1024 ||
@@ -52,9 +57,9 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   }
   const double secs = path.frames.size() / path.fps;
   std::printf("%s: %zu frames (%.1f s), %zu bytes = %.2f kbit/s (target %.2f): header %zu, views %zu (%zu updates at quality %d, "
-              "%zu refinements), geometry %zu, frames %zu\n",
+              "%zu of them residuals against the client's prediction, %zu refinements), geometry %zu, frames %zu\n",
               o.out.c_str(), path.frames.size(), secs, r.stream.size(), r.kbps, o.rate, r.header_bytes, r.view_bytes,
-              r.view_updates, r.quality, r.view_refinements, r.geometry_bytes, r.frame_bytes);
+              r.view_updates, r.quality, r.view_predicted, r.view_refinements, r.geometry_bytes, r.frame_bytes);
   double worst = 99;
   for (double p : r.frame_psnr) worst = std::min(worst, p);
   std::printf("  client: %u triangle slots, %d views, %zu bytes of workspace; PSNR R,G,B %.2f dB pooled, %.2f dB worst frame\n",
@@ -75,6 +80,10 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--quality", o->quality, "The views' image quality (default: the best that fits the rate)")->check(CLI::Range(0, 100));
   sub->add_option("--frames-per-record", o->frames_per_record, "Most frames a WFRM record holds (default 8)")
       ->check(CLI::Range(1, static_cast<int>(kWalkMaxFramesPerRecord)));
+  sub->add_flag("--predict", o->predict, "View updates may be residuals against the client's prediction of the view");
+  sub->add_option("--lookahead", o->lookahead, "Frames ahead a view's camera may come from (default 20)")->check(CLI::Range(0, 200));
+  sub->add_option("--widen", o->widen, "tan(half the views' field of view) / tan(half the screen's) (default 1.5)")
+      ->check(CLI::Range(1.0, 4.0));
   sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");
   sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 240x180)");
   sub->add_option("--refine-delta", o->refine_delta, "A refinement's image quality above the views' (0: none)")->check(CLI::Range(0, 100));

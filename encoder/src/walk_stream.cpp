@@ -58,6 +58,45 @@ class WalkFrameEncoder {
   WalkFrameState state_{};
 };
 
+// The client, fed the stream as it is written: what its view slots hold
+// when a view update's image is coded (the prediction it drew, or the view
+// a refinement adds to).
+class MirrorClient {
+ public:
+  explicit MirrorClient(size_t workspace) : ws_(workspace + (1u << 22)), arena_(ws_.data(), ws_.size()) {
+    PlayerConfig cfg = kClientPlayerConfig;
+    cfg.max_chunk_bytes = 1u << 21;
+    if (player_.init(arena_, cfg, PlayerCallbacks{}) != Status::ok) throw std::logic_error("encode_walk: the client cannot start");
+  }
+  void feed(const StreamWriter& w) {
+    const auto b = w.bytes();
+    const Status s = player_.feed(b.data() + fed_, b.size() - fed_);
+    fed_ = b.size();
+    if (s != Status::more_input)
+      throw std::logic_error(std::string("encode_walk: the client refused the stream: ") + status_name(s) + " (" +
+                             player_.error_detail() + ")");
+  }
+  bool predicted() const { return player_.walk_view_predicted(); }
+  Planes slot(uint8_t v) const {
+    const Texture* t = player_.walk_view(v);
+    if (t == nullptr) throw std::logic_error("encode_walk: no such view slot");
+    Planes p(t->width, t->height, ChromaFormat::yuv420);
+    for (int c = 0; c < 3; ++c) {
+      const uint8_t* src = c == 0 ? static_cast<const uint8_t*>(t->texels) : (c == 1 ? t->cb : t->cr);
+      const size_t stride = c == 0 ? t->stride : t->chroma_stride;
+      for (int y = 0; y < p.plane_height(c); ++y)
+        std::copy_n(src + y * stride, p.plane_width(c), p.row(c, y));
+    }
+    return p;
+  }
+
+ private:
+  std::vector<uint8_t> ws_;
+  Arena arena_;
+  Player player_;
+  size_t fed_ = 0;
+};
+
 double sc0_focal(const CameraPath& path, const WalkEncodeOptions& o) {
   return scene_camera(path.frames.front(), path.hfov_deg, o.width, o.height).focal;
 }
@@ -241,57 +280,75 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     wfrm[r] = e.finish();
   }
   // 5. The stream at a quality; the best that fits the rate.
+  // The view images in the rgb_to_planes form the codec takes.
+  std::map<uint32_t, Planes> view_planes;
+  for (const auto& [g, img] : view_images) view_planes[g] = rgb_to_planes(img, ChromaFormat::yuv420);
   const auto build = [&](int quality, WalkEncodeResult* res) {
     ImageEncodeOptions io;
     io.quality = quality;
     io.max_chunk_payload = 4096;
-    std::map<uint32_t, EncodedImage> coded, refined;
-    uint32_t max_payload = 4096;
-    for (const auto& [g, img] : view_images) {
-      coded[g] = encode_image(img, io);
-      max_payload = std::max(max_payload, coded[g].max_payload());
-    }
-    for (const auto& rs : refines)
-      for (const Refine& rf : rs) {
-        if (refined.count(rf.camera_frame)) continue;
-        ImageEncodeOptions ro2 = io;
-        ro2.quality = std::min(100, quality + o.refine_delta);
-        ro2.mode = ImageMode::residual;
-        ro2.prediction = &coded.at(rf.camera_frame).recon;
-        refined[rf.camera_frame] = encode_planes(rgb_to_planes(view_images.at(rf.camera_frame), ChromaFormat::yuv420), ro2);
-        max_payload = std::max(max_payload, refined[rf.camera_frame].max_payload());
-      }
+    std::map<uint32_t, EncodedImage> coded;
+    for (const auto& [g, pl] : view_planes) coded[g] = encode_planes(pl, io);
     StreamHeader hh = h;
-    hh.max_chunk_payload = max_payload;
+    hh.max_chunk_payload = 4096;
+    for (const auto& [g, e] : coded) hh.max_chunk_payload = std::max(hh.max_chunk_payload, e.max_payload());
     for (const auto& rec : wfrm) hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(rec.size()));
     StreamWriter w(hh);
+    MirrorClient client(h.workspace_bytes);
     uint8_t params[kWalkParamsBytes];
     walk_params_to_bytes(wp, params);
     w.add_chunk(chunk::kWalkParams, params);
+    client.feed(w);
     res->header_bytes = w.size();
     res->view_bytes = res->geometry_bytes = res->frame_bytes = 0;
-    res->view_updates = res->view_refinements = 0;
-    // A view into a slot: WVUP with its camera's pose, then its image.
-    const auto put_view = [&](uint32_t slot, uint32_t camera_frame, const EncodedImage& image) {
+    res->view_updates = res->view_refinements = res->view_predicted = 0;
+    // A view into a slot: WVUP with its camera's pose, then its image:
+    // intra, or a residual against what the client then holds (its
+    // prediction of the view, whichever is smaller; a refinement's base).
+    const auto put_view = [&](uint32_t slot, uint32_t camera_frame, bool refine) {
       const size_t before = w.size();
       uint8_t vb[kWalkViewBytes];
-      walk_view_to_bytes(static_cast<uint8_t>(slot), poses[camera_frame], vb);
+      WalkViewUpdate u;
+      u.slot = static_cast<uint8_t>(slot);
+      u.predict = o.predict && !refine;
+      u.pose = poses[camera_frame];
+      walk_view_to_bytes(u, vb);
       w.add_chunk(chunk::kWalkView, vb);
-      add_image_chunks(w, image);
+      client.feed(w);
+      const EncodedImage* image = &coded.at(camera_frame);
+      EncodedImage residual;
+      if (refine || client.predicted()) {
+        const Planes base = client.slot(static_cast<uint8_t>(slot));
+        ImageEncodeOptions ro = io;
+        ro.mode = ImageMode::residual;
+        ro.prediction = &base;
+        if (refine) ro.quality = std::min(100, quality + o.refine_delta);
+        residual = encode_planes(view_planes.at(camera_frame), ro);
+        // Rate and distortion together: about 3.5 dB a doubling of bytes
+        // is where these images' curves run.
+        const auto merit = [](const EncodedImage& e) { return e.psnr - 3.5 * std::log2(static_cast<double>(e.coded_bytes())); };
+        if (refine || merit(residual) > merit(*image)) {
+          image = &residual;
+          if (!refine) ++res->view_predicted;
+        }
+      }
+      add_image_chunks(w, *image);
+      client.feed(w);
       res->view_bytes += w.size() - before;
     };
     for (size_t r = 0; r < record_start.size(); ++r) {
       const size_t f = record_start[r];
       for (const auto& u : vp.updates[f]) {
-        put_view(u.slot, u.camera_frame, coded.at(u.camera_frame));
+        put_view(u.slot, u.camera_frame, false);
         ++res->view_updates;
       }
       for (const Refine& rf : refines[f]) {
-        put_view(rf.slot, rf.camera_frame, refined.at(rf.camera_frame));
+        put_view(rf.slot, rf.camera_frame, true);
         ++res->view_refinements;
       }
       const size_t before = w.size();
       w.add_chunk(chunk::kWalkFrame, wfrm[r]);
+      client.feed(w);
       // The record's geometry and the rest (its poses, views and the chunk's framing).
       res->geometry_bytes += std::min(geometry_part[r], wfrm[r].size());
       res->frame_bytes += w.size() - before - std::min(geometry_part[r], wfrm[r].size());

@@ -146,14 +146,17 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   };
   for (size_t f = 0; f < n; ++f) {
     if (unserved_px(f, held) > o.tolerance_px) {
-      // The slot whose view serves the fewest of this frame's pixels goes.
+      // An empty slot is filled first; else the slot whose view serves the
+      // fewest of this frame's pixels goes.
       size_t victim = 0, victim_px = std::numeric_limits<size_t>::max();
       for (size_t k = 0; k < held.size(); ++k) {
+        if (held[k] < 0) {
+          victim = k;
+          break;
+        }
         size_t px_served = 0;
-        if (held[k] >= 0)
-          for (const auto& [id, px] : visible[f]) px_served += factor(f, static_cast<size_t>(held[k]), id) <= limit ? px : 0;
+        for (const auto& [id, px] : visible[f]) px_served += factor(f, static_cast<size_t>(held[k]), id) <= limit ? px : 0;
         if (px_served < victim_px) victim = k, victim_px = px_served;
-        if (held[k] < 0) break;
       }
       // The camera, from this frame up to `lookahead` ahead, with which the
       // views serve the most frames from this one on (the frame itself

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "host_cases.h"
 #include "print.h"
 #include "vds/arena.h"
 #include "vds/board.h"
@@ -106,22 +107,7 @@ bool run_file(const char* path, int* failures) {
   cb.level = on_level;
   cb.frame_shown = on_frame;
   vds::Player& player = g_player;
-  Status s = player.init(arena, config, cb);
-  uint32_t offset = 0;
-  while (s == Status::ok || s == Status::more_input) {
-    const int32_t got = board::host_file_read(path, offset, g_read, kReadBytes);
-    if (got < 0) {
-      s = Status::io_error;
-      break;
-    }
-    if (got == 0) {
-      s = player.finish();
-      break;
-    }
-    offset += static_cast<uint32_t>(got);
-    s = player.feed(g_read, static_cast<size_t>(got));
-    if (s == Status::ok) break;
-  }
+  const Status s = vds::fw::play_host_file(player, player.init(arena, config, cb), path, g_read, kReadBytes);
   const vds::MeshState& m = player.mesh.mesh();
   const uint32_t splits = m.vertex_count() - g_run.base_vertices;
   const char* base = path;
@@ -163,14 +149,7 @@ bool run_file(const char* path, int* failures) {
 extern "C" int vds_app_main() {
   board::init();
   int failures = 0;
-  int files = 0;
-  char name[32] = "mesh_case0.vds";
-  for (int i = 0; i < 10; ++i) {
-    name[9] = static_cast<char>('0' + i);
-    if (!run_file(name, &failures)) break;
-    ++files;
-  }
-  if (files == 0) {
+  if (vds::fw::run_cases("mesh_case", [&](const char* name) { return run_file(name, &failures); }) == 0) {
     // No benchmark files: decode the golden test stream (the ctest run).
     if (!run_file(VDS_GOLDEN_MESH_STREAM, &failures)) {
       board::log("m4 error: cannot read " VDS_GOLDEN_MESH_STREAM "\n");

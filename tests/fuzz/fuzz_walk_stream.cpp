@@ -8,6 +8,7 @@
 // with ok, more_input or an error.
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <vector>
 
@@ -33,7 +34,13 @@ Stream valid_walk() {
   o.height = 48;
   o.refine_delta = 30;  // residual refinements too
   o.refine_after = 2;
+  o.predict = true;  // and updates against the client's prediction
+  o.threshold = 1.35;
   const auto r = vds::enc::encode_walk(vds::test::walk_room(), vds::test::walk_room_path(8), o);
+  if (r.view_predicted == 0 || r.view_refinements == 0) {
+    std::fprintf(stderr, "fuzz_walk_stream: the seed stream lacks predicted updates or refinements\n");
+    std::abort();
+  }
   Stream s;
   // Split the stream into its chunks by the container layout.
   size_t at = vds::kPreambleBytes;

@@ -12,6 +12,8 @@
 #include "vds/enc/frames.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/enc/walk_stream.h"
+#include "vds/bytes.h"
+#include "vds/crc32c.h"
 #include "vds/player.h"
 #include "vds/walk.h"
 #include "walk_room.h"
@@ -112,6 +114,40 @@ TEST(WalkStream, TheFeedLimitKeepsABoundedQueueOfFramesFromOverflowing) {
   std::printf("room, 60 frames: %zu view updates; at most %u frames completed by one feed\n", r.view_updates, most);
   EXPECT_EQ(s, vds::Status::ok);
   EXPECT_EQ(player.frames_shown(), 60u);
+}
+
+TEST(WalkStream, PredictedViewUpdatesAreResidualsTheClientAddsToItsPrediction) {
+  // With predictions, some view updates are coded as residuals against the
+  // view the client draws from what it holds; the client shows what the
+  // encoder's replay shows. A residual after an update that did not ask
+  // for the prediction is refused.
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
+  vds::enc::WalkEncodeOptions o;
+  o.quality = 60;
+  o.threshold = 1.35;  // updates while the old views still show much of the new one
+  o.predict = true;
+  const auto r = vds::enc::encode_walk(room, path, o);
+  ASSERT_GT(r.view_predicted, 0u);
+  EXPECT_EQ(vds::enc::client_frame_crcs(r.stream), r.frame_crc);
+  o.predict = false;
+  const auto plain = vds::enc::encode_walk(room, path, o);
+  EXPECT_LT(r.view_bytes, plain.view_bytes);
+  // Clear every WVUP's "predict" bit (and mend the chunk's CRC).
+  std::vector<uint8_t> bad = r.stream;
+  size_t cleared = 0;
+  for (size_t at = vds::kPreambleBytes; at + vds::kChunkHeadBytes <= bad.size();) {
+    const uint32_t type = vds::load_le32(&bad[at]), len = vds::load_le32(&bad[at + 4]);
+    const size_t body = at + vds::kChunkHeadBytes;
+    if (type == vds::chunk::kWalkView && (bad[body] & vds::kWalkViewPredict)) {
+      bad[body] &= static_cast<uint8_t>(~vds::kWalkViewPredict);
+      vds::store_le32(&bad[body + len], vds::crc32c(&bad[at], vds::kChunkHeadBytes + len));
+      ++cleared;
+    }
+    at = body + len + vds::kChunkTailBytes;
+  }
+  ASSERT_GT(cleared, 0u);
+  EXPECT_THROW(vds::enc::client_frame_crcs(bad), std::runtime_error);
 }
 
 TEST(WalkStream, DamagedStreamsAreRefusedNotCrashed) {

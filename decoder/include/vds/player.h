@@ -60,6 +60,7 @@
 #include "vds/jpeg.h"
 #include "vds/mesh.h"
 #include "vds/model_view.h"
+#include "vds/render.h"
 #include "vds/status.h"
 #include "vds/walk.h"
 #include "vds/walk_geometry.h"
@@ -176,6 +177,13 @@ class Player {
   // `frames_room` frames complete (a caller with a bounded queue of frame
   // records); SIZE_MAX when the mode puts no limit.
   size_t feed_limit(uint32_t frames_room) const;
+
+  // Walkthrough: a view slot as the client holds it (nullptr before WLKP or
+  // for a slot the stream does not have); between a WVUP and its image,
+  // whether the slot holds the view's prediction (the image may then be a
+  // residual against it). For encoders mirroring the client.
+  const Texture* walk_view(uint8_t slot) const;
+  bool walk_view_predicted() const;
 
   bool have_header() const { return parser_.have_header(); }
   const StreamHeader& header() const { return parser_.header(); }

@@ -63,11 +63,19 @@ Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPo
 Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out);
 void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]);
 
-// WVUP payload (17 bytes): u8 view slot, then the pose: i32 x, y, z (raw
-// Q16.16), u16 yaw, u16 pitch.
+// WVUP payload (17 bytes): u8 view slot (bits 0..6) and "predict" (bit
+// 7: the client draws its prediction of the view into the slot before the
+// image, which may then be a residual against it), then the pose: i32 x,
+// y, z (raw Q16.16), u16 yaw, u16 pitch.
 constexpr uint32_t kWalkViewBytes = 17;
-Status walk_view_from_bytes(const uint8_t* p, uint32_t size, uint8_t* slot, WalkPose* pose);
-void walk_view_to_bytes(uint8_t slot, const WalkPose& pose, uint8_t out[kWalkViewBytes]);
+constexpr uint8_t kWalkViewPredict = 0x80;
+struct WalkViewUpdate {
+  uint8_t slot = 0;
+  bool predict = false;
+  WalkPose pose;
+};
+Status walk_view_from_bytes(const uint8_t* p, uint32_t size, WalkViewUpdate* out);
+void walk_view_to_bytes(const WalkViewUpdate& u, uint8_t out[kWalkViewBytes]);
 
 // Positions in a frame record are on a grid of 1/16 world unit.
 constexpr int kWalkPoseShift = 12;  // raw Q16.16 per step: 2^12

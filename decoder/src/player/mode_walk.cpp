@@ -20,9 +20,11 @@ struct WalkPlay {
   Camera view_cam[kWalkMaxViews];
   bool view_ready[kWalkMaxViews];
   Texture view_tex[kWalkMaxViews];
+  Texture bordered[kWalkMaxViews];  // the same with their borders (predictions)
   int pending = -1;  // the view slot a WVUP opened, until its image is whole
   Camera pending_cam;
   bool pending_refines = false;  // the WVUP names the slot's own camera: its image may be a residual
+  bool pending_predicted = false;  // the slot holds the view's prediction: its image may be a residual
   bool image_open = false;
   Mesh* meshes = nullptr;
   Vec3<Q16_16>* positions = nullptr;
@@ -32,9 +34,25 @@ struct WalkPlay {
 
 namespace {
 
+// A view's planes carry a border of mid grey around the image (2 luma
+// texels, 1 chroma texel) that no image writes: a prediction drawing from
+// a view (predict_view) reads grey wherever a triangle reaches past it.
+constexpr uint32_t kBorder = 2;
 size_t plane_bytes(const StreamHeader& h) {
-  const size_t cw = (h.width + 1u) / 2u, ch = (h.height + 1u) / 2u;
-  return static_cast<size_t>(h.width) * h.height + 2 * cw * ch;
+  const size_t cw = (h.width + 1u) / 2u + kBorder, ch = (h.height + 1u) / 2u + kBorder;
+  return (static_cast<size_t>(h.width) + 2 * kBorder) * (h.height + 2 * kBorder) + 2 * cw * ch;
+}
+
+// The view with its border, for predictions: its camera's principal point
+// moves by the border.
+Texture with_border(const Texture& t) {
+  Texture b = t;
+  b.width = static_cast<uint16_t>(t.width + 2 * kBorder);
+  b.height = static_cast<uint16_t>(t.height + 2 * kBorder);
+  b.texels = static_cast<const uint8_t*>(t.texels) - kBorder * t.stride - kBorder;
+  b.cb = t.cb - (kBorder / 2) * t.chroma_stride - kBorder / 2;
+  b.cr = t.cr - (kBorder / 2) * t.chroma_stride - kBorder / 2;
+  return b;
 }
 
 RenderConfig render_config(const StreamHeader& h, const WalkParams& w, const PlayerConfig& c) {
@@ -106,17 +124,22 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
       s = Status::workspace_too_small;
       break;
     }
+    for (size_t i = 0; i < plane_bytes(h); ++i) planes[i] = 128;
+    // The image inside the border.
     Texture& t = wp->view_tex[v];
     t.format = TexFormat::ycbcr420;
     t.address = TexAddress::clamp;
     t.width = h.width;
     t.height = h.height;
-    t.stride = h.width;
-    t.texels = planes;
-    t.cb = planes + static_cast<size_t>(h.width) * h.height;
-    t.chroma_stride = (h.width + 1u) / 2u;
-    t.cr = t.cb + t.chroma_stride * ((h.height + 1u) / 2u);
+    t.stride = h.width + 2 * kBorder;
+    t.chroma_stride = (h.width + 1u) / 2u + kBorder;
+    const size_t chroma_plane = t.chroma_stride * ((h.height + 1u) / 2u + kBorder);
+    uint8_t* const cb = planes + static_cast<size_t>(t.stride) * (h.height + 2 * kBorder);
+    t.texels = planes + kBorder * t.stride + kBorder;
+    t.cb = cb + (kBorder / 2) * t.chroma_stride + kBorder / 2;
+    t.cr = cb + chroma_plane + (kBorder / 2) * t.chroma_stride + kBorder / 2;
     wp->view_ready[v] = false;
+    wp->bordered[v] = with_border(t);
   }
   if (s != Status::ok) {
     p.fail(s, "the walkthrough could not be set up");
@@ -129,6 +152,27 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   return true;
 }
 
+// Triangle i of a draw list: its positions, and a mesh mapping it from a view.
+Mesh& put_triangle(WalkPlay& w, uint32_t i, const Vec3<Q16_16>* tri) {
+  for (int k = 0; k < 3; ++k) w.positions[3 * i + static_cast<uint32_t>(k)] = tri[k];
+  Mesh& m = w.meshes[i];
+  m = Mesh{};
+  m.indices = &w.indices[3 * i];
+  m.shading = Shading::view_mapped;
+  m.filter = Filter::bilinear;
+  m.cull = Cull::none;
+  return m;
+}
+
+DrawList draw_list(const WalkPlay& w, uint32_t n) {
+  DrawList list;
+  list.positions = w.positions;
+  list.num_positions = 3 * n;
+  list.meshes = w.meshes;
+  list.num_meshes = n;
+  return list;
+}
+
 Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
   Camera cam;
   if (walk_camera(p.header(), pose, &cam) != Status::ok) return Status::malformed;
@@ -136,23 +180,100 @@ Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
   const uint32_t n = p.walk_geometry.hot_count();
   for (uint32_t i = 0; i < n; ++i) {
     const Vec3<Q16_16>* tri = p.walk_geometry.triangle(hot[i]);
-    for (int k = 0; k < 3; ++k) w.positions[3 * i + static_cast<uint32_t>(k)] = tri[k];
-    Mesh& m = w.meshes[i];
-    m = Mesh{};
-    m.indices = &w.indices[3 * i];
-    m.shading = Shading::view_mapped;
-    m.filter = Filter::bilinear;
-    m.cull = Cull::none;
+    Mesh& m = put_triangle(w, i, tri);
     const uint8_t v = w.view_of[hot[i]];
     m.texture = &w.view_tex[v];
     m.num_triangles = w.view_ready[v] && plane_homography(cam, w.view_cam[v], tri, &m.view_map) == Status::ok ? 1 : 0;
   }
-  DrawList list;
-  list.positions = w.positions;
-  list.num_positions = 3 * n;
-  list.meshes = w.meshes;
-  list.num_meshes = n;
-  return w.renderer.render(cam, list, 0, render_band, &p);
+  return w.renderer.render(cam, draw_list(w, n), 0, render_band, &p);
+}
+
+// A view's prediction: the band's RGB565 rows into the slot's Y'CbCr
+// 4:2:0 planes (JFIF equations in 16-bit fixed point, chroma from the sum
+// of each 2x2 block; bands start on even rows).
+struct PredictTarget {
+  const Texture* t;
+};
+
+inline void rgb_of(uint16_t c, int32_t& r, int32_t& g, int32_t& b) {
+  const int32_t r5 = c >> 11, g6 = (c >> 5) & 63, b5 = c & 31;
+  r = (r5 << 3) | (r5 >> 2);
+  g = (g6 << 2) | (g6 >> 4);
+  b = (b5 << 3) | (b5 >> 2);
+}
+
+bool predict_band(void* ctx, const Band& b) {
+  const Texture& t = *static_cast<const PredictTarget*>(ctx)->t;
+  if (b.format != PixelFormat::rgb565 || (b.y & 1) != 0) return false;
+  uint8_t* yp = static_cast<uint8_t*>(const_cast<void*>(t.texels));
+  for (uint16_t row = 0; row < b.height; row += 2) {
+    const uint16_t* p0 = reinterpret_cast<const uint16_t*>(b.pixels + static_cast<size_t>(row) * b.stride);
+    const bool pair = row + 1 < b.height;
+    const uint16_t* p1 = pair ? reinterpret_cast<const uint16_t*>(b.pixels + static_cast<size_t>(row + 1) * b.stride) : p0;
+    uint8_t* y0 = yp + static_cast<size_t>(b.y + row) * t.stride;
+    uint8_t* y1 = y0 + t.stride;
+    const size_t crow = static_cast<size_t>((b.y + row) >> 1) * t.chroma_stride;
+    uint8_t* cb = const_cast<uint8_t*>(t.cb) + crow;
+    uint8_t* cr = const_cast<uint8_t*>(t.cr) + crow;
+    for (uint16_t x = 0; x < b.width; x += 2) {
+      int32_t rs = 0, gs = 0, bs = 0, n = 0;
+      for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx) {
+          if (x + dx >= b.width || (dy == 1 && !pair)) continue;
+          int32_t r, g, bl;
+          rgb_of((dy ? p1 : p0)[x + dx], r, g, bl);
+          (dy ? y1 : y0)[x + dx] = static_cast<uint8_t>((19595 * r + 38470 * g + 7471 * bl + 32768) >> 16);
+          rs += r, gs += g, bs += bl, ++n;
+        }
+      // Means of the block (n is 1, 2 or 4), rounded; never below 0.
+      const int sh = 16 + (n >> 1);
+      const int32_t half = int32_t{1} << (sh - 1);
+      cb[x >> 1] = static_cast<uint8_t>((128 * 65536 * n - 11059 * rs - 21709 * gs + 32768 * bs + half) >> sh);
+      cr[x >> 1] = static_cast<uint8_t>((128 * 65536 * n + 32768 * rs - 27439 * gs - 5329 * bs + half) >> sh);
+    }
+  }
+  return true;
+}
+
+// Whether a triangle lies in front of a view's near plane.
+bool in_front(const Camera& v, const Vec3<Q16_16>* tri) {
+  for (int k = 0; k < 3; ++k)
+    if (camera_transform(v, tri[k]).z.raw() <= v.near_z.raw()) return false;
+  return true;
+}
+
+// Before a view update's image: every triangle the client holds drawn at
+// the new view's camera from a view it lies in front of — its own view
+// first, then the others in order, never the slot being replaced — into
+// the slot's planes; what no view shows is mid grey (the views' borders
+// and the background). *predicted is false when the client holds no other
+// view: nothing is drawn.
+Status predict_view(Player& p, WalkPlay& w, int slot, bool* predicted) {
+  *predicted = false;
+  int other = -1;
+  for (int v = 0; v < w.params.views && other < 0; ++v)
+    if (v != slot && w.view_ready[v]) other = v;
+  if (other < 0) return Status::ok;
+  uint32_t n = 0;
+  for (uint32_t slot_i = 0; slot_i < w.params.slots; ++slot_i) {
+    const Vec3<Q16_16>* tri = p.walk_geometry.triangle(slot_i);
+    if (tri == nullptr) continue;
+    Mesh& m = put_triangle(w, n++, tri);
+    const uint8_t own = w.view_of[slot_i];
+    int v = own != slot && own < w.params.views && w.view_ready[own] && in_front(w.view_cam[own], tri) ? own : -1;
+    for (int u = 0; u < w.params.views && v < 0; ++u)
+      if (u != slot && w.view_ready[u] && in_front(w.view_cam[u], tri)) v = u;
+    m.texture = &w.bordered[v >= 0 ? v : other];
+    Camera from = w.view_cam[v >= 0 ? v : other];
+    from.cx = Q16_16::from_raw(from.cx.raw() + static_cast<int32_t>(kBorder << 16));
+    from.cy = Q16_16::from_raw(from.cy.raw() + static_cast<int32_t>(kBorder << 16));
+    m.num_triangles = v >= 0 && plane_homography(w.pending_cam, from, tri, &m.view_map) == Status::ok ? 1 : 0;
+  }
+  PredictTarget target{&w.view_tex[slot]};
+  constexpr uint32_t kGrey = 0x808080;
+  const Status s = w.renderer.render(w.pending_cam, draw_list(w, n), kGrey, predict_band, &target);
+  *predicted = s == Status::ok;
+  return s;
 }
 
 ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size) {
@@ -180,19 +301,25 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
   if (type == chunk::kWalkParams) {
     refuse(Status::malformed, "a second WLKP");
   } else if (type == chunk::kWalkView) {
-    uint8_t slot;
-    WalkPose pose;
+    WalkViewUpdate u;
     if (w.pending >= 0) refuse(Status::malformed, "a view update before the last one's image is whole");
-    else if (walk_view_from_bytes(payload, size, &slot, &pose) != Status::ok || slot >= w.params.views)
+    else if (walk_view_from_bytes(payload, size, &u) != Status::ok || u.slot >= w.params.views)
       refuse(Status::malformed, "WVUP is not valid");
-    else if (walk_view_camera(p.header(), w.params, pose, &w.pending_cam) != Status::ok)
+    else if (walk_view_camera(p.header(), w.params, u.pose, &w.pending_cam) != Status::ok)
       refuse(Status::malformed, "WVUP's camera is not valid");
     else {
-      w.pending = slot;
+      w.pending = u.slot;
       w.image_open = false;
-      // The slot's own camera again: a refinement, added to what the slot holds.
-      w.pending_refines = w.view_ready[slot] && cameras_equal(w.view_cam[slot], w.pending_cam);
-      if (!w.pending_refines) w.view_ready[slot] = false;
+      // The slot's own camera again: a refinement, added to what the slot
+      // holds. Another camera: the slot is given the view's prediction
+      // when the update asks for it.
+      w.pending_refines = w.view_ready[u.slot] && cameras_equal(w.view_cam[u.slot], w.pending_cam);
+      w.pending_predicted = false;
+      if (!w.pending_refines) {
+        w.view_ready[u.slot] = false;
+        if (u.predict && predict_view(p, w, u.slot, &w.pending_predicted) != Status::ok)
+          refuse(Status::malformed, "a view's prediction could not be drawn");
+      }
     }
   } else if (type == chunk::kImageHeader || type == chunk::kImageData) {
     if (w.pending < 0) {
@@ -202,8 +329,8 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
       if (type == chunk::kImageHeader) {
         ImageHeader ih;
         if (w.image_open || image_header_from_bytes(payload, size, &ih) != Status::ok || ih.width != t.width ||
-            ih.height != t.height || ih.chroma != ChromaFormat::yuv420 || ih.region() || (ih.residual() && !w.pending_refines))
-          refuse(Status::malformed, "a view's image must be a 4:2:0 image of the frame's size, a residual only refining its own view");
+            ih.height != t.height || ih.chroma != ChromaFormat::yuv420 || ih.region() || (ih.residual() && !w.pending_refines && !w.pending_predicted))
+          refuse(Status::malformed, "a view's image must be a 4:2:0 image of the frame's size, a residual only on a prediction or its own view");
         else
           w.image_open = true;
       }
@@ -267,6 +394,12 @@ size_t feed_limit(const Player& p, uint32_t frames_room) {
 }
 
 }  // namespace
+
+const Texture* Player::walk_view(uint8_t slot) const {
+  return walk != nullptr && slot < walk->params.views ? &walk->view_tex[slot] : nullptr;
+}
+
+bool Player::walk_view_predicted() const { return walk != nullptr && walk->pending >= 0 && walk->pending_predicted; }
 
 size_t Player::walk_workspace_bytes(const StreamHeader& h, const WalkParams& w, const PlayerConfig& c) {
   const RenderConfig rc = render_config(h, w, c);

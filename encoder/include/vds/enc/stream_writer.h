@@ -30,6 +30,8 @@ class StreamWriter {
 
   const StreamHeader& header() const { return header_; }
   size_t size() const { return out_.size(); }
+  // The stream so far (HEAD and the chunks added), before END.
+  std::span<const uint8_t> bytes() const { return out_; }
 
  private:
   void put_chunk(uint32_t type, std::span<const uint8_t> payload);

@@ -32,6 +32,10 @@ struct WalkEncodeOptions {
   int refine_after = 10;    // frames after a view arrives; views serving at least twice that are refined
   int window = 2;         // hot: visible within this many frames either side
   int frames_per_record = kWalkMaxFramesPerRecord;  // most frames a WFRM record holds
+  // View updates ask the client to draw its prediction of the view, and
+  // are coded as a residual against it when that pays (rate and
+  // distortion); measured not to pay on the figure maps (docs/walkthrough.md).
+  bool predict = false;
   double tolerance = 0.005;  // share of a frame's pixels that may go without a view within the threshold
   int quality = -1;       // the views' image quality; -1: the best that fits the rate
   int width = 240, height = 180;
@@ -43,6 +47,7 @@ struct WalkEncodeResult {
   std::vector<uint8_t> stream;
   int quality = 0;
   size_t view_updates = 0, view_refinements = 0;
+  size_t view_predicted = 0;  // view updates coded as a residual against the client's prediction
   // Bytes by part: header (HEAD, WLKP), views (WVUP and the images), the
   // records' geometry, and the rest of the records (pose, views, framing).
   size_t header_bytes = 0, view_bytes = 0, geometry_bytes = 0, frame_bytes = 0;

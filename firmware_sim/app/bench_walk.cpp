@@ -1,0 +1,102 @@
+// Walkthrough playback on the board: reads vds walkthrough streams from
+// host files (walk_case0.vds, walk_case1.vds, ... until one is missing)
+// and plays each through vds::Player as the client does, from a workspace
+// as large as the board's RAM allows (the arena's high-water mark says
+// what the stream needed). Per frame it prints a "frame" line: the
+// frame's CRC and its instruction counts (parse, decode, display: the
+// player's frame records); per stream an "m4 walk" summary. The host board
+// and the Cortex-M4 board must print the same CRCs (bench/run_walk_m4.sh
+// compares them, and the CRCs with the encoder's replay).
+#include <cstddef>
+#include <cstdint>
+
+#include "host_cases.h"
+#include "print.h"
+#include "vds/arena.h"
+#include "vds/board.h"
+#include "vds/player.h"
+
+#ifndef VDS_APP_WORKSPACE_MAX
+#error "VDS_APP_WORKSPACE_MAX (the largest workspace this build can use) must be set by the build"
+#endif
+
+namespace {
+
+using vds::fw::Line;
+using vds::Status;
+namespace board = vds::board;
+
+constexpr uint32_t kChunkBytes = 32768;  // the largest chunk payload accepted
+constexpr uint32_t kReadBytes = 4096;    // file bytes fed to the player at a time
+
+alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
+uint8_t g_read[kReadBytes];
+
+struct Run {
+  uint32_t frames = 0;
+  uint64_t total = 0, worst = 0;  // parse + decode + display per frame
+  uint32_t worst_frame = 0;
+  uint64_t parse = 0, decode = 0, display = 0;
+};
+
+Run g_run;
+
+uint64_t clock(void*) { return board::instructions(); }
+
+void on_frame(void*, const vds::PlayedFrame& f) {
+  const uint64_t all = f.parse + f.decode + f.display;
+  ++g_run.frames;
+  g_run.total += all;
+  g_run.parse += f.parse;
+  g_run.decode += f.decode;
+  g_run.display += f.display;
+  if (all > g_run.worst) g_run.worst = all, g_run.worst_frame = f.index;
+  Line l;
+  l.str("frame ").dec(f.index).str(" crc=0x").hex32(f.crc).str(" parse=").dec(f.parse).str(" decode=").dec(f.decode);
+  board::log(l.str(" display=").dec(f.display).str("\n").c_str());
+}
+
+// Plays one stream file; false when it does not exist.
+bool run_file(const char* path, int* failures) {
+  const int32_t probe = board::host_file_read(path, 0, g_read, 1);
+  if (probe <= 0) return false;
+  vds::Arena arena(g_workspace, sizeof g_workspace);
+  g_run = Run{};
+  vds::PlayerConfig config = vds::kClientPlayerConfig;
+  config.max_chunk_bytes = kChunkBytes;
+  vds::PlayerCallbacks cb;
+  cb.clock = clock;
+  cb.frame_shown = on_frame;
+  static vds::Player player;
+  const Status s = vds::fw::play_host_file(player, player.init(arena, config, cb), path, g_read, kReadBytes);
+  const char* base = path;
+  for (const char* p = path; *p; ++p)
+    if (*p == '/') base = p + 1;
+  Line l;
+  l.str("m4 walk stream=").str(base).str(" status=").str(vds::status_name(s)).str(" frames=").dec(g_run.frames);
+  l.str(" instructions=").dec(g_run.total).str(" worst=").dec(g_run.worst).str(" worst_frame=").dec(g_run.worst_frame);
+  board::log(l.str("\n").c_str());
+  Line parts;
+  parts.str("m4 walk_parts stream=").str(base).str(" parse=").dec(g_run.parse).str(" decode=").dec(g_run.decode);
+  parts.str(" display=").dec(g_run.display).str(" workspace=").dec(arena.high_water()).str(" chunk_buffer=").dec(kChunkBytes);
+  board::log(parts.str("\n").c_str());
+
+
+  if (s != Status::ok) {
+    board::log(Line().str("m4 walk error: ").str(player.error_detail()).str("\n").c_str());
+    ++*failures;
+  }
+  return true;
+}
+
+}  // namespace
+
+extern "C" int vds_app_main() {
+  board::init();
+  int failures = 0;
+  if (vds::fw::run_cases("walk_case", [&](const char* name) { return run_file(name, &failures); }) == 0) {
+    board::log("m4 walk error: no walk_case0.vds in the working folder\n");
+    return 1;
+  }
+  return failures == 0 ? 0 : 1;
+}
