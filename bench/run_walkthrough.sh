@@ -12,7 +12,7 @@
 #   walkthrough_<map>_frames.jpg) and per-frame PSNR (walkthrough_<map>_psnr.png).
 #
 # Usage: bench/run_walkthrough.sh [BUILD_DIR]   (default build/host-release)
-#   MAPS="oa_dm4 oa_dm5 oa_rpg3dm2"; THRESHOLD=12; WORK (default BUILD_DIR/walk).
+#   MAPS="oa_dm4 oa_dm5 oa_rpg3dm2"; THRESHOLD=18; WORK (default BUILD_DIR/walk).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-build/host-release}
@@ -26,11 +26,11 @@ for map in ${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2}; do
   [ -f "$WORK/$map/tour.txt" ] || { echo "run_walkthrough: $WORK/$map/tour.txt missing (bench/run_walk_video.sh)" >&2; exit 1; }
   for rate in 8 16 32; do
     echo "== $map at $rate kbit/s"
-    "$VDS" encode-walk "$map" --path "$WORK/$map/tour.txt" --rate "$rate" --threshold "${THRESHOLD:-12}" \
+    "$VDS" encode-walk "$map" --path "$WORK/$map/tour.txt" --rate "$rate" --threshold "${THRESHOLD:-18}" \
       -o "$WORK/$map/walk_$rate.vds" --y4m "$WORK/$map/walk_$rate.y4m" 2>/dev/null | tee "$WORK/$map/walk_$rate.txt"
   done
 done
-BENCH_DIR="$ROOT/bench" $PY - "$WORK" "$RESULTS" "${THRESHOLD:-12}" ${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2} <<'PY'
+BENCH_DIR="$ROOT/bench" $PY - "$WORK" "$RESULTS" "${THRESHOLD:-18}" ${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2} <<'PY'
 import json, math, os, re, sys
 work, results, threshold, maps = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
 sys.path.insert(0, os.environ["BENCH_DIR"])

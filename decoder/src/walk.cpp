@@ -46,6 +46,8 @@ Status walk_camera(const StreamHeader& h, const WalkPose& pose, Camera* out) {
 Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPose& pose, Camera* out) {
   StreamHeader v = h;
   v.focal_x_q16 = v.focal_y_q16 = w.view_focal_q16;
+  v.center_x_q16 = static_cast<int32_t>(w.view_width) << 15;
+  v.center_y_q16 = static_cast<int32_t>(w.view_height) << 15;
   return walk_camera(v, pose, out);
 }
 
@@ -57,9 +59,12 @@ Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out) 
   w.quantum_raw = get_i32(p + 4);
   w.view_focal_q16 = get_i32(p + 8);
   w.frames_per_record = p[3];
+  w.view_width = load_le16(p + 12);
+  w.view_height = load_le16(p + 14);
   if (w.view_focal_q16 < (kCameraMinFocalPx << 16) || w.view_focal_q16 > (kCameraMaxFocalPx << 16) || w.slots == 0 ||
       w.views == 0 || w.views > kWalkMaxViews || w.frames_per_record == 0 || w.frames_per_record > kWalkMaxFramesPerRecord ||
-      w.quantum_raw < 1 || w.quantum_raw > 65536 || (w.quantum_raw & (w.quantum_raw - 1)) != 0)
+      w.quantum_raw < 1 || w.quantum_raw > 65536 || (w.quantum_raw & (w.quantum_raw - 1)) != 0 || w.view_width < 16 ||
+      w.view_height < 16)
     return Status::malformed;
   *out = w;
   return Status::ok;
@@ -71,6 +76,8 @@ void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]) {
   out[3] = w.frames_per_record;
   store_le32(out + 4, static_cast<uint32_t>(w.quantum_raw));
   store_le32(out + 8, static_cast<uint32_t>(w.view_focal_q16));
+  store_le16(out + 12, w.view_width);
+  store_le16(out + 14, w.view_height);
 }
 
 Status walk_view_from_bytes(const uint8_t* p, uint32_t size, WalkViewUpdate* out) {

@@ -17,7 +17,7 @@ namespace {
 
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, size = "240x180";
-  double rate = 16, threshold = 12, widen = -1;
+  double rate = 16, threshold = 18, widen = -1, view_scale = -1;
   int lookahead = -1;
   bool predict = false;
   int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
@@ -37,6 +37,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.predict = o.predict;
   if (o.lookahead >= 0) wo.lookahead = o.lookahead;
   if (o.widen > 0) wo.view_widen = o.widen;
+  if (o.view_scale > 0) wo.view_scale = o.view_scale;
   if (o.refine_delta >= 0) wo.refine_delta = o.refine_delta;
   if (o.refine_after >= 0) wo.refine_after = o.refine_after;
   if (std::sscanf(o.size.c_str(), "%dx%d", &wo.width, &wo.height) != 2 || wo.width < 16 || wo.height < 16 || wo.width > 1024 ||
@@ -76,7 +77,7 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("-o,--output", o->out, "Stream to write")->required();
   sub->add_option("--rate", o->rate, "Target rate, kbit/s (default 16)")->check(kPositive);
   sub->add_option("--views", o->views, "Views the client holds (default 2)")->check(CLI::Range(1, 8));
-  sub->add_option("--threshold", o->threshold, "Largest magnification a view serves (default 12)")->check(kPositive);
+  sub->add_option("--threshold", o->threshold, "Largest magnification a view serves (default 18)")->check(kPositive);
   sub->add_option("--quality", o->quality, "The views' image quality (default: the best that fits the rate)")->check(CLI::Range(0, 100));
   sub->add_option("--frames-per-record", o->frames_per_record, "Most frames a WFRM record holds (default 8)")
       ->check(CLI::Range(1, static_cast<int>(kWalkMaxFramesPerRecord)));
@@ -84,6 +85,7 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--lookahead", o->lookahead, "Frames ahead a view's camera may come from (default 20)")->check(CLI::Range(0, 200));
   sub->add_option("--widen", o->widen, "tan(half the views' field of view) / tan(half the screen's) (default 1.5)")
       ->check(CLI::Range(1.0, 4.0));
+  sub->add_option("--view-scale", o->view_scale, "The views' size over the frame's, each side (default 2/3)")->check(CLI::Range(0.1, 1.0));
   sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");
   sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 240x180)");
   sub->add_option("--refine-delta", o->refine_delta, "A refinement's image quality above the views' (0: none)")->check(CLI::Range(0, 100));

@@ -137,7 +137,15 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   RenderOptions ro;
   ro.width = o.width;
   ro.height = o.height;
-  const SceneRenderer renderer(s, load_scene_images(s), ro);
+  const std::vector<io::Image> images = load_scene_images(s);
+  const SceneRenderer renderer(s, images, ro);
+  // The views' size.
+  if (!(o.view_scale > 0 && o.view_scale <= 1)) throw std::invalid_argument("encode_walk: a view scale in (0, 1]");
+  // (No smaller than the client's smallest focal length allows.)
+  const double scale = std::clamp(o.view_scale, std::min(1.0, kCameraMinFocalPx / sc0_focal(path, o)), 1.0);
+  const int view_w = std::min(o.width, std::max(16, static_cast<int>(std::ceil(o.width * scale / 2 - 1e-9)) * 2));
+  const int view_h = std::min(o.height, std::max(16, static_cast<int>(std::ceil(o.height * scale / 2 - 1e-9)) * 2));
+  if (view_w > o.width || view_h > o.height) throw std::invalid_argument("encode_walk: views larger than the frame");
   std::vector<io::Image> truth(n);
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> visible(n);
   render_path(renderer, path, o.threads, [&](size_t f, const SceneFrame& fr) {
@@ -165,9 +173,11 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   // what a view at each frame's camera shows.
   const double kDeg = 3.14159265358979323846 / 180;
   // (No wider than the client's smallest focal length allows.)
-  const double widen = std::clamp(o.view_widen, 1.0, std::max(1.0, sc0_focal(path, o) / kCameraMinFocalPx));
+  const double widen = std::clamp(o.view_widen, 1.0, std::max(1.0, sc0_focal(path, o) * view_w / o.width / kCameraMinFocalPx));
   const double view_hfov = 2 * std::atan(widen * std::tan(path.hfov_deg * kDeg / 2)) / kDeg;
   vo.view_hfov_deg = view_hfov;
+  vo.view_width = view_w;
+  vo.view_height = view_h;
   CameraPath wide = path;
   wide.hfov_deg = view_hfov;
   RenderOptions vro = ro;
@@ -189,8 +199,12 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   for (const auto& ups : vp.updates)
     for (const auto& u : ups) view_images[u.camera_frame];
   size_t done = 0;
+  RenderOptions view_ro = ro;
+  view_ro.width = view_w;
+  view_ro.height = view_h;
+  const SceneRenderer view_renderer(s, images, view_ro);
   for (auto& [g, img] : view_images) {
-    img = renderer.render(from_walk_pose(poses[g]), view_hfov).rgb;
+    img = view_renderer.render(from_walk_pose(poses[g]), view_hfov).rgb;
     progress("views", ++done, view_images.size());
   }
   // 4. The header and the parts that do not depend on the views' quality.
@@ -211,7 +225,9 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     throw std::invalid_argument("encode_walk: 1 to 8 frames a record");
   wp.frames_per_record = static_cast<uint8_t>(o.frames_per_record);
   wp.quantum_raw = choose_walk_quantum(s, 1.0 / 16);
-  wp.view_focal_q16 = static_cast<int32_t>(std::lround(scene_camera(path.frames[0], view_hfov, o.width, o.height).focal * 65536));
+  wp.view_focal_q16 = static_cast<int32_t>(std::lround(scene_camera(path.frames[0], view_hfov, view_w, view_h).focal * 65536));
+  wp.view_width = static_cast<uint16_t>(view_w);
+  wp.view_height = static_cast<uint16_t>(view_h);
   h.workspace_bytes = static_cast<uint32_t>(Player::walk_workspace_bytes(h, wp, kClientPlayerConfig));
   h.max_triangles = slots;
   // Refinements: a view that serves at least 2 * refine_after frames gets,

@@ -49,10 +49,11 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     throw std::invalid_argument("plan_walk_views: options out of range");
   const double view_hfov = o.view_hfov_deg > 0 ? o.view_hfov_deg : path.hfov_deg;
   if (view_visible != nullptr && view_visible->size() != n) throw std::invalid_argument("plan_walk_views: one view visibility list per frame");
+  const int vw = o.view_width > 0 ? o.view_width : o.width, vh = o.view_height > 0 ? o.view_height : o.height;
   std::vector<vds::Camera> cams, vcams;
   for (const CameraPose& p : path.frames) {
     cams.push_back(client_camera(p, path.hfov_deg, o.width, o.height, o.near_z, o.far_z));
-    vcams.push_back(client_camera(p, view_hfov, o.width, o.height, o.near_z, o.far_z));
+    vcams.push_back(client_camera(p, view_hfov, vw, vh, o.near_z, o.far_z));
   }
   // Polygons the view at each frame's camera shows, for "does view v show polygon p".
   const auto& vv = view_visible != nullptr ? *view_visible : visible;
@@ -62,7 +63,7 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   std::vector<SceneCamera> scams, vscams;  // each frame's camera as the screen and as a view
   for (const CameraPose& p : path.frames) {
     scams.push_back(scene_camera(p, path.hfov_deg, o.width, o.height));
-    vscams.push_back(scene_camera(p, view_hfov, o.width, o.height));
+    vscams.push_back(scene_camera(p, view_hfov, vw, vh));
   }
   const double inf = std::numeric_limits<double>::infinity();
   // The factor of the view at frame g for polygon id on frame f's screen
@@ -122,7 +123,7 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
       int32_t x, y;
       if (!vds::camera_project(vcams[g], vds::camera_transform(vcams[g], {q16(p[0]), q16(p[1]), q16(p[2])}), &x, &y)) return inf;
       // The view must hold the point: inside its image (half a pixel of slack).
-      if (x < -128 || y < -128 || x > o.width * 256 + 128 || y > o.height * 256 + 128) return inf;
+      if (x < -128 || y < -128 || x > vw * 256 + 128 || y > vh * 256 + 128) return inf;
       const Q16_16 sc16 = vds::homography_scale(vs, x, y);
       if (sc16 == Q16_16::max()) return inf;
       worst = std::max(worst, sc16.raw() / 65536.0);

@@ -181,7 +181,7 @@ TEST(WalkStream, RecordsRoundTripAndRefuseBadFields) {
   EXPECT_NEAR(q.yaw_deg, p.yaw_deg, 360.0 / 65536);
   EXPECT_NEAR(q.pitch_deg, p.pitch_deg, 360.0 / 65536);
   uint8_t b[vds::kWalkParamsBytes];
-  vds::WalkParams w{300, 2, 5, 8192, 80 << 16};
+  vds::WalkParams w{300, 2, 5, 8192, 80 << 16, 160, 120};
   vds::walk_params_to_bytes(w, b);
   vds::WalkParams back;
   ASSERT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::ok);
@@ -190,6 +190,8 @@ TEST(WalkStream, RecordsRoundTripAndRefuseBadFields) {
   EXPECT_EQ(back.quantum_raw, 8192);
   EXPECT_EQ(back.view_focal_q16, 80 << 16);
   EXPECT_EQ(back.frames_per_record, 5);
+  EXPECT_EQ(back.view_width, 160);
+  EXPECT_EQ(back.view_height, 120);
   b[3] = 0;  // records of no frames
   EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
   b[3] = vds::kWalkMaxFramesPerRecord + 1;

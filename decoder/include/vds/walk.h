@@ -45,10 +45,12 @@ struct WalkPose {
 // invalid_argument when the result fails validate_camera().
 Status walk_camera(const StreamHeader& h, const WalkPose& pose, Camera* out);
 
-// WLKP payload (12 bytes): u16 polygon slots, u8 view slots, u8 the most
+// WLKP payload (16 bytes): u16 polygon slots, u8 view slots, u8 the most
 // frames a WFRM record holds (1..kWalkMaxFramesPerRecord), i32 vertex grid
 // quantum (raw Q16.16, a power of two), i32 the views' focal length
-// (Q16.16 pixels; views may see wider than the screen).
+// (Q16.16 pixels; views may see wider than the screen), u16 the views'
+// width and u16 height (16 up to the frame's; the principal point is their
+// centre).
 constexpr uint8_t kWalkMaxFramesPerRecord = 8;
 struct WalkParams {
   uint16_t slots = 0;
@@ -56,9 +58,11 @@ struct WalkParams {
   uint8_t frames_per_record = 1;
   int32_t quantum_raw = 0;
   int32_t view_focal_q16 = 0;
+  uint16_t view_width = 0, view_height = 0;
 };
-constexpr uint32_t kWalkParamsBytes = 12;
-// The camera of a view: walk_camera with the views' focal length.
+constexpr uint32_t kWalkParamsBytes = 16;
+// The camera of a view: walk_camera with the views' focal length and
+// their centre as the principal point.
 Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPose& pose, Camera* out);
 Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out);
 void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]);

@@ -38,9 +38,9 @@ namespace {
 // texels, 1 chroma texel) that no image writes: a prediction drawing from
 // a view (predict_view) reads grey wherever a triangle reaches past it.
 constexpr uint32_t kBorder = 2;
-size_t plane_bytes(const StreamHeader& h) {
-  const size_t cw = (h.width + 1u) / 2u + kBorder, ch = (h.height + 1u) / 2u + kBorder;
-  return (static_cast<size_t>(h.width) + 2 * kBorder) * (h.height + 2 * kBorder) + 2 * cw * ch;
+size_t plane_bytes(const WalkParams& w) {
+  const size_t cw = (w.view_width + 1u) / 2u + kBorder, ch = (w.view_height + 1u) / 2u + kBorder;
+  return (static_cast<size_t>(w.view_width) + 2 * kBorder) * (w.view_height + 2 * kBorder) + 2 * cw * ch;
 }
 
 // The view with its border, for predictions: its camera's principal point
@@ -90,8 +90,9 @@ bool start(Player& p, const StreamHeader& h) {
 
 bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   WalkParams w;
-  if (walk_params_from_bytes(payload, size, &w) != Status::ok || w.slots > kWalkMaxSlots) {
-    p.fail(Status::malformed, "WLKP is not valid");
+  if (walk_params_from_bytes(payload, size, &w) != Status::ok || w.slots > kWalkMaxSlots ||
+      w.view_width > p.header().width || w.view_height > p.header().height) {
+    p.fail(Status::malformed, "WLKP is not valid (or its views are larger than the frame)");
     return false;
   }
   const StreamHeader& h = p.header();
@@ -119,22 +120,22 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   wp->view_of = p.arena().alloc_array<uint8_t>(w.slots);
   if (s == Status::ok && (!wp->meshes || !wp->positions || !wp->indices || !wp->view_of)) s = Status::workspace_too_small;
   for (uint8_t v = 0; v < w.views && s == Status::ok; ++v) {
-    uint8_t* planes = static_cast<uint8_t*>(p.arena().alloc(plane_bytes(h), 4));
+    uint8_t* planes = static_cast<uint8_t*>(p.arena().alloc(plane_bytes(w), 4));
     if (planes == nullptr) {
       s = Status::workspace_too_small;
       break;
     }
-    for (size_t i = 0; i < plane_bytes(h); ++i) planes[i] = 128;
+    for (size_t i = 0; i < plane_bytes(w); ++i) planes[i] = 128;
     // The image inside the border.
     Texture& t = wp->view_tex[v];
     t.format = TexFormat::ycbcr420;
     t.address = TexAddress::clamp;
-    t.width = h.width;
-    t.height = h.height;
-    t.stride = h.width + 2 * kBorder;
-    t.chroma_stride = (h.width + 1u) / 2u + kBorder;
-    const size_t chroma_plane = t.chroma_stride * ((h.height + 1u) / 2u + kBorder);
-    uint8_t* const cb = planes + static_cast<size_t>(t.stride) * (h.height + 2 * kBorder);
+    t.width = w.view_width;
+    t.height = w.view_height;
+    t.stride = w.view_width + 2 * kBorder;
+    t.chroma_stride = (w.view_width + 1u) / 2u + kBorder;
+    const size_t chroma_plane = t.chroma_stride * ((w.view_height + 1u) / 2u + kBorder);
+    uint8_t* const cb = planes + static_cast<size_t>(t.stride) * (w.view_height + 2 * kBorder);
     t.texels = planes + kBorder * t.stride + kBorder;
     t.cb = cb + (kBorder / 2) * t.chroma_stride + kBorder / 2;
     t.cr = cb + chroma_plane + (kBorder / 2) * t.chroma_stride + kBorder / 2;
@@ -205,21 +206,24 @@ inline void rgb_of(uint16_t c, int32_t& r, int32_t& g, int32_t& b) {
 bool predict_band(void* ctx, const Band& b) {
   const Texture& t = *static_cast<const PredictTarget*>(ctx)->t;
   if (b.format != PixelFormat::rgb565 || (b.y & 1) != 0) return false;
+  // The frame is drawn whole; the view is its top left (at most as large).
+  const uint16_t rows = b.y >= t.height ? 0 : (b.y + b.height > t.height ? static_cast<uint16_t>(t.height - b.y) : b.height);
+  const uint16_t cols = b.width < t.width ? b.width : t.width;
   uint8_t* yp = static_cast<uint8_t*>(const_cast<void*>(t.texels));
-  for (uint16_t row = 0; row < b.height; row += 2) {
+  for (uint16_t row = 0; row < rows; row += 2) {
     const uint16_t* p0 = reinterpret_cast<const uint16_t*>(b.pixels + static_cast<size_t>(row) * b.stride);
-    const bool pair = row + 1 < b.height;
+    const bool pair = row + 1 < rows;
     const uint16_t* p1 = pair ? reinterpret_cast<const uint16_t*>(b.pixels + static_cast<size_t>(row + 1) * b.stride) : p0;
     uint8_t* y0 = yp + static_cast<size_t>(b.y + row) * t.stride;
     uint8_t* y1 = y0 + t.stride;
     const size_t crow = static_cast<size_t>((b.y + row) >> 1) * t.chroma_stride;
     uint8_t* cb = const_cast<uint8_t*>(t.cb) + crow;
     uint8_t* cr = const_cast<uint8_t*>(t.cr) + crow;
-    for (uint16_t x = 0; x < b.width; x += 2) {
+    for (uint16_t x = 0; x < cols; x += 2) {
       int32_t rs = 0, gs = 0, bs = 0, n = 0;
       for (int dy = 0; dy < 2; ++dy)
         for (int dx = 0; dx < 2; ++dx) {
-          if (x + dx >= b.width || (dy == 1 && !pair)) continue;
+          if (x + dx >= cols || (dy == 1 && !pair)) continue;
           int32_t r, g, bl;
           rgb_of((dy ? p1 : p0)[x + dx], r, g, bl);
           (dy ? y1 : y0)[x + dx] = static_cast<uint8_t>((19595 * r + 38470 * g + 7471 * bl + 32768) >> 16);
@@ -407,7 +411,7 @@ size_t Player::walk_workspace_bytes(const StreamHeader& h, const WalkParams& w, 
   return sizeof(WalkPlay) + alignof(WalkPlay) + WalkGeometry::workspace_bytes(w.slots) + ImageDecoder::kWorkspaceBytes +
          render_workspace_size(rc) + w.slots * sizeof(Mesh) + alignof(Mesh) + 3u * w.slots * sizeof(Vec3<Q16_16>) +
          alignof(Vec3<Q16_16>) + 3u * w.slots * sizeof(uint16_t) + alignof(uint16_t) + w.slots +
-         w.views * (plane_bytes(h) + 4);
+         w.views * (plane_bytes(w) + 4);
 }
 
 namespace detail {

@@ -25,9 +25,10 @@ namespace vds::enc {
 struct WalkEncodeOptions {
   double rate_kbps = 16;  // the whole stream, header included
   int views = 2;          // view slots the client holds
-  double threshold = 12;  // largest magnification a view serves (the sweep on oa_dm4: docs/walkthrough.md)
+  double threshold = 18;  // largest magnification a view serves (the sweeps on oa_dm4: docs/walkthrough.md)
   int lookahead = 20;     // frames ahead a view's camera may come from
   double view_widen = 1.5;  // tan(half the views' field of view) / tan(half the screen's)
+  double view_scale = 2.0 / 3;  // the views' size over the frame's (each side; 16 pixels at least, even)
   int refine_delta = 0;     // a refinement's quality above the views' (0: none; they did not pay on oa_dm4: docs/walkthrough.md)
   int refine_after = 10;    // frames after a view arrives; views serving at least twice that are refined
   int window = 2;         // hot: visible within this many frames either side

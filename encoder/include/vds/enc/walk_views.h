@@ -44,6 +44,7 @@ struct WalkViewOptions {
   int width = 240, height = 180;
   double near_z = 1, far_z = 4096;  // scene units
   double view_hfov_deg = 0;         // the views' horizontal field of view (0: the path's)
+  int view_width = 0, view_height = 0;  // the views' size (0: the frame's)
 };
 
 struct WalkViewPlan {
