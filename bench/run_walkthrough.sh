@@ -25,6 +25,8 @@ PY=/usr/bin/python3
 for map in ${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2}; do
   [ -f "$WORK/$map/tour.txt" ] || { echo "run_walkthrough: $WORK/$map/tour.txt missing (bench/run_walk_video.sh)" >&2; exit 1; }
   for rate in 8 16 32; do
+    # REUSE=1: streams encoded by an earlier run are kept.
+    [ "${REUSE:-0}" = 1 ] && [ -s "$WORK/$map/walk_$rate.txt" ] && [ -s "$WORK/$map/walk_$rate.y4m" ] && continue
     echo "== $map at $rate kbit/s"
     "$VDS" encode-walk "$map" --path "$WORK/$map/tour.txt" --rate "$rate" --threshold "${THRESHOLD:-18}" \
       -o "$WORK/$map/walk_$rate.vds" --y4m "$WORK/$map/walk_$rate.y4m" 2>/dev/null | tee "$WORK/$map/walk_$rate.txt"
@@ -41,7 +43,7 @@ rows, plot = [], {}
 for m in maps:
     for rate in (8, 16, 32):
         t = open(os.path.join(work, m, f"walk_{rate}.txt")).read()
-        k = re.search(r"= ([\d.]+) kbit/s.*header (\d+), views (\d+) \((\d+) updates at quality (\d+)\), geometry (\d+), frames (\d+)", t)
+        k = re.search(r"= ([\d.]+) kbit/s.*header (\d+), views (\d+) \((\d+) updates at quality (\d+)[^)]*\), geometry (\d+), frames (\d+)", t)
         q = re.search(r"(\d+) bytes of workspace; PSNR R,G,B ([\d.]+) dB pooled, ([\d.]+) dB worst", t)
         kb, hdr, views, ups, qual, geo, frm = float(k[1]), *map(int, k.groups()[1:])
         dur = anchors[m]["frames"] / 20

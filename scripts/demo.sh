@@ -7,7 +7,8 @@
 # (which reports its instruction counts). Both boards' frame CRCs must equal
 # the encoder's reconstruction. Then the Stanford bunny (glmark2-data) as a
 # progressive model at 2 KB/s to the host-native board, drawn after every
-# level, then the client self-test on both boards and the size of the
+# level; a walkthrough of the OpenArena map oa_dm4 at 2 KB/s to both
+# boards; then the client self-test on both boards and the size of the
 # client's parts. Everything goes to out/demo/; the summary
 # is out/demo/report.md.
 set -euo pipefail
@@ -21,10 +22,10 @@ rm -rf "$OUT"
 mkdir -p "$OUT/src"
 [ -f "$PK3" ] || { echo "demo: $PK3 not found; run scripts/fetch-data.sh" >&2; exit 1; }
 
-echo "demo: 1/6 taking twelve textures from $(basename "$PK3")"
+echo "demo: 1/7 taking twelve textures from $(basename "$PK3")"
 python3 "$ROOT/scripts/demo_reel.py" "$OUT/src" "$PK3"
 
-echo "demo: 2/6 encoding, then streaming to both boards at 115,200 baud (about a minute)"
+echo "demo: 2/7 encoding, then streaming to both boards at 115,200 baud (about a minute)"
 python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
   --qemu qemu-system-arm --elf "$CM4/vds_fw_client.elf" --work "$OUT" --quality 75 \
   --inputs "$OUT"/src/*.tga --report "$OUT/run.json" > "$OUT/end_to_end.log" 2>&1 || {
@@ -34,29 +35,40 @@ python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$ROOT/$BUIL
 }
 grep -E '^(encoder|host|cortex-m4) *:|^end-to-end' "$OUT/end_to_end.log"
 
-echo "demo: 3/6 the Stanford bunny as a progressive model at 2 KB/s to the host-native board, then to the Cortex-M4 board (about a minute)"
+echo "demo: 3/7 the Stanford bunny as a progressive model at 2 KB/s to the host-native board, then to the Cortex-M4 board (about a minute)"
 MODEL=/usr/share/glmark2/models/bunny.obj
 [ -f "$MODEL" ] || { echo "demo: $MODEL not found; run scripts/fetch-data.sh" >&2; exit 1; }
 python3 "$ROOT/scripts/demo_model.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
   --model "$MODEL" --out "$OUT/model" --qemu qemu-system-arm --elf "$CM4/vds_fw_client.elf" > "$OUT/model.md" || {
   cat "$OUT/model.md"
+  echo
+  cat "$OUT/walk.md"
   echo "demo: the model run failed (log: out/demo/model/serve.log)" >&2
   exit 1
 }
 grep -E '^(`|The same stream)' "$OUT/model.md"
 
-echo "demo: 4/6 client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
+echo "demo: 4/7 a walkthrough of oa_dm4 at 2 KB/s (vds path, vds encode-walk) to both boards (about two minutes)"
+python3 "$ROOT/scripts/demo_walk.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
+  --qemu qemu-system-arm --elf "$CM4/vds_fw_client.elf" --out "$OUT/walk" > "$OUT/walk.md" || {
+  cat "$OUT/walk.md"
+  echo "demo: the walkthrough run failed (logs: out/demo/walk/)" >&2
+  exit 1
+}
+grep -E '^(`|On the Cortex)' "$OUT/walk.md"
+
+echo "demo: 5/7 client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
 BOARDS=$(python3 "$ROOT/tests/tools/compare_boards.py" --host "$ROOT/$BUILD/firmware_sim/vds_fw_selftest_host" \
   --qemu qemu-system-arm --elf "$CM4/vds_fw_selftest.elf")
 echo "$BOARDS" | grep -E '^boards'
 
-echo "demo: 5/6 Cortex-M4 size of the client library and the link"
+echo "demo: 6/7 Cortex-M4 size of the client library and the link"
 SIZE_TABLE=$(python3 "$ROOT/tests/tools/check_freestanding.py" \
   --cxx arm-none-eabi-g++ --nm arm-none-eabi-nm --size arm-none-eabi-size --out "$OUT/linkcheck" \
   --lib "decoder=$ROOT/$BUILD/cm4/decoder/libvds_decoder.a" \
   --lib "transport_core=$ROOT/$BUILD/cm4/transport/libvds_transport_core.a")
 
-echo "demo: 6/6 writing the report"
+echo "demo: 7/7 writing the report"
 {
   python3 "$ROOT/scripts/client_report.py" --run "$OUT/run.json" --elf "$CM4/vds_fw_client.elf" \
     --map "$CM4/vds_fw_client.map" --title "vds demo: twelve textures to a simulated client" --images-dir host |
@@ -66,6 +78,8 @@ echo "demo: 6/6 writing the report"
   echo "(and \`frames.mp4\` when ffmpeg is installed). Stream: \`out/demo/e2e.vds\`; logs: \`out/demo/end_to_end.log\`."
   echo
   cat "$OUT/model.md"
+  echo
+  cat "$OUT/walk.md"
   echo
   echo "## Client self-test, host board against the Cortex-M4 board"
   echo

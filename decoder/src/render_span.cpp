@@ -32,13 +32,41 @@ inline uint32_t expand565(uint32_t c) {
 
 // JFIF full-range Y'CbCr -> R'G'B' (colour.h, the image output's
 // constants), each channel rounded and clamped.
-inline uint32_t ycbcr_to_rgb(int32_t y, int32_t cb, int32_t cr) {
+struct Channels {
+  int32_t r, g, b;  // rounded, not yet clamped: -256..511
+};
+inline Channels ycbcr_channels(int32_t y, int32_t cb, int32_t cr) {
   using namespace colour;
   const int32_t cbd = cb - kChromaCentre, crd = cr - kChromaCentre;
-  const int32_t r = y + ((kCrToR * crd + kHalf) >> kFracBits);
-  const int32_t g = y + ((-kCbToG * cbd - kCrToG * crd + kHalf) >> kFracBits);
-  const int32_t b = y + ((kCbToB * cbd + kHalf) >> kFracBits);
-  return (static_cast<uint32_t>(sat_u8(r)) << 16) | (static_cast<uint32_t>(sat_u8(g)) << 8) | sat_u8(b);
+  return {y + ((kCrToR * crd + kHalf) >> kFracBits), y + ((-kCbToG * cbd - kCrToG * crd + kHalf) >> kFracBits),
+          y + ((kCbToB * cbd + kHalf) >> kFracBits)};
+}
+inline uint32_t ycbcr_to_rgb(int32_t y, int32_t cb, int32_t cr) {
+  const Channels c = ycbcr_channels(y, cb, cr);
+  return (static_cast<uint32_t>(sat_u8(c.r)) << 16) | (static_cast<uint32_t>(sat_u8(c.g)) << 8) | sat_u8(c.b);
+}
+
+// The same straight to RGB565: each channel's value before clamping
+// (-256..511 for any Y', Cb, Cr) indexes a table holding it clamped,
+// rounded to 5 or 6 bits (pack565's rounding) and in place. Exactly
+// pack565(ycbcr_to_rgb(...)), in about 14 instructions less on a Cortex-M4.
+struct Pack565Table {
+  uint16_t r[768], g[768], b[768];
+};
+constexpr Pack565Table make_pack565_table() {
+  Pack565Table t{};
+  for (int i = 0; i < 768; ++i) {
+    const uint32_t v = static_cast<uint32_t>(i < 256 ? 0 : (i > 511 ? 255 : i - 256));
+    t.r[i] = static_cast<uint16_t>(((v * 249 + 1014) >> 11) << 11);
+    t.g[i] = static_cast<uint16_t>(((v * 253 + 505) >> 10) << 5);
+    t.b[i] = static_cast<uint16_t>((v * 249 + 1014) >> 11);
+  }
+  return t;
+}
+constexpr Pack565Table kPack565 = make_pack565_table();
+inline uint16_t ycbcr_to_565(int32_t y, int32_t cb, int32_t cr) {
+  const Channels c = ycbcr_channels(y, cb, cr);
+  return static_cast<uint16_t>(kPack565.r[c.r + 256] | kPack565.g[c.g + 256] | kPack565.b[c.b + 256]);
 }
 
 // Blend of two 0x00RR00BB (or 0x0000GG00) words with an 8-bit weight f of b:
@@ -75,6 +103,17 @@ inline OutColor<O> from8888(uint32_t c) {
     return c & 0xFFFFFFu;
   }
 }
+
+// Y'CbCr to the output format.
+template <PixelFormat O>
+inline OutColor<O> from_ycbcr(int32_t y, int32_t cb, int32_t cr) {
+  if constexpr (O == PixelFormat::rgb565) {
+    return ycbcr_to_565(y, cb, cr);
+  } else {
+    return from8888<O>(ycbcr_to_rgb(y, cb, cr));
+  }
+}
+
 template <PixelFormat O>
 inline OutColor<O> from565(uint32_t c) {
   if constexpr (O == PixelFormat::rgb565) {
@@ -110,7 +149,7 @@ struct NearestSampler {
     } else {
       // The chroma sample (col/2, row/2) covers luma texels 2i and 2i + 1.
       const uint32_t ci = static_cast<uint32_t>(row >> 1) * t.cstride + static_cast<uint32_t>(col >> 1);
-      return from8888<O>(ycbcr_to_rgb(t.base[index], t.cb[ci], t.cr[ci]));
+      return from_ycbcr<O>(t.base[index], t.cb[ci], t.cr[ci]);
     }
   }
 };
@@ -147,7 +186,7 @@ struct BilinearSampler {
       const uint32_t s1 = static_cast<uint32_t>(tx<A>((cv >> 8) + 1, t.chmask, t.chmax)) * t.cstride;
       const uint32_t cb = lerp8(lerp8(t.cb[s0 + k0], t.cb[s0 + k1], gu), lerp8(t.cb[s1 + k0], t.cb[s1 + k1], gu), gv);
       const uint32_t cr = lerp8(lerp8(t.cr[s0 + k0], t.cr[s0 + k1], gu), lerp8(t.cr[s1 + k0], t.cr[s1 + k1], gu), gv);
-      return from8888<O>(ycbcr_to_rgb(static_cast<int32_t>(yy), static_cast<int32_t>(cb), static_cast<int32_t>(cr)));
+      return from_ycbcr<O>(static_cast<int32_t>(yy), static_cast<int32_t>(cb), static_cast<int32_t>(cr));
     } else if constexpr (TF == TexFormat::rgb565 && O == PixelFormat::rgb565) {
       const uint16_t* p = reinterpret_cast<const uint16_t*>(t.base);
       const uint32_t top = lerp_spread(spread565(p[r0 + c0]), spread565(p[r0 + c1]), fu);
