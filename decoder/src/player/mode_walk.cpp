@@ -7,7 +7,9 @@
 // homography of its plane).
 // Views arrive as WVUP and an intra vds image decoded into the view's
 // Y'CbCr 4:2:0 planes; a WVUP naming a slot's own camera again may carry a
-// residual image that refines what the slot holds.
+// residual image that refines what the slot holds, and one with its
+// "predict" bit has the client draw the view from what it holds first
+// (predict_view), which the image may then be a residual against.
 #include "vds/homography.h"
 #include "vds/player.h"
 #include "vds/render.h"
