@@ -14,7 +14,6 @@ namespace {
 constexpr uint32_t kMaxFrameSide = 16384;
 constexpr uint32_t kMaxChunkPayloadLimit = 1u << 24;  // 16 MiB: far beyond any client
 
-int32_t get_s32(const uint8_t* p) { return static_cast<int32_t>(load_le32(p)); }
 
 }  // namespace
 
@@ -52,12 +51,12 @@ Status header_from_bytes(const uint8_t* p, uint32_t size, uint8_t version_major,
   h.height = load_le16(p + 4);
   h.frame_period_us = load_le32(p + 6);
   h.frame_count = load_le32(p + 10);
-  h.focal_x_q16 = get_s32(p + 14);
-  h.focal_y_q16 = get_s32(p + 18);
-  h.center_x_q16 = get_s32(p + 22);
-  h.center_y_q16 = get_s32(p + 26);
-  h.near_q16 = get_s32(p + 30);
-  h.far_q16 = get_s32(p + 34);
+  h.focal_x_q16 = load_le32s(p + 14);
+  h.focal_y_q16 = load_le32s(p + 18);
+  h.center_x_q16 = load_le32s(p + 22);
+  h.center_y_q16 = load_le32s(p + 26);
+  h.near_q16 = load_le32s(p + 30);
+  h.far_q16 = load_le32s(p + 34);
   h.max_chunk_payload = load_le32(p + 38);
   h.workspace_bytes = load_le32(p + 42);
   h.max_vertices = load_le32(p + 46);

@@ -2,18 +2,9 @@
 #include "vds/walk.h"
 
 #include "vds/bytes.h"
+#include "vds/walk_geometry.h"
 
 namespace vds {
-
-namespace {
-
-Q2_30 mul30(Q2_30 a, Q2_30 b) {
-  return Q2_30::from_raw(static_cast<int32_t>((static_cast<int64_t>(a.raw()) * b.raw() + (int64_t{1} << 29)) >> 30));
-}
-
-int32_t get_i32(const uint8_t* p) { return static_cast<int32_t>(load_le32(p)); }
-
-}  // namespace
 
 Status walk_camera(const StreamHeader& h, const WalkPose& pose, Camera* out) {
   // 2^-16 turn to 2^-32 turn.
@@ -25,11 +16,11 @@ Status walk_camera(const StreamHeader& h, const WalkPose& pose, Camera* out) {
   c.rotation.m[0][0] = sy;
   c.rotation.m[0][1] = Q2_30::from_raw(-cy.raw());
   c.rotation.m[0][2] = Q2_30::from_raw(0);
-  c.rotation.m[1][0] = mul30(sp, cy);
-  c.rotation.m[1][1] = mul30(sp, sy);
+  c.rotation.m[1][0] = mul_round<Q2_30>(sp, cy);
+  c.rotation.m[1][1] = mul_round<Q2_30>(sp, sy);
   c.rotation.m[1][2] = Q2_30::from_raw(-cp.raw());
-  c.rotation.m[2][0] = mul30(cp, cy);
-  c.rotation.m[2][1] = mul30(cp, sy);
+  c.rotation.m[2][0] = mul_round<Q2_30>(cp, cy);
+  c.rotation.m[2][1] = mul_round<Q2_30>(cp, sy);
   c.rotation.m[2][2] = sp;
   c.position = pose.position;
   c.fx = Q16_16::from_raw(h.focal_x_q16);
@@ -56,14 +47,14 @@ Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out) 
   WalkParams w;
   w.slots = load_le16(p);
   w.views = p[2];
-  w.quantum_raw = get_i32(p + 4);
-  w.view_focal_q16 = get_i32(p + 8);
+  w.quantum_raw = load_le32s(p + 4);
+  w.view_focal_q16 = load_le32s(p + 8);
   w.frames_per_record = p[3];
   w.view_width = load_le16(p + 12);
   w.view_height = load_le16(p + 14);
   if (w.view_focal_q16 < (kCameraMinFocalPx << 16) || w.view_focal_q16 > (kCameraMaxFocalPx << 16) || w.slots == 0 ||
       w.views == 0 || w.views > kWalkMaxViews || w.frames_per_record == 0 || w.frames_per_record > kWalkMaxFramesPerRecord ||
-      w.quantum_raw < 1 || w.quantum_raw > 65536 || (w.quantum_raw & (w.quantum_raw - 1)) != 0 || w.view_width < 16 ||
+      !walk_quantum_valid(w.quantum_raw) || w.view_width < 16 ||
       w.view_height < 16)
     return Status::malformed;
   *out = w;
@@ -84,7 +75,7 @@ Status walk_view_from_bytes(const uint8_t* p, uint32_t size, WalkViewUpdate* out
   if (size != kWalkViewBytes) return Status::malformed;
   out->slot = p[0] & static_cast<uint8_t>(~kWalkViewPredict);
   out->predict = (p[0] & kWalkViewPredict) != 0;
-  out->pose.position = {Q16_16::from_raw(get_i32(p + 1)), Q16_16::from_raw(get_i32(p + 5)), Q16_16::from_raw(get_i32(p + 9))};
+  out->pose.position = {Q16_16::from_raw(load_le32s(p + 1)), Q16_16::from_raw(load_le32s(p + 5)), Q16_16::from_raw(load_le32s(p + 9))};
   out->pose.yaw = load_le16(p + 13);
   out->pose.pitch = load_le16(p + 15);
   return Status::ok;
@@ -171,8 +162,7 @@ Status WalkFrameDecoder::decode(ArithDecoder& d, const uint16_t* hot, uint32_t h
     }
   }
   if (!d.ok()) return d.status();
-  int other_bits = 0;
-  while ((1 << other_bits) < views - 1) ++other_bits;
+  const int other_bits = walk_other_view_bits(views);
   for (uint32_t i = 0; i < hot_count; ++i) {
     uint8_t& v = view_of[hot[i]];
     if (v >= views) v = 0;

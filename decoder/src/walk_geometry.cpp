@@ -45,7 +45,7 @@ size_t WalkGeometry::workspace_bytes(uint32_t slots) {
 }
 
 Status WalkGeometry::init(Arena& arena, uint32_t slots, int32_t quantum_raw) {
-  if (slots == 0 || slots > kWalkMaxSlots || quantum_raw < 1 || quantum_raw > 65536 || (quantum_raw & (quantum_raw - 1)) != 0)
+  if (slots == 0 || slots > kWalkMaxSlots || !walk_quantum_valid(quantum_raw))
     return Status::invalid_argument;
   positions_ = arena.alloc_array<Vec3<Q16_16>>(3 * static_cast<size_t>(slots));
   filled_ = arena.alloc_array<uint8_t>(slots);
@@ -65,7 +65,6 @@ Status WalkGeometry::init(Arena& arena, uint32_t slots, int32_t quantum_raw) {
   ring_.reset(ring);
   for (int c = 0; c < 3; ++c)
     for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a] = INT32_MIN;
-  have_prev_ = false;
   return Status::ok;
 }
 
@@ -126,7 +125,6 @@ Status WalkGeometry::decode(ArithDecoder& d) {
     if (!d.ok()) return d.status();
     for (int c = 0; c < 3; ++c)
       for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a];
-    have_prev_ = true;
     filled_[slot] = 1;
     if (hot_now) mark_[slot] = 1;
   }

@@ -32,7 +32,6 @@ float load_f32(const uint8_t* p) {
   std::memcpy(&f, &u, 4);
   return f;
 }
-int32_t load_i32(const uint8_t* p) { return static_cast<int32_t>(load_le32(p)); }
 
 struct Reader {
   const uint8_t* data;
@@ -216,7 +215,7 @@ Scene read_bsp(const uint8_t* data, size_t size, const std::string& name, const 
   Reader r{data, size, name, {}, {}};
   constexpr size_t kHeader = 8 + 8 * kLumps;
   if (size < kHeader || std::memcmp(data, "IBSP", 4) != 0) r.fail("not a Quake III map (it must start with 'IBSP')");
-  const int32_t version = load_i32(data + 4);
+  const int32_t version = load_le32s(data + 4);
   if (version != 46) r.fail("BSP version " + std::to_string(version) + " (46, Quake III and OpenArena, is read)");
   for (int l = 0; l < kLumps; ++l) {
     r.offset[l] = load_le32(data + 8 + 8 * l);
@@ -254,7 +253,7 @@ Scene read_bsp(const uint8_t* data, size_t size, const std::string& name, const 
   if (nmodels == 0) r.fail("no models (the world is model 0)");
   for (size_t m = 0; m < nmodels; ++m) {
     const uint8_t* p = r.at(kModels, kModelBytes, m);
-    const int32_t first = load_i32(p + 24), n = load_i32(p + 28);
+    const int32_t first = load_le32s(p + 24), n = load_le32s(p + 28);
     if (first < 0 || n < 0 || static_cast<size_t>(first) > nfaces || static_cast<size_t>(n) > nfaces - first)
       r.fail("model " + std::to_string(m) + " names faces " + std::to_string(first) + "+" + std::to_string(n) + " of " +
              std::to_string(nfaces));
@@ -266,9 +265,9 @@ Scene read_bsp(const uint8_t* data, size_t size, const std::string& name, const 
   std::vector<SceneVertex> cp;
   for (size_t f = 0; f < nfaces; ++f) {
     const uint8_t* p = r.at(kFaces, kFaceBytes, f);
-    const int32_t texture = load_i32(p), type = load_i32(p + 8), vertex = load_i32(p + 12), nv = load_i32(p + 16),
-                  meshvert = load_i32(p + 20), nmv = load_i32(p + 24), lm = load_i32(p + 28);
-    const int32_t pw = load_i32(p + 96), ph = load_i32(p + 100);
+    const int32_t texture = load_le32s(p), type = load_le32s(p + 8), vertex = load_le32s(p + 12), nv = load_le32s(p + 16),
+                  meshvert = load_le32s(p + 20), nmv = load_le32s(p + 24), lm = load_le32s(p + 28);
+    const int32_t pw = load_le32s(p + 96), ph = load_le32s(p + 100);
     const std::string where = "face " + std::to_string(f) + " of " + std::to_string(nfaces);
     if (type == 1) ++s.polygons;
     else if (type == 2) ++s.patches;
@@ -321,7 +320,7 @@ Scene read_bsp(const uint8_t* data, size_t size, const std::string& name, const 
         if (!bad.empty()) r.fail(where + ": vertex " + std::to_string(vertex + i) + " has " + bad);
       }
       for (int32_t i = 0; i < nmv; ++i) {
-        const int32_t k = load_i32(r.at(kMeshVerts, 4, static_cast<size_t>(meshvert + i)));
+        const int32_t k = load_le32s(r.at(kMeshVerts, 4, static_cast<size_t>(meshvert + i)));
         if (k < 0 || k >= nv)
           r.fail(where + ": mesh vertex " + std::to_string(meshvert + i) + " is " + std::to_string(k) + ", not one of its " +
                  std::to_string(nv) + " vertices");

@@ -519,6 +519,22 @@ SceneFrame SceneRenderer::render(const CameraPose& pose, double hfov_deg) const 
   return out;
 }
 
+std::vector<std::pair<uint32_t, uint32_t>> visible_triangles(const SceneFrame& f) {
+  std::vector<uint32_t> ids;
+  ids.reserve(f.ids.size());
+  for (uint32_t id : f.ids)
+    if (id != kNoTriangle) ids.push_back(id);
+  std::sort(ids.begin(), ids.end());
+  std::vector<std::pair<uint32_t, uint32_t>> out;
+  for (size_t i = 0; i < ids.size();) {
+    size_t j = i;
+    while (j < ids.size() && ids[j] == ids[i]) ++j;
+    out.emplace_back(ids[i], static_cast<uint32_t>(j - i));
+    i = j;
+  }
+  return out;
+}
+
 void render_path(const SceneRenderer& r, const CameraPath& path, int threads,
                  const std::function<void(size_t, const SceneFrame&)>& sink, const std::function<void(size_t)>& progress) {
   const size_t n = path.frames.size();

@@ -2,6 +2,7 @@
 #include "vds/enc/walk_geometry.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -90,14 +91,6 @@ WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& vi
   return plan;
 }
 
-}  // namespace vds::enc
-
-#include <cmath>
-
-#include "vds/enc/arith_encoder.h"
-
-namespace vds::enc {
-
 int32_t choose_walk_quantum(const Scene& s, double tolerance) {
   for (int32_t q = 65536; q > 256; q /= 2) {
     const double step = q / 65536.0;
@@ -117,7 +110,7 @@ int32_t choose_walk_quantum(const Scene& s, double tolerance) {
 
 WalkGeometryEncoder::WalkGeometryEncoder(uint32_t slots, int32_t quantum_raw)
     : slots_(slots), quantum_(quantum_raw), ring_storage_(kWalkVertexRing), last_slot_(slots - 1) {
-  if (slots == 0 || slots > kWalkMaxSlots || quantum_raw < 1 || quantum_raw > 65536 || (quantum_raw & (quantum_raw - 1)) != 0)
+  if (slots == 0 || slots > kWalkMaxSlots || !walk_quantum_valid(quantum_raw))
     throw std::invalid_argument("WalkGeometryEncoder: slots or quantum out of range");
   ctx_.reset();
   ring_.reset(reinterpret_cast<int32_t(*)[3]>(ring_storage_.data()));

@@ -39,8 +39,7 @@ class WalkFrameEncoder {
       if (k >= 3) r = static_cast<int16_t>(static_cast<uint16_t>(r));  // angles: the short way round
       e.encode_signed(state_.zero[k], state_.mag[k], 6, r, 6, 3);
     }
-    int other_bits = 0;
-    while ((1 << other_bits) < views - 1) ++other_bits;
+    const int other_bits = walk_other_view_bits(views);
     for (size_t i = 0; i < hot.size(); ++i) {
       uint8_t& v = view_of[hot[i]];
       if (v >= views) v = 0;
@@ -97,10 +96,6 @@ class MirrorClient {
   size_t fed_ = 0;
 };
 
-double sc0_focal(const CameraPath& path, const WalkEncodeOptions& o) {
-  return scene_camera(path.frames.front(), path.hfov_deg, o.width, o.height).focal;
-}
-
 }  // namespace
 
 WalkPose walk_pose(const CameraPose& p) {
@@ -139,21 +134,18 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   ro.height = o.height;
   const std::vector<io::Image> images = load_scene_images(s);
   const SceneRenderer renderer(s, images, ro);
+  const SceneCamera sc = scene_camera(path.frames[0], path.hfov_deg, o.width, o.height);  // the screen's intrinsics
   // The views' size.
   if (!(o.view_scale > 0 && o.view_scale <= 1)) throw std::invalid_argument("encode_walk: a view scale in (0, 1]");
   // (No smaller than the client's smallest focal length allows.)
-  const double scale = std::clamp(o.view_scale, std::min(1.0, kCameraMinFocalPx / sc0_focal(path, o)), 1.0);
+  const double scale = std::clamp(o.view_scale, std::min(1.0, kCameraMinFocalPx / sc.focal), 1.0);
   const int view_w = std::min(o.width, std::max(16, static_cast<int>(std::ceil(o.width * scale / 2 - 1e-9)) * 2));
   const int view_h = std::min(o.height, std::max(16, static_cast<int>(std::ceil(o.height * scale / 2 - 1e-9)) * 2));
-  if (view_w > o.width || view_h > o.height) throw std::invalid_argument("encode_walk: views larger than the frame");
   std::vector<io::Image> truth(n);
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> visible(n);
   render_path(renderer, path, o.threads, [&](size_t f, const SceneFrame& fr) {
     truth[f] = fr.rgb;
-    std::map<uint32_t, uint32_t> px;
-    for (uint32_t id : fr.ids)
-      if (id != kNoTriangle) ++px[id];
-    visible[f].assign(px.begin(), px.end());
+    visible[f] = visible_triangles(fr);
   }, [&](size_t done) { progress("ground truth", done, n); });
   // 2. Geometry and views.
   std::vector<std::vector<uint32_t>> ids(n);
@@ -173,7 +165,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   // what a view at each frame's camera shows.
   const double kDeg = 3.14159265358979323846 / 180;
   // (No wider than the client's smallest focal length allows.)
-  const double widen = std::clamp(o.view_widen, 1.0, std::max(1.0, sc0_focal(path, o) * view_w / o.width / kCameraMinFocalPx));
+  const double widen = std::clamp(o.view_widen, 1.0, std::max(1.0, sc.focal * view_w / o.width / kCameraMinFocalPx));
   const double view_hfov = 2 * std::atan(widen * std::tan(path.hfov_deg * kDeg / 2)) / kDeg;
   vo.view_hfov_deg = view_hfov;
   vo.view_width = view_w;
@@ -185,31 +177,27 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vro.max_aniso = 1;
   const SceneRenderer view_vis(s, {}, vro);
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> view_visible(n);
-  render_path(view_vis, wide, o.threads, [&](size_t f, const SceneFrame& fr) {
-    std::map<uint32_t, uint32_t> px;
-    for (uint32_t id : fr.ids)
-      if (id != kNoTriangle) ++px[id];
-    view_visible[f].assign(px.begin(), px.end());
-  }, [&](size_t done) { progress("view visibility", done, n); });
+  render_path(view_vis, wide, o.threads, [&](size_t f, const SceneFrame& fr) { view_visible[f] = visible_triangles(fr); },
+              [&](size_t done) { progress("view visibility", done, n); });
   const WalkViewPlan vp = plan_walk_views(s, path, visible, vo, &view_visible);
   // 3. The views, rendered at the client's cameras.
   std::vector<WalkPose> poses(n);
   for (size_t f = 0; f < n; ++f) poses[f] = walk_pose(path.frames[f]);
-  std::map<uint32_t, io::Image> view_images;
+  // (As Y'CbCr planes, the form the image codec takes.)
+  std::map<uint32_t, Planes> view_planes;
   for (const auto& ups : vp.updates)
-    for (const auto& u : ups) view_images[u.camera_frame];
+    for (const auto& u : ups) view_planes[u.camera_frame];
   size_t done = 0;
   RenderOptions view_ro = ro;
   view_ro.width = view_w;
   view_ro.height = view_h;
   const SceneRenderer view_renderer(s, images, view_ro);
-  for (auto& [g, img] : view_images) {
-    img = view_renderer.render(from_walk_pose(poses[g]), view_hfov).rgb;
-    progress("views", ++done, view_images.size());
+  for (auto& [g, planes] : view_planes) {
+    planes = rgb_to_planes(view_renderer.render(from_walk_pose(poses[g]), view_hfov).rgb, ChromaFormat::yuv420);
+    progress("views", ++done, view_planes.size());
   }
   // 4. The header and the parts that do not depend on the views' quality.
   StreamHeader h = default_header(StreamMode::walkthrough, static_cast<uint16_t>(o.width), static_cast<uint16_t>(o.height));
-  const SceneCamera sc = scene_camera(path.frames[0], path.hfov_deg, o.width, o.height);
   h.frame_period_us = static_cast<uint32_t>(std::lround(1e6 / path.fps));
   h.frame_count = static_cast<uint32_t>(n);
   h.focal_x_q16 = h.focal_y_q16 = static_cast<int32_t>(std::lround(sc.focal * 65536));
@@ -296,9 +284,6 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     wfrm[r] = e.finish();
   }
   // 5. The stream at a quality; the best that fits the rate.
-  // The view images in the rgb_to_planes form the codec takes.
-  std::map<uint32_t, Planes> view_planes;
-  for (const auto& [g, img] : view_images) view_planes[g] = rgb_to_planes(img, ChromaFormat::yuv420);
   const auto build = [&](int quality, WalkEncodeResult* res) {
     ImageEncodeOptions io;
     io.quality = quality;

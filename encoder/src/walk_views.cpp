@@ -50,21 +50,20 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   const double view_hfov = o.view_hfov_deg > 0 ? o.view_hfov_deg : path.hfov_deg;
   if (view_visible != nullptr && view_visible->size() != n) throw std::invalid_argument("plan_walk_views: one view visibility list per frame");
   const int vw = o.view_width > 0 ? o.view_width : o.width, vh = o.view_height > 0 ? o.view_height : o.height;
+  // Each frame's camera as the screen and as a view: the client's and the scene's.
   std::vector<vds::Camera> cams, vcams;
+  std::vector<SceneCamera> scams, vscams;
   for (const CameraPose& p : path.frames) {
     cams.push_back(client_camera(p, path.hfov_deg, o.width, o.height, o.near_z, o.far_z));
     vcams.push_back(client_camera(p, view_hfov, vw, vh, o.near_z, o.far_z));
+    scams.push_back(scene_camera(p, path.hfov_deg, o.width, o.height));
+    vscams.push_back(scene_camera(p, view_hfov, vw, vh));
   }
   // Polygons the view at each frame's camera shows, for "does view v show polygon p".
   const auto& vv = view_visible != nullptr ? *view_visible : visible;
   std::vector<std::unordered_set<uint32_t>> shows(n);
   for (size_t f = 0; f < n; ++f)
     for (const auto& [id, px] : vv[f]) shows[f].insert(id);
-  std::vector<SceneCamera> scams, vscams;  // each frame's camera as the screen and as a view
-  for (const CameraPose& p : path.frames) {
-    scams.push_back(scene_camera(p, path.hfov_deg, o.width, o.height));
-    vscams.push_back(scene_camera(p, view_hfov, vw, vh));
-  }
   const double inf = std::numeric_limits<double>::infinity();
   // The factor of the view at frame g for polygon id on frame f's screen
   // (+inf if g does not show it): the largest magnification of the

@@ -3,7 +3,6 @@
 // (one sample a pixel: visibility only).
 #pragma once
 #include <cstdint>
-#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,11 +32,7 @@ inline TourVisibility tour_visibility(const std::string& map, size_t frames) {
   ro.max_aniso = 1;
   const vds::enc::SceneRenderer r(t.scene, {}, ro);
   for (const auto& pose : t.path.frames) {
-    const auto f = r.render(pose, t.path.hfov_deg);
-    std::map<uint32_t, uint32_t> px;
-    for (uint32_t id : f.ids)
-      if (id != vds::enc::kNoTriangle) ++px[id];
-    t.visible.emplace_back(px.begin(), px.end());
+    t.visible.push_back(vds::enc::visible_triangles(r.render(pose, t.path.hfov_deg)));
   }
   return t;
 }

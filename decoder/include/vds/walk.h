@@ -81,6 +81,14 @@ struct WalkViewUpdate {
 Status walk_view_from_bytes(const uint8_t* p, uint32_t size, WalkViewUpdate* out);
 void walk_view_to_bytes(const WalkViewUpdate& u, uint8_t out[kWalkViewBytes]);
 
+// Bypass bins naming a view other than a triangle's last in a frame
+// record: ceil(log2(views - 1)).
+constexpr int walk_other_view_bits(uint8_t views) {
+  int b = 0;
+  while ((1 << b) < views - 1) ++b;
+  return b;
+}
+
 // Positions in a frame record are on a grid of 1/16 world unit.
 constexpr int kWalkPoseShift = 12;  // raw Q16.16 per step: 2^12
 

@@ -134,7 +134,6 @@ class WalkGeometry {
   WalkVertexRing ring_{};
   int32_t prev_[3][3]{};  // the previous triangle sent (grid units)
   int32_t cur_[3][3]{};   // the one being read
-  bool have_prev_ = false;
 };
 
 // Grid steps in a map unit, as bits: 65536 / quantum rounded down to a
@@ -143,6 +142,12 @@ inline int walk_fraction_bits(int32_t quantum_raw) {
   int b = 0;
   while (b < 16 && (int32_t{65536} >> (b + 1)) >= quantum_raw) ++b;
   return b;
+}
+
+// A vertex grid quantum the client takes: a power of two in raw Q16.16
+// world units, 1 (1/65536 unit) to 65536 (one unit).
+constexpr bool walk_quantum_valid(int32_t quantum_raw) {
+  return quantum_raw >= 1 && quantum_raw <= 65536 && (quantum_raw & (quantum_raw - 1)) == 0;
 }
 
 // Bits for a slot index in a budget of `slots` (ceil(log2 slots), at least 1).

@@ -115,8 +115,8 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
   return result;
 }
 
-// A frame can complete at any chunk (a model draws after every level, and
-// a coarse level can be one small chunk; a walkthrough at each WFRM).
+// A frame can complete at any chunk: a model draws after every level, and
+// a coarse level can be one small chunk.
 size_t feed_limit(const Player&, uint32_t frames_room) { return detail::chunk_per_frame_feed_limit(frames_room); }
 
 }  // namespace

@@ -336,7 +336,7 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
         ImageHeader ih;
         if (w.image_open || image_header_from_bytes(payload, size, &ih) != Status::ok || ih.width != t.width ||
             ih.height != t.height || ih.chroma != ChromaFormat::yuv420 || ih.region() || (ih.residual() && !w.pending_refines && !w.pending_predicted))
-          refuse(Status::malformed, "a view's image must be a 4:2:0 image of the frame's size, a residual only on a prediction or its own view");
+          refuse(Status::malformed, "a view's image must be a 4:2:0 image of the views' size, a residual only on a prediction or its own view");
         else
           w.image_open = true;
       }

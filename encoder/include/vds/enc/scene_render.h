@@ -16,6 +16,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 #include "vds/enc/camera_path.h"
@@ -49,6 +50,9 @@ struct SceneFrame {
   std::vector<uint32_t> ids;   // triangle (Scene::indices / 3) seen at each pixel centre, kNoTriangle for none
   std::vector<float> depth;    // its camera-space z (map units), +infinity for none
 };
+
+// The triangles a frame shows, each with the pixels it covers, by triangle.
+std::vector<std::pair<uint32_t, uint32_t>> visible_triangles(const SceneFrame& f);
 
 class SceneRenderer {
  public:
