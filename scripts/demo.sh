@@ -48,7 +48,7 @@ python3 "$ROOT/scripts/demo_model.py" --vds "$VDS" --host-board "$ROOT/$BUILD/fi
 }
 grep -E '^(`|The same stream)' "$OUT/model.md"
 
-echo "demo: 4/7 a walkthrough of oa_dm4 at 2 KB/s (vds path, vds encode-walk) to both boards (about two minutes)"
+echo "demo: 4/7 a walkthrough of oa_dm4 at 2 KB/s (vds path, vds encode-walk) to both boards, each frame at its time (about two minutes)"
 python3 "$ROOT/scripts/demo_walk.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
   --qemu qemu-system-arm --elf "$CM4/vds_fw_client.elf" --out "$OUT/walk" > "$OUT/walk.md" || {
   cat "$OUT/walk.md"

@@ -1,15 +1,19 @@
 #!/usr/bin/env python3
 """The walkthrough part of the demo: a tour through an OpenArena map
-(`vds path`), encoded as a walkthrough at 16 kbit/s (`vds encode-walk`),
-served at 2 KB/s (19,200 baud) over a pseudo-terminal to the client
-firmware on the host-native board, which writes the frames it shows, and
-over TCP to the same firmware on the Cortex-M4 board in QEMU, which counts
-the instructions of every frame. Every frame's CRC on both boards must
-equal the host replay of the client's display path (`vds frames`). Prints
-a markdown section for the demo report.
+(`vds path`), encoded as a walkthrough shaped for the link (`vds
+encode-walk --rate`: 88 % of the line's bytes, the rest left to the
+link's framing and the acknowledgements sharing the line), served at 2
+KB/s (19,200 baud) over a pseudo-terminal to the client firmware on the
+host-native board, which writes the frames it shows, and over TCP to the
+same firmware on the Cortex-M4 board in QEMU, which counts the
+instructions of every frame. Both show frame i the stream's pre-roll
+plus i frame periods after its first byte. Every frame's CRC on both
+boards must equal the host replay of the client's display path (`vds
+frames`). Prints a markdown section for the demo report, with the frames
+each board showed late.
 
 Usage: demo_walk.py --vds VDS --host-board EXE --qemu QEMU --elf CLIENT.elf --out DIR
-       [--map oa_dm4] [--frames 300] [--rate 16] [--baud 19200]"""
+       [--map oa_dm4] [--frames 300] [--rate KBPS] [--baud 19200]"""
 import argparse
 import os
 import re
@@ -36,10 +40,12 @@ def main():
         ap.add_argument(k, required=True)
     ap.add_argument("--map", default="oa_dm4")
     ap.add_argument("--frames", type=int, default=300)
-    ap.add_argument("--rate", type=float, default=16)
+    ap.add_argument("--rate", type=float, default=None)
     ap.add_argument("--baud", type=int, default=19200)
     ap.add_argument("--timeout", type=float, default=600)
     a = ap.parse_args()
+    if a.rate is None:
+        a.rate = round(a.baud / 10 * 0.88 * 8 / 1000, 1)
     os.makedirs(a.out, exist_ok=True)
     tour = os.path.join(a.out, "tour.txt")
     stream = os.path.join(a.out, "walk.vds")
@@ -67,13 +73,20 @@ def main():
     ws = re.search(r"workspace high-water (\d+) bytes", m4.board_log)
     budget = re.search(r"ready, workspace (\d+) bytes", m4.board_log)
     size = re.search(r"(\d+) bytes = ([\d.]+) kbit/s", enc)
+    preroll = re.search(r"pre-roll ([\d.]+) s", enc)
+    late = {}
+    for name, r in (("host-native", host), ("Cortex-M4", m4)):
+        m = re.search(r"client stats\s+(\d+) frames shown, (\d+) late", r.serve.stdout)
+        late[name] = f"{m[2]} of {m[1]}" if m else "unknown"
     psnr = re.search(r"PSNR R,G,B ([\d.]+) dB pooled, ([\d.]+) dB worst", enc)
     print(f"## A walkthrough of {a.map} at {a.baud // 10 / 1000:.1f} KB/s ({a.baud} baud), both boards\n")
     print(f"`vds path {a.map} --frames {a.frames}` and `vds encode-walk --rate {a.rate:g}`: {int(size[1]):,} bytes, "
           f"{size[2]} kbit/s for {len(want)} frames at 20 frames/s; PSNR over R, G, B against the ground truth "
           f"{psnr[1]} dB pooled, {psnr[2]} dB the worst frame. Every frame each board showed is identical to the host "
           f"replay: {'yes' if not failures else 'NO'}. Link time {host.seconds:.1f} s (host-native board) and "
-          f"{m4.seconds:.1f} s (Cortex-M4 board) for {len(want) / 20:.0f} s of video. Frames: "
+          f"{m4.seconds:.1f} s (Cortex-M4 board) for {len(want) / 20:.0f} s of video. Each board shows frame i "
+          f"{preroll[1]} s (the stream's pre-roll) plus i frame periods after the first byte; frames later than a period: "
+          f"{late['host-native']} (host-native board), {late['Cortex-M4']} (Cortex-M4 board). Frames: "
           f"`out/demo/walk/host/frames/`, video `out/demo/walk/host/frames.y4m`, contact sheet "
           f"`out/demo/walk/host/contact_sheet.png`.\n")
     if counts and ws and budget:

@@ -52,6 +52,11 @@ Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out) 
   w.frames_per_record = p[3];
   w.view_width = load_le16(p + 12);
   w.view_height = load_le16(p + 14);
+  w.rate_bytes = load_le32(p + 16);
+  w.buffer_bytes = load_le32(p + 20);
+  w.preroll_ms = load_le32(p + 24);
+  const bool timed = w.rate_bytes != 0;
+  if ((!timed && (w.buffer_bytes != 0 || w.preroll_ms != 0)) || w.preroll_ms > kWalkMaxPrerollMs) return Status::malformed;
   if (w.view_focal_q16 < (kCameraMinFocalPx << 16) || w.view_focal_q16 > (kCameraMaxFocalPx << 16) || w.slots == 0 ||
       w.views == 0 || w.views > kWalkMaxViews || w.frames_per_record == 0 || w.frames_per_record > kWalkMaxFramesPerRecord ||
       !walk_quantum_valid(w.quantum_raw) || w.view_width < 16 ||
@@ -69,6 +74,9 @@ void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]) {
   store_le32(out + 8, static_cast<uint32_t>(w.view_focal_q16));
   store_le16(out + 12, w.view_width);
   store_le16(out + 14, w.view_height);
+  store_le32(out + 16, w.rate_bytes);
+  store_le32(out + 20, w.buffer_bytes);
+  store_le32(out + 24, w.preroll_ms);
 }
 
 Status walk_view_from_bytes(const uint8_t* p, uint32_t size, WalkViewUpdate* out) {

@@ -1,6 +1,8 @@
 // `vds encode-walk SCENE --path PATH --rate KBPS -o OUT.vds`: a walkthrough
 // stream (vds/enc/walk_stream.h), played through the client library as it
 // is made, with what the client shows measured against the ground truth.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -18,7 +20,7 @@ namespace {
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, size = "240x180";
   double rate = 16, threshold = 18, widen = -1, view_scale = -1;
-  int lookahead = -1;
+  int lookahead = -1, preroll = -1;
   bool predict = false;
   int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
 };
@@ -35,6 +37,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.quality = o.quality;
   wo.frames_per_record = o.frames_per_record;
   wo.predict = o.predict;
+  if (o.preroll >= 0) wo.preroll_ms = static_cast<uint32_t>(o.preroll);
   if (o.lookahead >= 0) wo.lookahead = o.lookahead;
   if (o.widen > 0) wo.view_widen = o.widen;
   if (o.view_scale > 0) wo.view_scale = o.view_scale;
@@ -57,10 +60,22 @@ void run_encode_walk(const EncodeWalkOptions& o) {
     y.close();
   }
   const double secs = path.frames.size() / path.fps;
-  std::printf("%s: %zu frames (%.1f s), %zu bytes = %.2f kbit/s (target %.2f): header %zu, views %zu (%zu updates at quality %d, "
-              "%zu of them residuals against the client's prediction, %zu refinements), geometry %zu, frames %zu\n",
+  int qmin = 100, qmax = 0;
+  for (int q : r.view_quality) qmin = std::min(qmin, q), qmax = std::max(qmax, q);
+  if (r.view_quality.empty()) qmin = qmax = 0;
+  std::printf("%s: %zu frames (%.1f s), %zu bytes = %.2f kbit/s (target %.2f): header %zu, views %zu (%zu updates at quality %d to %d, "
+              "mean %d, %zu of them residuals against the client's prediction, %zu refinements), geometry %zu, frames %zu\n",
               o.out.c_str(), path.frames.size(), secs, r.stream.size(), r.kbps, o.rate, r.header_bytes, r.view_bytes,
-              r.view_updates, r.quality, r.view_predicted, r.view_refinements, r.geometry_bytes, r.frame_bytes);
+              r.view_updates, qmin, qmax, r.quality, r.view_predicted, r.view_refinements, r.geometry_bytes, r.frame_bytes);
+  std::printf("  schedule: pre-roll %.3f s at %u bytes/s into a %u-byte window: every frame's data arrives by its time; "
+              "the first frame's data %zu bytes\n",
+              r.preroll_ms / 1000.0, r.rate_bytes, r.buffer_bytes, r.first_frame_bytes);
+  if (r.rate_bytes > std::lround(o.rate * 1000 / 8))
+    std::fprintf(stderr, "encode-walk: warning: %.2f kbit/s cannot bring every frame in time%s; the stream states the least "
+                 "rate that can, %.2f kbit/s, and a client on a slower link shows late frames\n",
+                 o.rate, o.quality >= 0 ? " at this quality" : " even at the lowest quality", r.rate_bytes * 8 / 1000.0);
+  if (r.preroll_ms > (o.preroll >= 0 ? static_cast<uint32_t>(o.preroll) : enc::WalkEncodeOptions{}.preroll_ms))
+    std::fprintf(stderr, "encode-walk: warning: the stream needs a pre-roll of %.3f s, more than asked\n", r.preroll_ms / 1000.0);
   double worst = 99;
   for (double p : r.frame_psnr) worst = std::min(worst, p);
   std::printf("  client: %u triangle slots, %d views, %zu bytes of workspace; PSNR R,G,B %.2f dB pooled, %.2f dB worst frame\n",
@@ -78,7 +93,9 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--rate", o->rate, "Target rate, kbit/s (default 16)")->check(kPositive);
   sub->add_option("--views", o->views, "Views the client holds (default 2)")->check(CLI::Range(1, 8));
   sub->add_option("--threshold", o->threshold, "Largest magnification a view serves (default 18)")->check(kPositive);
-  sub->add_option("--quality", o->quality, "The views' image quality (default: the best that fits the rate)")->check(CLI::Range(0, 100));
+  sub->add_option("--preroll", o->preroll, "Most pre-roll, ms: every frame's data arrives by its time (default 1000)")
+      ->check(CLI::Range(0, static_cast<int>(kWalkMaxPrerollMs)));
+  sub->add_option("--quality", o->quality, "The views' image quality (default: each view's, by the rate control)")->check(CLI::Range(0, 100));
   sub->add_option("--frames-per-record", o->frames_per_record, "Most frames a WFRM record holds (default 8)")
       ->check(CLI::Range(1, static_cast<int>(kWalkMaxFramesPerRecord)));
   sub->add_flag("--predict", o->predict, "View updates may be residuals against the client's prediction of the view");

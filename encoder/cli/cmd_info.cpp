@@ -11,6 +11,7 @@
 #include "vds/bytes.h"
 #include "vds/container.h"
 #include "vds/image.h"
+#include "vds/walk.h"
 #include "vds/jpeg.h"
 #include "vds/enc/mesh_encoder.h"
 #include "vds/enc/scene.h"
@@ -159,6 +160,22 @@ void run_info(const InfoOptions& o) {
       row.note = size >= 6 ? "vds image data: MCUs " + std::to_string(load_le32(payload)) + "+" +
                                  std::to_string(payload[4] | (payload[5] << 8))
                            : "vds image data (malformed)";
+      c->rows.push_back(row);
+      return ChunkResult::consumed;
+    }
+    if (type == chunk::kWalkParams) {
+      WalkParams w;
+      if (walk_params_from_bytes(payload, size, &w) == Status::ok) {
+        row.note = "walkthrough: " + std::to_string(w.slots) + " triangle slots, " + std::to_string(w.views) + " views of " +
+                   std::to_string(w.view_width) + "x" + std::to_string(w.view_height) + ", records of up to " +
+                   std::to_string(w.frames_per_record) + " frames; ";
+        row.note += w.rate_bytes == 0 ? std::string("untimed")
+                                      : "shaped for " + std::to_string(w.rate_bytes) + " bytes/s into a " +
+                                            std::to_string(w.buffer_bytes) + "-byte window, pre-roll " +
+                                            std::to_string(w.preroll_ms) + " ms";
+      } else {
+        row.note = "walkthrough parameters (malformed)";
+      }
       c->rows.push_back(row);
       return ChunkResult::consumed;
     }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <stdexcept>
 
 #include "vds/enc/arith_encoder.h"
@@ -11,6 +12,7 @@
 #include "vds/enc/image_codec.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/enc/walk_geometry.h"
+#include "vds/enc/walk_schedule.h"
 #include "vds/enc/walk_views.h"
 #include "vds/player.h"
 
@@ -218,22 +220,33 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   wp.view_height = static_cast<uint16_t>(view_h);
   h.workspace_bytes = static_cast<uint32_t>(Player::walk_workspace_bytes(h, wp, kClientPlayerConfig));
   h.max_triangles = slots;
+  // The view updates, numbered in stream order; each has its own quality.
+  std::vector<std::vector<size_t>> update_of(n);
+  std::vector<uint32_t> update_camera;
+  for (size_t f = 0; f < n; ++f)
+    for (const auto& u : vp.updates[f]) {
+      update_of[f].push_back(update_camera.size());
+      update_camera.push_back(u.camera_frame);
+    }
   // Refinements: a view that serves at least 2 * refine_after frames gets,
   // refine_after frames after it arrives, a residual image at a higher
   // quality against what the client holds of it.
   struct Refine {
     uint32_t slot, camera_frame;
+    size_t update;  // the update it refines
   };
   std::vector<std::vector<Refine>> refines(n);
   if (o.refine_delta > 0) {
     for (size_t f = 0; f < n; ++f)
-      for (const auto& u : vp.updates[f]) {
+      for (size_t k = 0; k < vp.updates[f].size(); ++k) {
+        const auto& u = vp.updates[f][k];
         size_t next = n;
         for (size_t g = f + 1; g < n && next == n; ++g)
           for (const auto& v : vp.updates[g])
             if (v.slot == u.slot) next = g;
         const size_t at = f + static_cast<size_t>(o.refine_after);
-        if (next - f >= 2 * static_cast<size_t>(o.refine_after) && at < n) refines[at].push_back({u.slot, u.camera_frame});
+        if (next - f >= 2 * static_cast<size_t>(o.refine_after) && at < n)
+          refines[at].push_back({u.slot, u.camera_frame, update_of[f][k]});
       }
   }
   // Records: a frame with view updates or refinements starts one (they
@@ -283,30 +296,77 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     }
     wfrm[r] = e.finish();
   }
-  // 5. The stream at a quality; the best that fits the rate.
-  const auto build = [&](int quality, WalkEncodeResult* res) {
-    ImageEncodeOptions io;
-    io.quality = quality;
-    io.max_chunk_payload = 4096;
-    std::map<uint32_t, EncodedImage> coded;
-    for (const auto& [g, pl] : view_planes) coded[g] = encode_planes(pl, io);
-    StreamHeader hh = h;
-    hh.max_chunk_payload = 4096;
-    for (const auto& [g, e] : coded) hh.max_chunk_payload = std::max(hh.max_chunk_payload, e.max_payload());
-    for (const auto& rec : wfrm) hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(rec.size()));
+  // 5. The views' qualities under the rate control, then the stream.
+  // Each view's intra image at a quality, coded once.
+  std::map<std::pair<uint32_t, int>, EncodedImage> coded;
+  const auto intra = [&](uint32_t g, int q) -> const EncodedImage& {
+    auto it = coded.find({g, q});
+    if (it == coded.end()) {
+      ImageEncodeOptions io;
+      io.quality = q;
+      io.max_chunk_payload = 4096;
+      it = coded.emplace(std::make_pair(g, q), encode_planes(view_planes.at(g), io)).first;
+    }
+    return it->second;
+  };
+  StreamHeader hh = h;
+  hh.max_chunk_payload = 4096;
+  for (const auto& rec : wfrm) hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(rec.size()));
+  constexpr size_t kFraming = kChunkHeadBytes + kChunkTailBytes;
+  size_t header_bytes = 0;
+  {
+    StreamWriter w(hh);
+    uint8_t params[kWalkParamsBytes] = {};
+    w.add_chunk(chunk::kWalkParams, params);
+    header_bytes = w.size();
+  }
+  const auto link_latency = [&](double rate) {
+    if (!o.link_framing) return 0.0;
+    const uint16_t payload = link::line_frame_payload(static_cast<uint32_t>(rate), link::host_config(0).max_tx_payload);
+    return link::frame_wire_bound(payload) / rate;
+  };
+  WalkLink lk;
+  lk.rate_bytes = o.rate_kbps * 1000 / 8;
+  lk.buffer_bytes = o.buffer_bytes;
+  lk.frame_period_s = 1 / path.fps;
+  lk.latency_s = link_latency(lk.rate_bytes);
+  if (!(lk.rate_bytes >= 1 && lk.rate_bytes < 4e9)) throw std::invalid_argument("encode_walk: a rate of 8 bit/s up to 32 Gbit/s");
+  wp.rate_bytes = static_cast<uint32_t>(std::lround(lk.rate_bytes));
+  wp.buffer_bytes = static_cast<uint32_t>(std::min<size_t>(o.buffer_bytes, UINT32_MAX));
+  // The stream as the client takes it, with the views at qualities `q`
+  // (refinements and predicted updates counted as their intra image).
+  const auto pieces_at = [&](const std::vector<int>& q) {
+    std::vector<WalkPiece> p{{header_bytes, 0, 0, false}};
+    for (size_t r = 0; r < record_start.size(); ++r) {
+      const uint32_t f = static_cast<uint32_t>(record_start[r]);
+      const uint32_t last = static_cast<uint32_t>((r + 1 < record_start.size() ? record_start[r + 1] : n) - 1);
+      for (size_t u : update_of[f]) p.push_back({kFraming + kWalkViewBytes + intra(update_camera[u], q[u]).coded_bytes(), f, f, false});
+      for (const Refine& rf : refines[f])
+        p.push_back({kFraming + kWalkViewBytes + intra(rf.camera_frame, std::min(100, q[rf.update] + o.refine_delta)).coded_bytes(), f, f, false});
+      p.push_back({kFraming + wfrm[r].size(), f, last, true});
+    }
+    return p;
+  };
+  // The stream with the views at qualities `q`, its stated pre-roll
+  // `preroll_ms`; the pieces as written.
+  std::vector<WalkPiece> written;
+  const auto build = [&](const std::vector<int>& q, uint32_t preroll_ms, WalkEncodeResult* res) {
     StreamWriter w(hh);
     MirrorClient client(h.workspace_bytes);
+    WalkParams wpp = wp;
+    wpp.preroll_ms = preroll_ms;
     uint8_t params[kWalkParamsBytes];
-    walk_params_to_bytes(wp, params);
+    walk_params_to_bytes(wpp, params);
     w.add_chunk(chunk::kWalkParams, params);
     client.feed(w);
     res->header_bytes = w.size();
+    written.assign(1, WalkPiece{w.size(), 0, 0, false});
     res->view_bytes = res->geometry_bytes = res->frame_bytes = 0;
     res->view_updates = res->view_refinements = res->view_predicted = 0;
     // A view into a slot: WVUP with its camera's pose, then its image:
     // intra, or a residual against what the client then holds (its
-    // prediction of the view, whichever is smaller; a refinement's base).
-    const auto put_view = [&](uint32_t slot, uint32_t camera_frame, bool refine) {
+    // prediction of the view, whichever is better; a refinement's base).
+    const auto put_view = [&](uint32_t slot, uint32_t camera_frame, int quality, bool refine) {
       const size_t before = w.size();
       uint8_t vb[kWalkViewBytes];
       WalkViewUpdate u;
@@ -316,14 +376,15 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       walk_view_to_bytes(u, vb);
       w.add_chunk(chunk::kWalkView, vb);
       client.feed(w);
-      const EncodedImage* image = &coded.at(camera_frame);
+      const EncodedImage* image = &intra(camera_frame, quality);
       EncodedImage residual;
       if (refine || client.predicted()) {
         const Planes base = client.slot(static_cast<uint8_t>(slot));
-        ImageEncodeOptions ro = io;
+        ImageEncodeOptions ro;
+        ro.max_chunk_payload = 4096;
         ro.mode = ImageMode::residual;
         ro.prediction = &base;
-        if (refine) ro.quality = std::min(100, quality + o.refine_delta);
+        ro.quality = refine ? std::min(100, quality + o.refine_delta) : quality;
         residual = encode_planes(view_planes.at(camera_frame), ro);
         // Rate and distortion together: about 3.5 dB a doubling of bytes
         // is where these images' curves run.
@@ -336,46 +397,117 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       add_image_chunks(w, *image);
       client.feed(w);
       res->view_bytes += w.size() - before;
+      return w.size() - before;
     };
     for (size_t r = 0; r < record_start.size(); ++r) {
-      const size_t f = record_start[r];
-      for (const auto& u : vp.updates[f]) {
-        put_view(u.slot, u.camera_frame, false);
+      const uint32_t f = static_cast<uint32_t>(record_start[r]);
+      const uint32_t last = static_cast<uint32_t>((r + 1 < record_start.size() ? record_start[r + 1] : n) - 1);
+      for (size_t k = 0; k < vp.updates[f].size(); ++k) {
+        const size_t u = update_of[f][k];
+        written.push_back({put_view(vp.updates[f][k].slot, update_camera[u], q[u], false), f, f, false});
         ++res->view_updates;
       }
       for (const Refine& rf : refines[f]) {
-        put_view(rf.slot, rf.camera_frame, true);
+        written.push_back({put_view(rf.slot, rf.camera_frame, q[rf.update], true), f, f, false});
         ++res->view_refinements;
       }
       const size_t before = w.size();
       w.add_chunk(chunk::kWalkFrame, wfrm[r]);
       client.feed(w);
+      written.push_back({w.size() - before, f, last, true});
       // The record's geometry and the rest (its poses, views and the chunk's framing).
       res->geometry_bytes += std::min(geometry_part[r], wfrm[r].size());
       res->frame_bytes += w.size() - before - std::min(geometry_part[r], wfrm[r].size());
     }
     res->stream = w.finish();
-    res->quality = quality;
     res->slots = slots;
     res->workspace_bytes = h.workspace_bytes;
     res->kbps = res->stream.size() * 8.0 / (n / path.fps) / 1000;
+    res->preroll_ms = preroll_ms;
   };
-  WalkEncodeResult r;
-  if (o.quality >= 0) {
-    build(o.quality, &r);
-  } else {
-    // Bisection on the quality (sizes rise with it).
-    int lo = 0, hi = 100;
-    build(lo, &r);
-    WalkEncodeResult best = r;
+  const size_t updates = update_camera.size();
+  const auto preroll_of = [&](const std::vector<WalkPiece>& p) { return walk_preroll_ms(p, lk, kWalkMaxPrerollMs); };
+  std::vector<int> q(updates, std::max(0, o.quality));
+  // The link the stream is shaped for: the rate asked for, unless even the
+  // lowest quality (or the one asked for) cannot bring every frame in time
+  // at it with any pre-roll (the window bounds what a pre-roll can hold
+  // back): then the least rate that can, with the pre-roll asked for.
+  if (preroll_of(pieces_at(q)) == UINT32_MAX) {
+    const double asked = lk.rate_bytes;
+    const auto carries = [&](double rate) {
+      lk.rate_bytes = rate;
+      lk.latency_s = link_latency(rate);
+      return preroll_of(pieces_at(q)) <= o.preroll_ms;
+    };
+    double lo = asked, hi = asked;
+    do {
+      lo = hi;
+      hi *= 2;
+      if (hi > 1024 * asked) throw std::runtime_error("encode_walk: no link up to 1024 times the rate carries the stream");
+    } while (!carries(hi));
+    while (hi - lo > 1) {
+      const double mid = std::floor((lo + hi) / 2);
+      (carries(mid) ? hi : lo) = mid;
+    }
+    lk.rate_bytes = std::ceil(hi);
+    lk.latency_s = link_latency(lk.rate_bytes);
+    wp.rate_bytes = static_cast<uint32_t>(lk.rate_bytes);
+  }
+  // A target even the lowest quality cannot meet becomes the least pre-roll there is.
+  uint32_t target = o.preroll_ms;
+  if (o.quality < 0 && updates > 0) target = std::max(target, preroll_of(pieces_at(q)));
+  if (o.quality < 0 && updates > 0) {
+    // The best quality for every view with which the pre-roll is within
+    // the target (bisection: bytes rise with quality) ...
+    const auto fits = [&](const std::vector<int>& qq) { return preroll_of(pieces_at(qq)) <= target; };
+    int lo = -1, hi = 101;
     while (hi - lo > 1) {
       const int mid = (lo + hi) / 2;
-      build(mid, &r);
+      (fits(std::vector<int>(updates, mid)) ? lo : hi) = mid;
       progress("rate control", static_cast<size_t>(7 - std::log2(hi - lo)), 7);
-      if (r.kbps <= o.rate_kbps) lo = mid, best = r;
-      else hi = mid;
     }
-    r = std::move(best);
+    std::fill(q.begin(), q.end(), std::max(lo, 0));
+    // ... then each view in turn a step higher while the pre-roll stays
+    // within it: the views where the link has room rise.
+    {
+      constexpr int kStep = 2;
+      for (bool rose = true; rose;) {
+        rose = false;
+        for (size_t u = 0; u < updates; ++u) {
+          if (q[u] + kStep > 100) continue;
+          q[u] += kStep;
+          if (fits(q)) rose = true;
+          else q[u] -= kStep;
+        }
+        progress("rate control: the views' mean quality", static_cast<size_t>(std::accumulate(q.begin(), q.end(), 0) / updates), 100);
+      }
+    }
+  }
+  // The stream, stating the pre-roll it needs as written (the model's
+  // figure unless residuals changed the sizes).
+  WalkEncodeResult r;
+  uint32_t stated = preroll_of(pieces_at(q));
+  for (int attempt = 0;; ++attempt) {
+    if (stated == UINT32_MAX)
+      throw std::runtime_error("encode_walk: at " + std::to_string(o.rate_kbps) + " kbit/s the stream would need more than " +
+                               std::to_string(kWalkMaxPrerollMs / 1000) + " s of pre-roll");
+    build(q, stated, &r);
+    const uint32_t need = preroll_of(written);
+    if (need == stated) break;
+    if (attempt >= 8) throw std::logic_error("encode_walk: the pre-roll does not settle");
+    // Over the target: every view a step lower (rate control only).
+    if (need > target && o.quality < 0)
+      for (int& v : q) v = std::max(0, v - 2);
+    stated = need > target && o.quality < 0 ? preroll_of(pieces_at(q)) : need;
+  }
+  r.view_quality = q;
+  r.quality = updates > 0 ? static_cast<int>(std::lround(std::accumulate(q.begin(), q.end(), 0.0) / updates)) : q.empty() ? 0 : q[0];
+  r.rate_bytes = wp.rate_bytes;
+  r.buffer_bytes = wp.buffer_bytes;
+  r.pieces = written;
+  for (const WalkPiece& p : written) {
+    r.first_frame_bytes += p.bytes;
+    if (p.record) break;
   }
   // 6. What the client shows, against the ground truth.
   std::vector<io::Image> shown;

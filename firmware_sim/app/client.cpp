@@ -54,6 +54,7 @@ struct Client {
   // Frames shown.
   uint32_t late_frames = 0;
   uint32_t first_frame_ms = 0;
+  uint32_t first_byte_ms = 0;  // when the stream's first byte was taken (a timed stream's clock starts)
 
   // Upward messages.
   link::FrameRecord pending[kPendingRecords];
@@ -90,9 +91,13 @@ void frame_shown(void*, const vds::PlayedFrame& f) {
   const uint32_t now = board::millis();
   const vds::StreamHeader& h = g.player.header();
   if (f.index == 0) g.first_frame_ms = now;
-  // Frame i is due one period after frame i-1, counted from the first one.
+  // A timed stream's frame i is due when its schedule says, counted from
+  // the first byte; any other's one period after frame i-1, counted from
+  // the first frame. Late: shown more than a period after that.
   bool late = false;
-  if (h.frame_period_us != 0) {
+  if (g.player.timed()) {
+    late = now - g.first_byte_ms > g.player.due_ms(f.index) + h.frame_period_us / 1000;
+  } else if (h.frame_period_us != 0) {
     const uint64_t due_ms = g.first_frame_ms + (static_cast<uint64_t>(f.index) * h.frame_period_us) / 1000;
     late = now > due_ms + h.frame_period_us / 1000;
   }
@@ -109,6 +114,21 @@ void frame_shown(void*, const vds::PlayedFrame& f) {
     rec.received_ms = now;
     rec.late = late ? 1 : 0;
     ++g.pending_count;
+  }
+}
+
+void send_messages(uint32_t now);
+
+// A timed stream's frame waits for its time: the link is served and the
+// frame records go up meanwhile; the stream bytes stay in the link's window.
+void wait_until(void*, uint64_t due_ms) {
+  for (;;) {
+    const uint32_t now = board::millis();
+    const uint32_t since = now - g.first_byte_ms;
+    if (since >= due_ms) return;
+    service_link(nullptr);
+    send_messages(now);
+    board::wait_for_event(static_cast<uint32_t>(due_ms - since));
   }
 }
 
@@ -157,6 +177,7 @@ Status start_stream() {
   };
   cb.frame_shown = frame_shown;
   cb.service = service_link;
+  cb.wait_until = wait_until;
   if (board::instruction_resolution() != 0) cb.clock = [](void*) { return board::instructions(); };
   cb.notice = notice;
   return g.player.init(g.arena, vds::kClientPlayerConfig, cb);
@@ -178,6 +199,7 @@ void feed_stream() {
     if (limit < want) want = limit;
     size_t got = 0;
     if (g.link.read(link::channel::kStream, buf, want, &got) != Status::ok || got == 0) return;
+    if (g.stream_bytes == 0) g.first_byte_ms = board::millis();
     g.stream_bytes += static_cast<uint32_t>(got);
     g.stream_crc = vds::crc32c_update(g.stream_crc, buf, got);
     const Status s = g.player.feed(buf, got);

@@ -150,6 +150,125 @@ TEST(WalkStream, PredictedViewUpdatesAreResidualsTheClientAddsToItsPrediction) {
   EXPECT_THROW(vds::enc::client_frame_crcs(bad), std::runtime_error);
 }
 
+// A client in simulated time, as the firmware plays a timed stream: the
+// link carries `rate` bytes a second while the client's window has room
+// (`window` bytes arrived and not yet taken); the client takes what has
+// arrived in pieces of up to 256 bytes and holds each frame until it is
+// due. Counts the frames whose data came after their time.
+struct TimedClient {
+  const std::vector<uint8_t>* stream = nullptr;
+  double rate = 0, window = 0, preroll = 0, period = 0;
+  double t = 0, link_t = 0;  // the client's time; when the link delivered its last byte
+  size_t arrived = 0, taken = 0;
+  uint32_t frame = 0, late = 0;
+  double worst = -1e9;  // the latest a frame's data came, after its time (s)
+
+  void advance_to(double when) {
+    while (arrived < stream->size()) {
+      if (arrived >= taken + static_cast<size_t>(window)) {
+        link_t = std::max(link_t, when);  // the link idles while the window is full
+        return;
+      }
+      if (link_t + 1 / rate > when) return;
+      link_t += 1 / rate;
+      ++arrived;
+    }
+  }
+  static void wait_until(void* ctx, uint64_t) {
+    auto& c = *static_cast<TimedClient*>(ctx);
+    // The time from the simulation's own pre-roll, not the stream's.
+    const double due = 1 / c.rate + c.preroll + c.frame++ * c.period;
+    c.worst = std::max(c.worst, c.t - due);
+    if (c.t > due + 1e-9) ++c.late;
+    if (c.t < due) {
+      c.t = due;
+      c.advance_to(due);
+    }
+  }
+  vds::Status play(vds::Player& player) {
+    vds::Status s = vds::Status::more_input;
+    while (s == vds::Status::more_input && taken < stream->size()) {
+      if (arrived == taken) {
+        t = std::max(t, link_t + 1 / rate);
+        advance_to(t);
+      }
+      const size_t n = std::min<size_t>(256, arrived - taken);
+      taken += n;
+      s = player.feed(stream->data() + taken - n, n);
+    }
+    return s;
+  }
+};
+
+uint32_t late_frames(const std::vector<uint8_t>& stream, double rate, double window, double preroll, uint32_t* frames = nullptr,
+                     uint32_t* stated_ms = nullptr) {
+  std::vector<uint8_t> ws(1u << 22);
+  vds::Arena arena(ws.data(), ws.size());
+  vds::PlayerConfig cfg = vds::kClientPlayerConfig;
+  cfg.max_chunk_bytes = 1u << 16;
+  TimedClient c;
+  c.stream = &stream;
+  c.rate = rate;
+  c.window = window;
+  c.preroll = preroll;
+  vds::PlayerCallbacks cb;
+  cb.ctx = &c;
+  cb.wait_until = TimedClient::wait_until;
+  vds::Player player;
+  EXPECT_EQ(player.init(arena, cfg, cb), vds::Status::ok);
+  c.period = 0;
+  // The period is the header's; known once HEAD is in.
+  EXPECT_EQ(player.feed(stream.data(), 0), vds::Status::more_input);
+  c.period = 0.05;
+  EXPECT_EQ(c.play(player), vds::Status::ok);
+  EXPECT_TRUE(player.timed());
+  if (frames != nullptr) *frames = player.frames_shown();
+  if (stated_ms != nullptr) *stated_ms = player.preroll_ms();
+  return c.late;
+}
+
+TEST(WalkStream, RateControlBringsEveryFrameInTimeWithTheStatedPreroll) {
+  // The rate control shapes the stream for a link and a client window, and
+  // states its pre-roll (WLKP): a client that waits that long after the
+  // first byte and then shows a frame every period has every frame's data
+  // in time, its window never over-full. A slower link, or views coded at
+  // one high quality with the same pre-roll, bring frames late.
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
+  ASSERT_DOUBLE_EQ(path.fps, 20);
+  vds::enc::WalkEncodeOptions o;
+  o.rate_kbps = 12;
+  o.preroll_ms = 400;
+  o.buffer_bytes = 1024;
+  o.link_framing = false;  // the simulated link delivers byte by byte
+  const double rate = 1500;
+  const auto r = vds::enc::encode_walk(room, path, o);
+  EXPECT_LE(r.preroll_ms, 400u);
+  EXPECT_EQ(r.rate_bytes, 1500u);
+  EXPECT_EQ(r.buffer_bytes, 1024u);
+  uint32_t frames = 0, stated = 0;
+  EXPECT_EQ(late_frames(r.stream, rate, 1024, r.preroll_ms / 1000.0, &frames, &stated), 0u);
+  EXPECT_EQ(frames, 60u);
+  EXPECT_EQ(stated, r.preroll_ms);
+  // Views of different qualities: where the link is busy, lower.
+  const auto [lo, hi] = std::minmax_element(r.view_quality.begin(), r.view_quality.end());
+  ASSERT_EQ(r.view_quality.size(), r.view_updates);
+  EXPECT_LT(*lo, *hi);
+  EXPECT_GT(late_frames(r.stream, 0.8 * rate, 1024, r.preroll_ms / 1000.0), 0u);
+  // Views at one high quality do not fit the link with any pre-roll (the
+  // window bounds what a pre-roll holds back): the stream states the least
+  // rate that carries it, and plays in time at that rate, not at the one asked.
+  o.quality = 90;
+  const auto fixed = vds::enc::encode_walk(room, path, o);
+  EXPECT_GT(fixed.rate_bytes, 1500u);
+  EXPECT_LE(fixed.preroll_ms, 400u);
+  EXPECT_GT(late_frames(fixed.stream, rate, 1024, 0.4), 0u);
+  EXPECT_EQ(late_frames(fixed.stream, fixed.rate_bytes, 1024, fixed.preroll_ms / 1000.0), 0u);
+  EXPECT_GT(late_frames(fixed.stream, 0.9 * fixed.rate_bytes, 1024, fixed.preroll_ms / 1000.0), 0u);
+  std::printf("room, 60 frames at 12 kbit/s: pre-roll %u ms (views at quality %d to %d, PSNR %.2f dB); at quality 90 %u bytes/s, "
+              "pre-roll %u ms\n", r.preroll_ms, *lo, *hi, r.psnr_rgb, fixed.rate_bytes, fixed.preroll_ms);
+}
+
 TEST(WalkStream, DamagedStreamsAreRefusedNotCrashed) {
   const vds::enc::Scene room = vds::test::walk_room();
   vds::enc::WalkEncodeOptions o;
@@ -181,7 +300,7 @@ TEST(WalkStream, RecordsRoundTripAndRefuseBadFields) {
   EXPECT_NEAR(q.yaw_deg, p.yaw_deg, 360.0 / 65536);
   EXPECT_NEAR(q.pitch_deg, p.pitch_deg, 360.0 / 65536);
   uint8_t b[vds::kWalkParamsBytes];
-  vds::WalkParams w{300, 2, 5, 8192, 80 << 16, 160, 120};
+  vds::WalkParams w{300, 2, 5, 8192, 80 << 16, 160, 120, 2000, 4096, 1500};
   vds::walk_params_to_bytes(w, b);
   vds::WalkParams back;
   ASSERT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::ok);
@@ -192,6 +311,15 @@ TEST(WalkStream, RecordsRoundTripAndRefuseBadFields) {
   EXPECT_EQ(back.frames_per_record, 5);
   EXPECT_EQ(back.view_width, 160);
   EXPECT_EQ(back.view_height, 120);
+  EXPECT_EQ(back.rate_bytes, 2000u);
+  EXPECT_EQ(back.buffer_bytes, 4096u);
+  EXPECT_EQ(back.preroll_ms, 1500u);
+  vds::store_le32(b + 24, vds::kWalkMaxPrerollMs + 1);  // a pre-roll of more than ten minutes
+  EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
+  vds::store_le32(b + 24, 1500);
+  vds::store_le32(b + 16, 0);  // no rate, but a pre-roll
+  EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
+  vds::store_le32(b + 16, 2000);
   b[3] = 0;  // records of no frames
   EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
   b[3] = vds::kWalkMaxFramesPerRecord + 1;

@@ -118,6 +118,11 @@ struct PlayerCallbacks {
   void (*frame_shown)(void* ctx, const PlayedFrame& frame) = nullptr;
   void (*service)(void* ctx) = nullptr;
   uint64_t (*clock)(void* ctx) = nullptr;
+  // A timed stream (Player::timed()): called before each frame is drawn
+  // with the time it is due, in milliseconds after the stream's first byte;
+  // the client returns at that time (serving its link meanwhile) or at
+  // once if it is past. Its time is not counted in the frame's stages.
+  void (*wait_until)(void* ctx, uint64_t due_ms) = nullptr;
   void (*notice)(void* ctx, PlayerNotice what, uint32_t a, uint32_t b, uint32_t c) = nullptr;
   bool (*send_up)(void* ctx, uint8_t kind, const uint8_t* data, size_t n) = nullptr;
   void (*level)(void* ctx, const PlayedLevel& level) = nullptr;
@@ -190,6 +195,13 @@ class Player {
   const PlayerPlan& plan() const { return plan_; }
   bool workspace_full() const { return full_; }
   uint32_t frames_shown() const { return frames_; }
+  // Whether the stream states a schedule (a walkthrough's WLKP): frame i is
+  // due preroll_ms() + i frame periods after its first byte.
+  bool timed() const { return timed_; }
+  uint32_t preroll_ms() const { return preroll_ms_; }
+  uint64_t due_ms(uint32_t frame) const {
+    return preroll_ms_ + static_cast<uint64_t>(frame) * parser_.header().frame_period_us / 1000;
+  }
   uint64_t error_offset() const { return parser_.error_offset(); }
   const char* error_detail() const { return error_detail_ != nullptr ? error_detail_ : parser_.error_detail(); }
   uint32_t chunks() const { return parser_.chunks(); }
@@ -219,6 +231,10 @@ class Player {
   uint64_t parse_total() const { return parse_total_; }
   void set_full() { full_ = true; }
   void set_plan(const PlayerPlan& p) { plan_ = p; }
+  void set_schedule(uint32_t preroll_ms) {
+    timed_ = true;
+    preroll_ms_ = preroll_ms;
+  }
   // A mode's own failure: feed() returns `s` (not the parser's "aborted").
   void fail(Status s, const char* detail) {
     mode_status_ = s;
@@ -265,6 +281,8 @@ class Player {
   PlayedFrame at_start_{};  // the totals a frame's counts start from
   uint32_t frame_crc_ = 0;
   uint32_t frames_ = 0;
+  bool timed_ = false;
+  uint32_t preroll_ms_ = 0;
 };
 
 }  // namespace vds

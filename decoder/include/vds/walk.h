@@ -59,8 +59,17 @@ struct WalkParams {
   int32_t quantum_raw = 0;
   int32_t view_focal_q16 = 0;
   uint16_t view_width = 0, view_height = 0;
+  // The schedule the stream was shaped for (0, 0, 0: none; the client
+  // shows each frame when its data is whole): a link carrying rate_bytes
+  // stream bytes a second into a client holding up to buffer_bytes it has
+  // not yet taken shows frame i at preroll_ms + i frame periods after the
+  // stream's first byte, every frame's data there in time.
+  uint32_t rate_bytes = 0;
+  uint32_t buffer_bytes = 0;
+  uint32_t preroll_ms = 0;
 };
-constexpr uint32_t kWalkParamsBytes = 16;
+constexpr uint32_t kWalkParamsBytes = 28;
+constexpr uint32_t kWalkMaxPrerollMs = 600000;  // ten minutes
 // The camera of a view: walk_camera with the views' focal length and
 // their centre as the principal point.
 Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPose& pose, Camera* out);

@@ -113,6 +113,7 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   if (wp == nullptr) return false;
   *wp = WalkPlay{};
   wp->params = w;
+  if (w.rate_bytes != 0 && h.frame_period_us != 0) p.set_schedule(w.preroll_ms);
   Status s = p.walk_geometry.init(p.arena(), w.slots, w.quantum_raw);
   if (s == Status::ok) s = p.image.init(p.arena());
   if (s == Status::ok) s = wp->renderer.init(render_config(h, w, p.config()), p.arena());

@@ -50,6 +50,8 @@ Status Player::init(Arena& arena, const PlayerConfig& config, const PlayerCallba
   at_start_ = PlayedFrame{};
   frame_crc_ = 0;
   frames_ = 0;
+  timed_ = false;
+  preroll_ms_ = 0;
   band_buffer = nullptr;
   image_ready = image_open = jpeg_ready = jpeg_open = jpeg_begun = false;
   level_mark = 0;
@@ -109,6 +111,11 @@ void Player::restart_counts(uint64_t parse_from) {
 
 bool Player::begin_frame() {
   frame_crc_ = 0;
+  if (timed_ && cb_.wait_until != nullptr) {
+    const uint64_t w0 = cb_.clock != nullptr ? cb_.clock(cb_.ctx) : 0;
+    cb_.wait_until(cb_.ctx, due_ms(frames_));
+    if (cb_.clock != nullptr) service_total_ += cb_.clock(cb_.ctx) - w0;
+  }
   const uint64_t t0 = work_clock();
   const bool go = cb_.begin_frame == nullptr || cb_.begin_frame(cb_.ctx, parser_.header().width, parser_.header().height);
   display_total_ += work_clock() - t0;

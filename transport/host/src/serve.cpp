@@ -174,7 +174,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     FaultConfig up = o.faults;
     up.seed = o.faults.seed + 0x5EED;
     const uint16_t line = o.drain.ring_bytes != 0 ? static_cast<uint16_t>(o.drain.ring_bytes) : 4096;
-    LinkSim sim(o.baud, o.faults, up, host_config(seed), device_config(seed + 1, line), 1, o.drain);
+    LinkSim sim(o.baud, o.faults, up, host_config(seed, o.baud / 10), device_config(seed + 1, line), 1, o.drain);
     rep.simulated = true;
     // Simulated time is free; still bound it so a broken link cannot spin forever.
     const uint64_t rate = o.drain.ring_bytes != 0 && o.drain.rate_permille != 0 ? o.drain.rate_permille : 1000;
@@ -204,7 +204,7 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
   } else {
     std::unique_ptr<Backend> b = open_backend(o.link, o.baud, o.paced);
     if (log) log("link " + b->describe() + " open; waiting for the client");
-    const LinkConfig hc = host_config(seed);
+    const LinkConfig hc = host_config(seed, o.paced && o.link.rfind("usb:", 0) != 0 ? o.baud / 10 : 0);
     std::vector<uint64_t> ws((link_workspace_size(hc) + 7) / 8);
     Arena arena(ws.data(), ws.size() * 8);
     Link host;

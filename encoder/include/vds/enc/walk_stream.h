@@ -18,6 +18,9 @@
 #include "vds/enc/camera_path.h"
 #include "vds/enc/scene.h"
 #include "vds/enc/scene_render.h"
+#include "vds/enc/walk_schedule.h"
+#include "vds/link/frame.h"
+#include "vds/link/link.h"
 #include "vds/walk.h"
 
 namespace vds::enc {
@@ -38,7 +41,16 @@ struct WalkEncodeOptions {
   // distortion); measured not to pay on the figure maps (docs/walkthrough.md).
   bool predict = false;
   double tolerance = 0.005;  // share of a frame's pixels that may go without a view within the threshold
-  int quality = -1;       // the views' image quality; -1: the best that fits the rate
+  int quality = -1;       // the views' image quality; -1: each view's by the rate control
+  // The rate control: the stream is shaped for a link of rate_kbps into a
+  // client whose stream window holds buffer_bytes, every frame's data there
+  // by its time with a pre-roll of at most preroll_ms (docs/walkthrough.md).
+  uint32_t preroll_ms = 1000;
+  size_t buffer_bytes = link::device_config(0).channels[link::channel::kStream].rx_bytes;  // the client firmware's
+  // A byte reaches the client when the link frame carrying it is whole: up
+  // to a frame's time on a line of the stream's rate later (the frames the
+  // host sends on such a line: link::line_frame_payload). false: byte by byte.
+  bool link_framing = true;
   int width = 240, height = 180;
   int threads = 0;
   std::function<void(const std::string& stage, size_t done, size_t total)> progress;
@@ -46,7 +58,12 @@ struct WalkEncodeOptions {
 
 struct WalkEncodeResult {
   std::vector<uint8_t> stream;
-  int quality = 0;
+  int quality = 0;                // the views' mean quality
+  std::vector<int> view_quality;  // each view update's, in stream order
+  uint32_t preroll_ms = 0;        // the pre-roll the stream states (WLKP)
+  uint32_t rate_bytes = 0, buffer_bytes = 0;
+  size_t first_frame_bytes = 0;   // the stream up to the first frame record (header, first views, first geometry)
+  std::vector<WalkPiece> pieces;  // the stream as the client takes it (vds/enc/walk_schedule.h)
   size_t view_updates = 0, view_refinements = 0;
   size_t view_predicted = 0;  // view updates coded as a residual against the client's prediction
   // Bytes by part: header (HEAD, WLKP), views (WVUP and the images), the

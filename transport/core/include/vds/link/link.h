@@ -54,6 +54,17 @@ constexpr uint16_t kFirstFramePayload = 128;
 // frame may carry (the 16-bit window arithmetic needs far less than 32 KiB).
 constexpr uint16_t kMinFramePayload = 8;
 constexpr uint16_t kMaxFramePayload = 4096;
+// The largest data frame payload a sender uses on a line carrying
+// `line_bytes_per_s` (0: unknown): a frame holds the line for at most
+// kMaxFrameLineMs, so the acknowledgements and messages sharing its
+// direction wait no longer, and a byte reaches the receiver no later, than
+// that after the line carried it. Never below 64 bytes nor above `cap`.
+constexpr uint32_t kMaxFrameLineMs = 100;
+constexpr uint16_t line_frame_payload(uint32_t line_bytes_per_s, uint16_t cap) {
+  if (line_bytes_per_s == 0) return cap;
+  const uint64_t p = static_cast<uint64_t>(line_bytes_per_s) * kMaxFrameLineMs / 1000;
+  return p < 64 ? (cap < 64 ? cap : 64) : p < cap ? static_cast<uint16_t>(p) : cap;
+}
 
 // HELLO capability bits (informative in version 1.0: every 1.0 endpoint has all).
 constexpr uint8_t kCapSelectiveAck = 0x01;
@@ -234,14 +245,15 @@ constexpr LinkConfig device_config(uint32_t nonce_seed, uint16_t line_bytes = 40
   return c;
 }
 
-// The host's configuration matching device_config.
-constexpr LinkConfig host_config(uint32_t nonce_seed) {
+// The host's configuration matching device_config, for a line carrying
+// `line_bytes_per_s` (0: unknown; line_frame_payload).
+constexpr LinkConfig host_config(uint32_t nonce_seed, uint32_t line_bytes_per_s = 0) {
   LinkConfig c{};
   c.role = Role::host;
   c.nonce_seed = nonce_seed;
   c.keepalive_ms = 2000;  // its acks share the line with the stream
   c.max_rx_payload = 256;
-  c.max_tx_payload = 1024;
+  c.max_tx_payload = line_frame_payload(line_bytes_per_s, 1024);
   c.channels[channel::kStream] = {Mode::reliable, 16384, 512, Mode::none, 0};
   c.channels[channel::kControl] = {Mode::reliable, 1024, 16, Mode::reliable, 1024};
   c.channels[channel::kPose] = {Mode::none, 0, 0, Mode::datagram, 64};
