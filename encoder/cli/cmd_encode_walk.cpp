@@ -67,13 +67,17 @@ void run_encode_walk(const EncodeWalkOptions& o) {
               "mean %d, %zu of them residuals against the client's prediction, %zu refinements), geometry %zu, frames %zu\n",
               o.out.c_str(), path.frames.size(), secs, r.stream.size(), r.kbps, o.rate, r.header_bytes, r.view_bytes,
               r.view_updates, qmin, qmax, r.quality, r.view_predicted, r.view_refinements, r.geometry_bytes, r.frame_bytes);
-  std::printf("  schedule: pre-roll %.3f s at %u bytes/s into a %u-byte window: every frame's data arrives by its time; "
-              "the first frame's data %zu bytes\n",
-              r.preroll_ms / 1000.0, r.rate_bytes, r.buffer_bytes, r.first_frame_bytes);
-  if (r.rate_bytes > std::lround(o.rate * 1000 / 8))
-    std::fprintf(stderr, "encode-walk: warning: %.2f kbit/s cannot bring every frame in time%s; the stream states the least "
-                 "rate that can, %.2f kbit/s, and a client on a slower link shows late frames\n",
-                 o.rate, o.quality >= 0 ? " at this quality" : " even at the lowest quality", r.rate_bytes * 8 / 1000.0);
+  if (r.rate_bytes != 0)
+    std::printf("  schedule: pre-roll %.3f s at %u bytes/s into a %u-byte window: every frame's data arrives by its time; "
+                "the first frame's data %zu bytes\n",
+                r.preroll_ms / 1000.0, r.rate_bytes, r.buffer_bytes, r.first_frame_bytes);
+  else
+    std::printf("  schedule: none (untimed: the client shows each frame when its data is whole); the first frame's data %zu bytes\n",
+                r.first_frame_bytes);
+  if (r.rate_bytes == 0)
+    std::fprintf(stderr, "encode-walk: warning: at %.2f kbit/s no pre-roll brings every frame in time%s (what follows a frame "
+                 "record must fit the client's %zu-byte window): the stream is untimed\n",
+                 o.rate, o.quality >= 0 ? " at this quality" : " even at the lowest quality", enc::WalkEncodeOptions{}.buffer_bytes);
   if (r.preroll_ms > (o.preroll >= 0 ? static_cast<uint32_t>(o.preroll) : enc::WalkEncodeOptions{}.preroll_ms))
     std::fprintf(stderr, "encode-walk: warning: the stream needs a pre-roll of %.3f s, more than asked\n", r.preroll_ms / 1000.0);
   double worst = 99;

@@ -42,6 +42,7 @@ void add_render(CLI::App& app);
 void add_encode_walk(CLI::App& app);
 void add_pack(CLI::App& app);
 void add_serve(CLI::App& app);
+void add_play(CLI::App& app);
 void add_encode_mesh(CLI::App& app);
 void add_encode_frames(CLI::App& app);
 void add_frames(CLI::App& app);

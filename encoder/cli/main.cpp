@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   vds::cli::add_info(app);
   vds::cli::add_pack(app);
   vds::cli::add_serve(app);
+  vds::cli::add_play(app);
   vds::cli::add_encode_mesh(app);
   vds::cli::add_encode_frames(app);
   vds::cli::add_frames(app);

@@ -428,38 +428,30 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   const size_t updates = update_camera.size();
   const auto preroll_of = [&](const std::vector<WalkPiece>& p) { return walk_preroll_ms(p, lk, kWalkMaxPrerollMs); };
   std::vector<int> q(updates, std::max(0, o.quality));
-  // The link the stream is shaped for: the rate asked for, unless even the
-  // lowest quality (or the one asked for) cannot bring every frame in time
-  // at it with any pre-roll (the window bounds what a pre-roll can hold
-  // back): then the least rate that can, with the pre-roll asked for.
-  if (preroll_of(pieces_at(q)) == UINT32_MAX) {
-    const double asked = lk.rate_bytes;
-    const auto carries = [&](double rate) {
-      lk.rate_bytes = rate;
-      lk.latency_s = link_latency(rate);
-      return preroll_of(pieces_at(q)) <= o.preroll_ms;
-    };
-    double lo = asked, hi = asked;
-    do {
-      lo = hi;
-      hi *= 2;
-      if (hi > 1024 * asked) throw std::runtime_error("encode_walk: no link up to 1024 times the rate carries the stream");
-    } while (!carries(hi));
-    while (hi - lo > 1) {
-      const double mid = std::floor((lo + hi) / 2);
-      (carries(mid) ? hi : lo) = mid;
-    }
-    lk.rate_bytes = std::ceil(hi);
-    lk.latency_s = link_latency(lk.rate_bytes);
-    wp.rate_bytes = static_cast<uint32_t>(lk.rate_bytes);
-  }
+  // No schedule fits when even the lowest quality (or the one asked for)
+  // cannot bring every frame in time at the rate with any pre-roll: what
+  // follows a held record must fit the client's window (geometry bursts
+  // on entering large rooms). The stream is then untimed (the client shows
+  // each frame when its data is whole) and the rate control keeps only the
+  // average within the rate.
+  const bool timed = preroll_of(pieces_at(q)) != UINT32_MAX;
+  if (!timed) wp.rate_bytes = wp.buffer_bytes = 0;
+  const auto total = [](const std::vector<WalkPiece>& p) {
+    size_t b = 0;
+    for (const WalkPiece& x : p) b += x.bytes;
+    return b;
+  };
   // A target even the lowest quality cannot meet becomes the least pre-roll there is.
   uint32_t target = o.preroll_ms;
-  if (o.quality < 0 && updates > 0) target = std::max(target, preroll_of(pieces_at(q)));
+  if (timed && o.quality < 0 && updates > 0) target = std::max(target, preroll_of(pieces_at(q)));
+  // Whether views at qualities `qq` keep the stream in time with the target
+  // pre-roll (untimed: within the rate on average).
+  const auto fits = [&](const std::vector<int>& qq) {
+    const std::vector<WalkPiece> p = pieces_at(qq);
+    return timed ? preroll_of(p) <= target : total(p) <= lk.rate_bytes * n / path.fps;
+  };
   if (o.quality < 0 && updates > 0) {
-    // The best quality for every view with which the pre-roll is within
-    // the target (bisection: bytes rise with quality) ...
-    const auto fits = [&](const std::vector<int>& qq) { return preroll_of(pieces_at(qq)) <= target; };
+    // The best quality for every view that fits (bisection: bytes rise with quality) ...
     int lo = -1, hi = 101;
     while (hi - lo > 1) {
       const int mid = (lo + hi) / 2;
@@ -469,7 +461,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     std::fill(q.begin(), q.end(), std::max(lo, 0));
     // ... then each view in turn a step higher while the pre-roll stays
     // within it: the views where the link has room rise.
-    {
+    if (timed) {
       constexpr int kStep = 2;
       for (bool rose = true; rose;) {
         rose = false;
@@ -486,15 +478,14 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   // The stream, stating the pre-roll it needs as written (the model's
   // figure unless residuals changed the sizes).
   WalkEncodeResult r;
-  uint32_t stated = preroll_of(pieces_at(q));
+  uint32_t stated = timed ? preroll_of(pieces_at(q)) : 0;
   for (int attempt = 0;; ++attempt) {
-    if (stated == UINT32_MAX)
-      throw std::runtime_error("encode_walk: at " + std::to_string(o.rate_kbps) + " kbit/s the stream would need more than " +
-                               std::to_string(kWalkMaxPrerollMs / 1000) + " s of pre-roll");
     build(q, stated, &r);
-    const uint32_t need = preroll_of(written);
+    const uint32_t need = timed ? preroll_of(written) : 0;
     if (need == stated) break;
     if (attempt >= 8) throw std::logic_error("encode_walk: the pre-roll does not settle");
+    if (need == UINT32_MAX && o.quality >= 0)
+      throw std::runtime_error("encode_walk: with its residual views the stream no longer fits the rate with any pre-roll");
     // Over the target: every view a step lower (rate control only).
     if (need > target && o.quality < 0)
       for (int& v : q) v = std::max(0, v - 2);

@@ -6,7 +6,12 @@ the stream at 64x48, and e2e_boards.py serves it to the host-native board
 and the Cortex-M4 board in QEMU: every frame each board displays must have
 the CRC the encoder's replay of the client gives.
 
-Usage: walk_case.py --vds VDS --work DIR [e2e_boards.py options...]"""
+With --play it plays the stream with `vds play` on both boards instead:
+every frame equal to the replay, the host board's frames written as PNGs;
+and `vds play` refuses a damaged stream and a missing firmware.
+
+Usage: walk_case.py --vds VDS --work DIR [e2e_boards.py options...]
+       walk_case.py --play --vds VDS --work DIR --host-board EXE --qemu QEMU --elf ELF"""
 import os
 import subprocess
 import sys
@@ -61,9 +66,41 @@ def main():
     stream = os.path.join(work, "walk.vds")
     subprocess.run([vds, "encode-walk", os.path.join(work, "room.obj"), "--path", os.path.join(work, "path.txt"),
                     "--size", "64x48", "--rate", "64", "-o", stream], check=True)
+    if "--play" in args:
+        sys.exit(play(vds, work, stream, args))
     rest = [a for i, a in enumerate(args) if a != "--vds" and (i == 0 or args[i - 1] != "--vds")]
     e2e = os.path.join(os.path.dirname(os.path.abspath(__file__)), "e2e_boards.py")
     sys.exit(subprocess.run([sys.executable, e2e, "--vds", vds, "--stream", stream] + rest).returncode)
+
+
+def play(vds, work, stream, args):
+    """`vds play` on both boards, a damaged stream, a missing firmware."""
+    opt = lambda k: args[args.index(k) + 1]
+    fails = []
+    for board, firmware in (("host", opt("--host-board")), ("qemu", opt("--elf"))):
+        out = os.path.join(work, "play_" + board)
+        r = subprocess.run([vds, "play", stream, "--board", board, "--firmware", firmware, "--qemu", opt("--qemu"),
+                            "--baud", "115200", "--out", out, "--timeout", "300"], capture_output=True, text=True)
+        if r.returncode != 0 or f"40 frames; the {board} board showed 40, 40 of them equal to the replay's" not in r.stdout:
+            fails.append(f"vds play --board {board}: exit {r.returncode}\n{r.stdout[-3000:]}{r.stderr[-3000:]}")
+        if board == "host" and len([f for f in os.listdir(os.path.join(out, "frames")) if f.endswith(".png")]) != 40:
+            fails.append("vds play --board host did not write 40 PNG frames")
+    # A payload byte flipped in the stream's last chunk: refused before any board starts.
+    data = bytearray(open(stream, "rb").read())
+    data[-20] ^= 0x40
+    bad = os.path.join(work, "damaged.vds")
+    open(bad, "wb").write(bytes(data))
+    r = subprocess.run([vds, "play", bad, "--board", "host", "--firmware", opt("--host-board")], capture_output=True, text=True)
+    if r.returncode != 1 or "damaged.vds" not in r.stderr:
+        fails.append(f"a damaged stream: exit {r.returncode}, {r.stderr!r}")
+    r = subprocess.run([vds, "play", stream, "--board", "qemu", "--firmware", os.path.join(work, "no-such.elf")],
+                       capture_output=True, text=True)
+    if r.returncode != 2 or "no-such.elf" not in r.stderr:
+        fails.append(f"a missing firmware: exit {r.returncode}, {r.stderr!r}")
+    for f in fails:
+        print("FAIL " + f)
+    print("vds play: both boards showed the replay's 40 frames; damaged stream and missing firmware refused" if not fails else "")
+    return 1 if fails else 0
 
 
 if __name__ == "__main__":
