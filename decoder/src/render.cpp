@@ -81,7 +81,7 @@ Status check_list(const DrawList& list) {
   if (list.num_meshes && !list.meshes) return Status::invalid_argument;
   for (uint32_t i = 0; i < list.num_meshes; ++i) {
     const Mesh& m = list.meshes[i];
-    if (static_cast<uint8_t>(m.shading) > 3 || static_cast<uint8_t>(m.filter) > 1 || static_cast<uint8_t>(m.cull) > 2) {
+    if (static_cast<uint8_t>(m.shading) > 3 || static_cast<uint8_t>(m.filter) > 2 || static_cast<uint8_t>(m.cull) > 2) {
       return Status::invalid_argument;
     }
     if (m.num_triangles == 0) continue;

@@ -160,6 +160,29 @@ constexpr int bilinear_frac_bits(TexFormat tf, PixelFormat o) {
   return tf == TexFormat::rgb565 && o == PixelFormat::rgb565 ? 5 : 8;
 }
 
+// Y'CbCr 4:2:0 only (Filter::bilinear_luma): luma as BilinearSampler,
+// chroma the texel the sample point lies in.
+template <TexFormat TF, TexAddress A, PixelFormat O>
+struct LumaBilinearSampler {
+  static constexpr int kFracBits = 8;
+  static constexpr bool kInlineStart = false;
+  // (u, v): the sample point minus half a texel, 8 fraction bits.
+  static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
+    const int32_t i0 = u >> 8, j0 = v >> 8;
+    const uint32_t fu = static_cast<uint32_t>(u) & 255u, fv = static_cast<uint32_t>(v) & 255u;
+    const uint32_t c0 = static_cast<uint32_t>(tx<A>(i0, t.wmask, t.wmax));
+    const uint32_t c1 = static_cast<uint32_t>(tx<A>(i0 + 1, t.wmask, t.wmax));
+    const uint32_t r0 = static_cast<uint32_t>(tx<A>(j0, t.hmask, t.hmax)) * t.stride;
+    const uint32_t r1 = static_cast<uint32_t>(tx<A>(j0 + 1, t.hmask, t.hmax)) * t.stride;
+    const uint8_t* y = t.base;
+    const uint32_t yy = lerp8(lerp8(y[r0 + c0], y[r0 + c1], fu), lerp8(y[r1 + c0], y[r1 + c1], fu), fv);
+    // The point in chroma texels: (u_q8 + 128) / 512.
+    const uint32_t k = static_cast<uint32_t>(tx<A>((u + 128) >> 9, t.cwmask, t.cwmax));
+    const uint32_t ci = static_cast<uint32_t>(tx<A>((v + 128) >> 9, t.chmask, t.chmax)) * t.cstride + k;
+    return from_ycbcr<O>(static_cast<int32_t>(yy), t.cb[ci], t.cr[ci]);
+  }
+};
+
 template <TexFormat TF, TexAddress A, PixelFormat O>
 struct BilinearSampler {
   static constexpr int kFracBits = bilinear_frac_bits(TF, O);
@@ -602,6 +625,8 @@ SpanFn pick_filter(Filter f, bool apron, bool repeat, bool proj) {
   if (f == Filter::nearest) return pick_address<NearestSampler, TF, O, D>(repeat, proj);
   if constexpr (TF != TexFormat::ycbcr420) {
     if (apron) return pick_address<BilinearApronSampler, TF, O, D>(repeat, proj);
+  } else {
+    if (f == Filter::bilinear_luma) return pick_address<LumaBilinearSampler, TF, O, D>(repeat, proj);
   }
   return pick_address<BilinearSampler, TF, O, D>(repeat, proj);
 }

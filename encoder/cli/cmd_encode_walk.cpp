@@ -20,7 +20,7 @@ namespace {
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, size = "240x180";
   double rate = 16, threshold = 18, widen = -1, view_scale = -1;
-  int lookahead = -1, preroll = -1;
+  int lookahead = -1, preroll = -1, window = -1;
   bool predict = false;
   int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
 };
@@ -38,6 +38,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.frames_per_record = o.frames_per_record;
   wo.predict = o.predict;
   if (o.preroll >= 0) wo.preroll_ms = static_cast<uint32_t>(o.preroll);
+  if (o.window >= 0) wo.buffer_bytes = static_cast<size_t>(o.window);
   if (o.lookahead >= 0) wo.lookahead = o.lookahead;
   if (o.widen > 0) wo.view_widen = o.widen;
   if (o.view_scale > 0) wo.view_scale = o.view_scale;
@@ -77,7 +78,8 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   if (r.rate_bytes == 0)
     std::fprintf(stderr, "encode-walk: warning: at %.2f kbit/s no pre-roll brings every frame in time%s (what follows a frame "
                  "record must fit the client's %zu-byte window): the stream is untimed\n",
-                 o.rate, o.quality >= 0 ? " at this quality" : " even at the lowest quality", enc::WalkEncodeOptions{}.buffer_bytes);
+                 o.rate, o.quality >= 0 ? " at this quality" : " even at the lowest quality",
+                 o.window >= 0 ? static_cast<size_t>(o.window) : enc::WalkEncodeOptions{}.buffer_bytes);
   if (r.preroll_ms > (o.preroll >= 0 ? static_cast<uint32_t>(o.preroll) : enc::WalkEncodeOptions{}.preroll_ms))
     std::fprintf(stderr, "encode-walk: warning: the stream needs a pre-roll of %.3f s, more than asked\n", r.preroll_ms / 1000.0);
   double worst = 99;
@@ -99,6 +101,8 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--threshold", o->threshold, "Largest magnification a view serves (default 18)")->check(kPositive);
   sub->add_option("--preroll", o->preroll, "Most pre-roll, ms: every frame's data arrives by its time (default 1000)")
       ->check(CLI::Range(0, static_cast<int>(kWalkMaxPrerollMs)));
+  sub->add_option("--window", o->window, "The client's stream window, bytes (default 4096: the client firmware's)")
+      ->check(CLI::Range(256, 1 << 24));
   sub->add_option("--quality", o->quality, "The views' image quality (default: each view's, by the rate control)")->check(CLI::Range(0, 100));
   sub->add_option("--frames-per-record", o->frames_per_record, "Most frames a WFRM record holds (default 8)")
       ->check(CLI::Range(1, static_cast<int>(kWalkMaxFramesPerRecord)));

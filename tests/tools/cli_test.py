@@ -107,5 +107,16 @@ check(code == 2 and "--tail needs the arithmetic coder" in err and not os.path.e
 code, out, err = run("encode-mesh", obj, "-o", model + ".splits", "--tail", "0")
 check(code == 0 and "single-rate tail" not in out, "--tail 0 splits all the way")
 
+# vds play and encode-walk: options checked before anything runs.
+code, out, err = run("play", stream, "--board", "fpga")
+check(code == 2 and "--board" in err, "vds play refuses a board it does not have")
+code, out, err = run("play", os.path.join(TMP, "no-such.vds"), "--board", "host")
+check(code == 1 and "no-such.vds" in err, "vds play names a missing stream")
+code, out, err = run("encode-walk", "scene.obj", "--path", "p.txt", "-o", os.path.join(TMP, "w.vds"), "--preroll", "700000")
+check(code == 2 and "--preroll" in err and not os.path.exists(os.path.join(TMP, "w.vds")),
+      "encode-walk refuses a pre-roll over ten minutes, nothing written")
+code, out, err = run("encode-walk", "scene.obj", "--path", "p.txt", "-o", os.path.join(TMP, "w.vds"), "--window", "16")
+check(code == 2 and "--window" in err, "encode-walk refuses a window under 256 bytes")
+
 print(f"{len(failures)} failed" if failures else "all CLI checks passed")
 sys.exit(1 if failures else 0)
