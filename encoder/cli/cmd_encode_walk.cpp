@@ -20,7 +20,7 @@ namespace {
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, size = "240x180";
   double rate = 16, threshold = 18, widen = -1, view_scale = -1;
-  int lookahead = -1, preroll = -1, window = -1;
+  int lookahead = -1, preroll = -1, window = -1, max_sends = -1;
   bool predict = false;
   int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
 };
@@ -39,6 +39,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.predict = o.predict;
   if (o.preroll >= 0) wo.preroll_ms = static_cast<uint32_t>(o.preroll);
   if (o.window >= 0) wo.buffer_bytes = static_cast<size_t>(o.window);
+  if (o.max_sends >= 0) wo.max_sends = o.max_sends;
   if (o.lookahead >= 0) wo.lookahead = o.lookahead;
   if (o.widen > 0) wo.view_widen = o.widen;
   if (o.view_scale > 0) wo.view_scale = o.view_scale;
@@ -101,6 +102,8 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--threshold", o->threshold, "Largest magnification a view serves (default 18)")->check(kPositive);
   sub->add_option("--preroll", o->preroll, "Most pre-roll, ms: every frame's data arrives by its time (default 1000)")
       ->check(CLI::Range(0, static_cast<int>(kWalkMaxPrerollMs)));
+  sub->add_option("--max-sends", o->max_sends, "Polygons a frame sends at most; the rest go earlier where their slots allow (0: no limit)")
+      ->check(CLI::Range(0, 100000));
   sub->add_option("--window", o->window, "The client's stream window, bytes (default 4096: the client firmware's)")
       ->check(CLI::Range(256, 1 << 24));
   sub->add_option("--quality", o->quality, "The views' image quality (default: each view's, by the rate control)")->check(CLI::Range(0, 100));

@@ -11,7 +11,8 @@
 
 namespace vds::enc {
 
-WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& visible, uint32_t slots, int window) {
+WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& visible, uint32_t slots, int window,
+                                    size_t max_sends) {
   const size_t n = visible.size();
   WalkGeometryPlan plan;
   plan.slots = slots;
@@ -87,6 +88,24 @@ WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& vi
     }
     for (uint32_t id : hot[f]) plan.hot[f].push_back(slot_of[id]);
     std::sort(plan.hot[f].begin(), plan.hot[f].end());
+  }
+  // Bursts spread backwards, a frame at a time.
+  for (size_t f = n; max_sends > 0 && f-- > 1;) {
+    std::vector<WalkGeometryPlan::Send>& now = plan.sends[f];
+    if (now.size() <= max_sends) continue;
+    std::vector<WalkGeometryPlan::Send>& before = plan.sends[f - 1];
+    const std::vector<uint32_t>& drawn = plan.hot[f - 1];
+    std::vector<WalkGeometryPlan::Send> keep;
+    for (const WalkGeometryPlan::Send& snd : now) {
+      const bool free_before = !std::binary_search(drawn.begin(), drawn.end(), snd.slot) &&
+                               std::none_of(before.begin(), before.end(), [&](const auto& b) { return b.slot == snd.slot; });
+      if (keep.size() < max_sends || !free_before) {
+        keep.push_back(snd);
+      } else {
+        before.push_back({snd.id, snd.slot, false});
+      }
+    }
+    now = std::move(keep);
   }
   return plan;
 }

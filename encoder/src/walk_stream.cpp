@@ -155,7 +155,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     for (const auto& [id, px] : visible[f]) ids[f].push_back(id);
   const WalkGeometryPlan probe = plan_walk_geometry(ids, kWalkMaxSlots, o.window);
   const uint32_t slots = static_cast<uint32_t>(std::min<size_t>(kWalkMaxSlots, probe.peak_hot + 16));
-  const WalkGeometryPlan geo = plan_walk_geometry(ids, slots, o.window);
+  const WalkGeometryPlan geo = plan_walk_geometry(ids, slots, o.window, static_cast<size_t>(o.max_sends));
   WalkViewOptions vo;
   vo.slots = o.views;
   vo.threshold = o.threshold;
@@ -271,7 +271,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     for (size_t f = record_start[r]; f < end; ++f) {
       std::vector<WalkGeometryEncoder::Send> sends;
       for (const auto& snd : geo.sends[f]) {
-        WalkGeometryEncoder::Send gs{snd.slot, true, {}};
+        WalkGeometryEncoder::Send gs{snd.slot, snd.hot, {}};
         for (int c = 0; c < 3; ++c)
           for (int a = 0; a < 3; ++a)
             gs.vertices[static_cast<size_t>(c)][static_cast<size_t>(a)] =

@@ -90,6 +90,7 @@ size_t lru_resends(const Visible& hot, size_t slots) {
 
 TEST(WalkGeometry, AClientReplayingTheSendsHoldsEveryHotPolygon) {
   vds::test::Xorshift32 rng;
+  size_t total_moved = 0;
   for (int round = 0; round < 40; ++round) {
     // A walk: polygons come into view and leave, some come back.
     Visible vis(120);
@@ -105,29 +106,41 @@ TEST(WalkGeometry, AClientReplayingTheSendsHoldsEveryHotPolygon) {
     const auto probe = plan_walk_geometry(vis, 1u << 20, window);
     const uint32_t slots = static_cast<uint32_t>(probe.peak_hot + rng.next() % 20);
     const auto p = plan_walk_geometry(vis, slots, window);
-    std::vector<uint32_t> client(slots, std::numeric_limits<uint32_t>::max());
-    size_t sends = 0;
+    // The same with bursts spread: sends ahead of their frame, never drawn
+    // where they are sent.
+    const size_t limit = 1 + rng.next() % 6;
+    const auto spread = plan_walk_geometry(vis, slots, window, limit);
     Visible hot_ids(vis.size());
-    for (size_t f = 0; f < vis.size(); ++f) {
-      for (const auto& s : p.sends[f]) {
-        ASSERT_LT(s.slot, slots);
-        client[s.slot] = s.id;
-        ++sends;
+    size_t sends = 0, moved = 0;
+    for (const auto* plan : {&p, &spread}) {
+      std::vector<uint32_t> client(slots, std::numeric_limits<uint32_t>::max());
+      for (size_t f = 0; f < vis.size(); ++f) {
+        for (const auto& s : plan->sends[f]) {
+          ASSERT_LT(s.slot, slots);
+          client[s.slot] = s.id;
+          if (plan == &p) ++sends;
+          if (!s.hot) {
+            ++moved;
+            ASSERT_FALSE(std::binary_search(plan->hot[f].begin(), plan->hot[f].end(), s.slot)) << "round " << round;
+          }
+        }
+        // The hot slots hold exactly the polygons visible within the window.
+        std::set<uint32_t> want;
+        for (size_t g = f >= static_cast<size_t>(window) ? f - window : 0; g <= std::min(vis.size() - 1, f + window); ++g)
+          want.insert(vis[g].begin(), vis[g].end());
+        std::set<uint32_t> got;
+        for (uint32_t s : plan->hot[f]) got.insert(client[s]);
+        ASSERT_EQ(got, want) << "round " << round << " frame " << f << (plan == &p ? "" : " (spread)");
+        hot_ids[f].assign(want.begin(), want.end());
       }
-      // The hot slots hold exactly the polygons visible within the window.
-      std::set<uint32_t> want;
-      for (size_t g = f >= static_cast<size_t>(window) ? f - window : 0; g <= std::min(vis.size() - 1, f + window); ++g)
-        want.insert(vis[g].begin(), vis[g].end());
-      std::set<uint32_t> got;
-      for (uint32_t s : p.hot[f]) got.insert(client[s]);
-      ASSERT_EQ(got, want) << "round " << round << " frame " << f;
-      hot_ids[f].assign(want.begin(), want.end());
     }
+    total_moved += moved;
     EXPECT_EQ(sends, p.first_sends + p.resends);
     EXPECT_LE(p.resends, lru_resends(hot_ids, slots)) << "round " << round;
     // Slots for every polygon: nothing is sent twice.
     EXPECT_EQ(plan_walk_geometry(vis, pool, window).resends, 0u);
   }
+  EXPECT_GT(total_moved, 0u);  // the limit moved sends ahead
 }
 
 TEST(WalkGeometry, TheScheduleOfATourOfOaDm4) {

@@ -79,6 +79,31 @@ TEST(WalkStream, RecordsOfSeveralFramesShowWhatRecordsOfOneShow) {
   EXPECT_LE(eight.stream.size() + 12 * (60 - records), one.stream.size()) << one.stream.size() << " " << eight.stream.size();
 }
 
+TEST(WalkStream, PolygonsSentAheadShowWhatPolygonsSentOnTimeShow) {
+  // Bursts of geometry spread to the frames before (--max-sends): the
+  // client draws the same pictures, the largest record is smaller.
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
+  vds::enc::WalkEncodeOptions o;
+  o.quality = 30;
+  o.frames_per_record = 1;
+  const auto plain = vds::enc::encode_walk(room, path, o);
+  o.max_sends = 2;
+  const auto spread = vds::enc::encode_walk(room, path, o);
+  EXPECT_EQ(spread.frame_crc, plain.frame_crc);
+  EXPECT_EQ(vds::enc::client_frame_crcs(spread.stream), spread.frame_crc);
+  // (After the first frame's, which nothing can precede.)
+  const auto largest = [](const std::vector<vds::enc::WalkPiece>& p) {
+    size_t m = 0;
+    for (const auto& x : p)
+      if (x.record && x.first_frame > 0) m = std::max(m, x.bytes);
+    return m;
+  };
+  EXPECT_LT(largest(spread.pieces), largest(plain.pieces));
+  std::printf("room: largest frame record after the first %zu bytes, %zu with at most 2 polygons a frame\n", largest(plain.pieces),
+              largest(spread.pieces));
+}
+
 TEST(WalkStream, TheFeedLimitKeepsABoundedQueueOfFramesFromOverflowing) {
   // A client with room for `room` frame records feeds no more than the
   // player's feed limit: however the records drain, no feed completes more

@@ -26,8 +26,9 @@ namespace vds::enc {
 struct WalkGeometryPlan {
   uint32_t slots = 0;
   struct Send {
-    uint32_t id;    // the polygon (triangle index in the scene)
-    uint32_t slot;  // where it goes, replacing what was there
+    uint32_t id;      // the polygon (triangle index in the scene)
+    uint32_t slot;    // where it goes, replacing what was there
+    bool hot = true;  // drawn in the frame it is sent with (false: sent ahead)
   };
   std::vector<std::vector<Send>> sends;      // per frame: polygons to have arrived by that frame
   std::vector<std::vector<uint32_t>> hot;    // per frame: the slots to draw, ascending
@@ -36,8 +37,13 @@ struct WalkGeometryPlan {
 };
 
 // `visible[f]`: the polygon IDs frame f shows. Throws std::runtime_error if
-// a frame's hot set exceeds `slots`.
-WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& visible, uint32_t slots, int window);
+// a frame's hot set exceeds `slots`. `max_sends` > 0 spreads bursts: a
+// frame with more sends than that passes the rest to the frame before,
+// each as long as its slot is not drawn there (the polygon it replaces is
+// then evicted a frame earlier), so that entering a large room does not
+// put hundreds of polygons into one frame's record.
+WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& visible, uint32_t slots, int window,
+                                    size_t max_sends = 0);
 
 // The vertex grid for a scene: the largest power-of-two step from 1 map
 // unit down to 1/256 (raw Q16.16) that puts every vertex within `tolerance`

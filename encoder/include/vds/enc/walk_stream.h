@@ -35,6 +35,7 @@ struct WalkEncodeOptions {
   int refine_delta = 0;     // a refinement's quality above the views' (0: none; they did not pay on oa_dm4: docs/walkthrough.md)
   int refine_after = 10;    // frames after a view arrives; views serving at least twice that are refined
   int window = 2;         // hot: visible within this many frames either side
+  int max_sends = 0;      // polygons a frame sends at most before the rest go a frame earlier (0: no limit)
   int frames_per_record = kWalkMaxFramesPerRecord;  // most frames a WFRM record holds
   // View updates ask the client to draw its prediction of the view, and
   // are coded as a residual against it when that pays (rate and
