@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <vector>
 
 #include "vds/enc/frames.h"
@@ -60,19 +61,27 @@ TEST(WalkStream, RefinementsAddToTheViewsTheClientHolds) {
   EXPECT_GT(refined.stream.size(), plain.stream.size());
 }
 
-TEST(WalkStream, RecordsOfSeveralFramesShowWhatRecordsOfOneShow) {
-  // The same views and decisions in records of up to 8 frames and of one:
-  // the same pictures, fewer chunks, fewer bytes.
+// The room at quality 30 in records of one frame, then again with
+// `change` made to the options: both streams show the same pictures.
+std::pair<vds::enc::WalkEncodeResult, vds::enc::WalkEncodeResult> same_pictures(
+    const std::function<void(vds::enc::WalkEncodeOptions&)>& change) {
   const vds::enc::Scene room = vds::test::walk_room();
   const vds::enc::CameraPath path = vds::test::walk_room_path(60);
   vds::enc::WalkEncodeOptions o;
   o.quality = 30;
   o.frames_per_record = 1;
-  const auto one = vds::enc::encode_walk(room, path, o);
-  o.frames_per_record = 8;
-  const auto eight = vds::enc::encode_walk(room, path, o);
-  EXPECT_EQ(eight.frame_crc, one.frame_crc);
-  EXPECT_EQ(vds::enc::client_frame_crcs(eight.stream), eight.frame_crc);
+  auto a = vds::enc::encode_walk(room, path, o);
+  change(o);
+  auto b = vds::enc::encode_walk(room, path, o);
+  EXPECT_EQ(b.frame_crc, a.frame_crc);
+  EXPECT_EQ(vds::enc::client_frame_crcs(b.stream), b.frame_crc);
+  return {std::move(a), std::move(b)};
+}
+
+TEST(WalkStream, RecordsOfSeveralFramesShowWhatRecordsOfOneShow) {
+  // The same views and decisions in records of up to 8 frames and of one:
+  // the same pictures, fewer chunks, fewer bytes.
+  const auto [one, eight] = same_pictures([](auto& o) { o.frames_per_record = 8; });
   // At least 12 bytes of framing saved per record merged away (60 records
   // of one frame; the records of eight break at each view update).
   const size_t records = (60 + 7) / 8 + one.view_updates;
@@ -82,16 +91,7 @@ TEST(WalkStream, RecordsOfSeveralFramesShowWhatRecordsOfOneShow) {
 TEST(WalkStream, PolygonsSentAheadShowWhatPolygonsSentOnTimeShow) {
   // Bursts of geometry spread to the frames before (--max-sends): the
   // client draws the same pictures, the largest record is smaller.
-  const vds::enc::Scene room = vds::test::walk_room();
-  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
-  vds::enc::WalkEncodeOptions o;
-  o.quality = 30;
-  o.frames_per_record = 1;
-  const auto plain = vds::enc::encode_walk(room, path, o);
-  o.max_sends = 2;
-  const auto spread = vds::enc::encode_walk(room, path, o);
-  EXPECT_EQ(spread.frame_crc, plain.frame_crc);
-  EXPECT_EQ(vds::enc::client_frame_crcs(spread.stream), spread.frame_crc);
+  const auto [plain, spread] = same_pictures([](auto& o) { o.max_sends = 2; });
   // (After the first frame's, which nothing can precede.)
   const auto largest = [](const std::vector<vds::enc::WalkPiece>& p) {
     size_t m = 0;
