@@ -160,31 +160,10 @@ constexpr int bilinear_frac_bits(TexFormat tf, PixelFormat o) {
   return tf == TexFormat::rgb565 && o == PixelFormat::rgb565 ? 5 : 8;
 }
 
-// Y'CbCr 4:2:0 only (Filter::bilinear_luma): luma as BilinearSampler,
-// chroma the texel the sample point lies in.
-template <TexFormat TF, TexAddress A, PixelFormat O>
-struct LumaBilinearSampler {
-  static constexpr int kFracBits = 8;
-  static constexpr bool kInlineStart = false;
-  // (u, v): the sample point minus half a texel, 8 fraction bits.
-  static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
-    const int32_t i0 = u >> 8, j0 = v >> 8;
-    const uint32_t fu = static_cast<uint32_t>(u) & 255u, fv = static_cast<uint32_t>(v) & 255u;
-    const uint32_t c0 = static_cast<uint32_t>(tx<A>(i0, t.wmask, t.wmax));
-    const uint32_t c1 = static_cast<uint32_t>(tx<A>(i0 + 1, t.wmask, t.wmax));
-    const uint32_t r0 = static_cast<uint32_t>(tx<A>(j0, t.hmask, t.hmax)) * t.stride;
-    const uint32_t r1 = static_cast<uint32_t>(tx<A>(j0 + 1, t.hmask, t.hmax)) * t.stride;
-    const uint8_t* y = t.base;
-    const uint32_t yy = lerp8(lerp8(y[r0 + c0], y[r0 + c1], fu), lerp8(y[r1 + c0], y[r1 + c1], fu), fv);
-    // The point in chroma texels: (u_q8 + 128) / 512.
-    const uint32_t k = static_cast<uint32_t>(tx<A>((u + 128) >> 9, t.cwmask, t.cwmax));
-    const uint32_t ci = static_cast<uint32_t>(tx<A>((v + 128) >> 9, t.chmask, t.chmax)) * t.cstride + k;
-    return from_ycbcr<O>(static_cast<int32_t>(yy), t.cb[ci], t.cr[ci]);
-  }
-};
-
-template <TexFormat TF, TexAddress A, PixelFormat O>
-struct BilinearSampler {
+// kNearestChroma (Y'CbCr 4:2:0, Filter::bilinear_luma): chroma from the
+// chroma texel the sample point lies in instead of blended.
+template <TexFormat TF, TexAddress A, PixelFormat O, bool kNearestChroma>
+struct BilinearBlend {
   static constexpr int kFracBits = bilinear_frac_bits(TF, O);
   static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
   static constexpr uint32_t kFracMask = (1u << kFracBits) - 1;
@@ -199,17 +178,24 @@ struct BilinearSampler {
     if constexpr (TF == TexFormat::ycbcr420) {
       const uint8_t* y = t.base;
       const uint32_t yy = lerp8(lerp8(y[r0 + c0], y[r0 + c1], fu), lerp8(y[r1 + c0], y[r1 + c1], fu), fv);
-      // In chroma texels the point is u/2, minus half a chroma texel:
-      // (u_q8 + 128)/2 - 128 = u_q8/2 - 64.
-      const int32_t cu = (u >> 1) - 64, cv = (v >> 1) - 64;
-      const uint32_t gu = static_cast<uint32_t>(cu) & 255u, gv = static_cast<uint32_t>(cv) & 255u;
-      const uint32_t k0 = static_cast<uint32_t>(tx<A>(cu >> 8, t.cwmask, t.cwmax));
-      const uint32_t k1 = static_cast<uint32_t>(tx<A>((cu >> 8) + 1, t.cwmask, t.cwmax));
-      const uint32_t s0 = static_cast<uint32_t>(tx<A>(cv >> 8, t.chmask, t.chmax)) * t.cstride;
-      const uint32_t s1 = static_cast<uint32_t>(tx<A>((cv >> 8) + 1, t.chmask, t.chmax)) * t.cstride;
-      const uint32_t cb = lerp8(lerp8(t.cb[s0 + k0], t.cb[s0 + k1], gu), lerp8(t.cb[s1 + k0], t.cb[s1 + k1], gu), gv);
-      const uint32_t cr = lerp8(lerp8(t.cr[s0 + k0], t.cr[s0 + k1], gu), lerp8(t.cr[s1 + k0], t.cr[s1 + k1], gu), gv);
-      return from_ycbcr<O>(static_cast<int32_t>(yy), static_cast<int32_t>(cb), static_cast<int32_t>(cr));
+      if constexpr (kNearestChroma) {
+        // The point in chroma texels: (u_q8 + 128) / 512.
+        const uint32_t k = static_cast<uint32_t>(tx<A>((u + 128) >> 9, t.cwmask, t.cwmax));
+        const uint32_t ci = static_cast<uint32_t>(tx<A>((v + 128) >> 9, t.chmask, t.chmax)) * t.cstride + k;
+        return from_ycbcr<O>(static_cast<int32_t>(yy), t.cb[ci], t.cr[ci]);
+      } else {
+        // In chroma texels the point is u/2, minus half a chroma texel:
+        // (u_q8 + 128)/2 - 128 = u_q8/2 - 64.
+        const int32_t cu = (u >> 1) - 64, cv = (v >> 1) - 64;
+        const uint32_t gu = static_cast<uint32_t>(cu) & 255u, gv = static_cast<uint32_t>(cv) & 255u;
+        const uint32_t k0 = static_cast<uint32_t>(tx<A>(cu >> 8, t.cwmask, t.cwmax));
+        const uint32_t k1 = static_cast<uint32_t>(tx<A>((cu >> 8) + 1, t.cwmask, t.cwmax));
+        const uint32_t s0 = static_cast<uint32_t>(tx<A>(cv >> 8, t.chmask, t.chmax)) * t.cstride;
+        const uint32_t s1 = static_cast<uint32_t>(tx<A>((cv >> 8) + 1, t.chmask, t.chmax)) * t.cstride;
+        const uint32_t cb = lerp8(lerp8(t.cb[s0 + k0], t.cb[s0 + k1], gu), lerp8(t.cb[s1 + k0], t.cb[s1 + k1], gu), gv);
+        const uint32_t cr = lerp8(lerp8(t.cr[s0 + k0], t.cr[s0 + k1], gu), lerp8(t.cr[s1 + k0], t.cr[s1 + k1], gu), gv);
+        return from_ycbcr<O>(static_cast<int32_t>(yy), static_cast<int32_t>(cb), static_cast<int32_t>(cr));
+      }
     } else if constexpr (TF == TexFormat::rgb565 && O == PixelFormat::rgb565) {
       const uint16_t* p = reinterpret_cast<const uint16_t*>(t.base);
       const uint32_t top = lerp_spread(spread565(p[r0 + c0]), spread565(p[r0 + c1]), fu);
@@ -221,6 +207,11 @@ struct BilinearSampler {
     }
   }
 };
+
+template <TexFormat TF, TexAddress A, PixelFormat O>
+using BilinearSampler = BilinearBlend<TF, A, O, false>;
+template <TexFormat TF, TexAddress A, PixelFormat O>
+using LumaBilinearSampler = BilinearBlend<TF, A, O, true>;
 
 // Bilinear filtering of a texture with an apron (Texture::apron): the right
 // and lower neighbours are at +1 and +stride whatever the addressing. Clamp

@@ -122,12 +122,7 @@ uint16_t free_port() {
 }
 
 void run_play(const PlayArgs& a) {
-  std::vector<uint8_t> bytes;
-  try {
-    bytes = enc::read_file(a.stream);
-  } catch (const std::exception& e) {
-    throw Failure(kExitBadInput, e.what());
-  }
+  const std::vector<uint8_t> bytes = enc::read_file(a.stream);  // (main reports its refusal, naming the file)
   // What the client must show.
   std::vector<uint32_t> want;
   try {

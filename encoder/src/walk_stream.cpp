@@ -257,6 +257,8 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     if (f == 0 || !vp.updates[f].empty() || !refines[f].empty() ||
         f - record_start.back() >= static_cast<size_t>(wp.frames_per_record))
       record_start.push_back(f);
+  // The frame after record r's last.
+  const auto record_end = [&](size_t r) { return r + 1 < record_start.size() ? record_start[r + 1] : n; };
   WalkGeometryEncoder ge(slots, wp.quantum_raw);
   WalkFrameEncoder fe;
   std::vector<std::vector<uint8_t>> wfrm(record_start.size());  // by record
@@ -265,7 +267,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   std::vector<uint8_t> slot_view(slots, 0);
   std::vector<uint32_t> id_of_slot(slots, 0);  // the triangle each slot holds, as the sends so far put them
   for (size_t r = 0; r < record_start.size(); ++r) {
-    const size_t end = r + 1 < record_start.size() ? record_start[r + 1] : n;
+    const size_t end = record_end(r);
     ArithEncoder e;
     fe.encode_count(e, static_cast<uint32_t>(end - record_start[r]), wp.frames_per_record);
     for (size_t f = record_start[r]; f < end; ++f) {
@@ -339,7 +341,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     std::vector<WalkPiece> p{{header_bytes, 0, 0, false}};
     for (size_t r = 0; r < record_start.size(); ++r) {
       const uint32_t f = static_cast<uint32_t>(record_start[r]);
-      const uint32_t last = static_cast<uint32_t>((r + 1 < record_start.size() ? record_start[r + 1] : n) - 1);
+      const uint32_t last = static_cast<uint32_t>(record_end(r) - 1);
       for (size_t u : update_of[f]) p.push_back({kFraming + kWalkViewBytes + intra(update_camera[u], q[u]).coded_bytes(), f, f, false});
       for (const Refine& rf : refines[f])
         p.push_back({kFraming + kWalkViewBytes + intra(rf.camera_frame, std::min(100, q[rf.update] + o.refine_delta)).coded_bytes(), f, f, false});
@@ -401,7 +403,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     };
     for (size_t r = 0; r < record_start.size(); ++r) {
       const uint32_t f = static_cast<uint32_t>(record_start[r]);
-      const uint32_t last = static_cast<uint32_t>((r + 1 < record_start.size() ? record_start[r + 1] : n) - 1);
+      const uint32_t last = static_cast<uint32_t>(record_end(r) - 1);
       for (size_t k = 0; k < vp.updates[f].size(); ++k) {
         const size_t u = update_of[f][k];
         written.push_back({put_view(vp.updates[f][k].slot, update_camera[u], q[u], false), f, f, false});
@@ -492,7 +494,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     stated = need > target && o.quality < 0 ? preroll_of(pieces_at(q)) : need;
   }
   r.view_quality = q;
-  r.quality = updates > 0 ? static_cast<int>(std::lround(std::accumulate(q.begin(), q.end(), 0.0) / updates)) : q.empty() ? 0 : q[0];
+  r.quality = updates > 0 ? static_cast<int>(std::lround(std::accumulate(q.begin(), q.end(), 0.0) / updates)) : 0;
   r.rate_bytes = wp.rate_bytes;
   r.buffer_bytes = wp.buffer_bytes;
   r.pieces = written;

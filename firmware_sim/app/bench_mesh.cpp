@@ -96,8 +96,7 @@ void on_frame(void*, const vds::PlayedFrame& f) {
 
 // Plays one stream file; false when it does not exist.
 bool run_file(const char* path, int* failures) {
-  const int32_t probe = board::host_file_read(path, 0, g_read, 1);
-  if (probe <= 0) return false;
+  if (!vds::fw::host_file_exists(path)) return false;
   vds::Arena arena(g_workspace, sizeof g_workspace);
   g_run = Run{};
   vds::PlayerConfig config = vds::kClientPlayerConfig;
@@ -110,9 +109,7 @@ bool run_file(const char* path, int* failures) {
   const Status s = vds::fw::play_host_file(player, player.init(arena, config, cb), path, g_read, kReadBytes);
   const vds::MeshState& m = player.mesh.mesh();
   const uint32_t splits = m.vertex_count() - g_run.base_vertices;
-  const char* base = path;
-  for (const char* p = path; *p; ++p)
-    if (*p == '/') base = p + 1;
+  const char* base = vds::fw::file_name(path);
   // The model view's share of the workspace, from the plan the player made.
   size_t view_bytes = 0;
   if (player.plan().known) {

@@ -58,8 +58,7 @@ void on_frame(void*, const vds::PlayedFrame& f) {
 
 // Plays one stream file; false when it does not exist.
 bool run_file(const char* path, int* failures) {
-  const int32_t probe = board::host_file_read(path, 0, g_read, 1);
-  if (probe <= 0) return false;
+  if (!vds::fw::host_file_exists(path)) return false;
   vds::Arena arena(g_workspace, sizeof g_workspace);
   g_run = Run{};
   vds::PlayerConfig config = vds::kClientPlayerConfig;
@@ -69,9 +68,7 @@ bool run_file(const char* path, int* failures) {
   cb.frame_shown = on_frame;
   static vds::Player player;
   const Status s = vds::fw::play_host_file(player, player.init(arena, config, cb), path, g_read, kReadBytes);
-  const char* base = path;
-  for (const char* p = path; *p; ++p)
-    if (*p == '/') base = p + 1;
+  const char* base = vds::fw::file_name(path);
   Line l;
   l.str("m4 walk stream=").str(base).str(" status=").str(vds::status_name(s)).str(" frames=").dec(g_run.frames);
   l.str(" instructions=").dec(g_run.total).str(" worst=").dec(g_run.worst).str(" worst_frame=").dec(g_run.worst_frame);
@@ -80,8 +77,6 @@ bool run_file(const char* path, int* failures) {
   parts.str("m4 walk_parts stream=").str(base).str(" parse=").dec(g_run.parse).str(" decode=").dec(g_run.decode);
   parts.str(" display=").dec(g_run.display).str(" workspace=").dec(arena.high_water()).str(" chunk_buffer=").dec(kChunkBytes);
   board::log(parts.str("\n").c_str());
-
-
   if (s != Status::ok) {
     board::log(Line().str("m4 walk error: ").str(player.error_detail()).str("\n").c_str());
     ++*failures;

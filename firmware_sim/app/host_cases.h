@@ -26,6 +26,20 @@ inline Status play_host_file(Player& player, Status s, const char* path, uint8_t
   return s;
 }
 
+// Whether the host has a file at `path` with at least one byte.
+inline bool host_file_exists(const char* path) {
+  uint8_t b = 0;
+  return board::host_file_read(path, 0, &b, 1) > 0;
+}
+
+// The part of `path` after its last '/'.
+inline const char* file_name(const char* path) {
+  const char* base = path;
+  for (const char* p = path; *p; ++p)
+    if (*p == '/') base = p + 1;
+  return base;
+}
+
 // Calls run(name) for "<stem>0.vds", "<stem>1.vds", ... (at most ten)
 // until run returns false (the file is missing); returns how many ran.
 // `stem` is at most 20 characters.
