@@ -95,9 +95,13 @@ void apply_shaders(const Pk3Set& pk3, Scene* s) {
 Pk3Set::Pk3Set(const std::string& dir) {
   std::vector<std::string> paths;
   std::error_code ec;
-  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
-    const std::string ext = ascii_lower(e.path().extension().string());
-    if (e.is_regular_file() && ext == ".pk3") paths.push_back(e.path().string());
+  if (std::filesystem::is_regular_file(dir, ec)) {
+    paths.push_back(dir);  // one archive
+  } else {
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+      const std::string ext = ascii_lower(e.path().extension().string());
+      if (e.is_regular_file() && ext == ".pk3") paths.push_back(e.path().string());
+    }
   }
   if (ec) throw std::runtime_error(dir + ": cannot list (" + ec.message() + ")");
   if (paths.empty()) throw std::runtime_error(dir + ": holds no .pk3 archive");

@@ -61,7 +61,11 @@ struct PngSource {
   size_t size, at;
 };
 
-Image read_png(const uint8_t* data, size_t size, const std::string& what) {
+// keep16: a 16-bit PNG keeps its samples, two bytes each (big-endian) in
+// an Image of twice the channels; *wide says whether it did.
+Image read_png(const uint8_t* data, size_t size, const std::string& what, bool keep16 = false,
+               bool* wide = nullptr) {
+  if (wide != nullptr) *wide = false;
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (png == nullptr || info == nullptr) {
@@ -113,13 +117,16 @@ Image read_png(const uint8_t* data, size_t size, const std::string& what) {
       // 8 bits per channel: palettes and low bit depths expanded, 16 bits
       // cut to their high byte, transparency as an alpha channel.
       png_set_expand(png);
-      png_set_strip_16(png);
+      const int bytes = keep16 && png_get_bit_depth(png, info) == 16 ? 2 : 1;
+      if (bytes == 1) png_set_strip_16(png);
       png_set_interlace_handling(png);
       png_read_update_info(png, info);
       const int channels = png_get_channels(png, info);
-      if (channels < 1 || channels > 4 || png_get_rowbytes(png, info) != static_cast<size_t>(w) * channels)
+      if (channels < 1 || channels > 4 ||
+          png_get_rowbytes(png, info) != static_cast<size_t>(w) * channels * bytes)
         png_error(png, "unexpected row layout");
-      r->img = Image(static_cast<int>(w), static_cast<int>(h), channels);
+      r->img = Image(static_cast<int>(w), static_cast<int>(h), channels * bytes);
+      if (wide != nullptr) *wide = bytes == 2;
       // Rows one at a time (interlaced images take several passes).
       const int passes = png_set_interlace_handling(png);
       for (int pass = 0; pass < passes; ++pass)
@@ -235,7 +242,12 @@ Image read_tga(const uint8_t* data, size_t size, const std::string& what) {
 
 // --- PNM (P5 grey, P6 RGB; maxval up to 65535, read to 8 bits) ------------------
 
-Image read_pnm(const uint8_t* data, size_t size, const std::string& what) {
+// keep16: a PNM of maxval > 255 keeps its samples, two bytes each
+// (big-endian) in an Image of twice the channels, *wide set, and *maxval_out
+// its maxval.
+Image read_pnm(const uint8_t* data, size_t size, const std::string& what, bool keep16 = false,
+               bool* wide = nullptr, int* maxval_out = nullptr) {
+  if (wide != nullptr) *wide = false;
   const bool grey = data[1] == '5';
   size_t at = 2;
   if (size < 3 || !(data[2] == ' ' || data[2] == '\t' || data[2] == '\r' || data[2] == '\n'))
@@ -272,6 +284,13 @@ Image read_pnm(const uint8_t* data, size_t size, const std::string& what) {
   if (size - at < need)
     refuse(what, "the PNM declares " + std::to_string(w) + "x" + std::to_string(h) + " pixels, " + std::to_string(need) +
                      " bytes, but " + std::to_string(size - at) + " follow its header");
+  if (maxval_out != nullptr) *maxval_out = static_cast<int>(maxval);
+  if (keep16 && sample == 2) {
+    Image img(static_cast<int>(w), static_cast<int>(h), channels * 2);
+    std::memcpy(img.pixels.data(), data + at, need);
+    if (wide != nullptr) *wide = true;
+    return img;
+  }
   Image img(static_cast<int>(w), static_cast<int>(h), channels);
   for (size_t i = 0; i < img.pixels.size(); ++i) {
     const int64_t v = sample == 2 ? (data[at + 2 * i] << 8) | data[at + 2 * i + 1] : data[at + i];
@@ -298,6 +317,40 @@ Image decode_image(const uint8_t* data, size_t size, const std::string& what, in
   else
     img = read_tga(data, size, what);
   return convert(img, want_channels);
+}
+
+Heightmap decode_heightmap(const uint8_t* data, size_t size, const std::string& what) {
+  if (size == 0) refuse(what, "the file is empty");
+  Heightmap hm;
+  Image img;
+  bool wide = false;
+  int maxval = 255;
+  if (size >= 8 && png_sig_cmp(data, 0, 8) == 0) {
+    img = read_png(data, size, what, true, &wide);
+    if (wide) maxval = 65535;
+  } else if (size >= 3 && data[0] == 'P' && (data[1] == '5' || data[1] == '6')) {
+    img = read_pnm(data, size, what, true, &wide, &maxval);
+    if (!wide) maxval = 255;
+  } else {
+    img = decode_image(data, size, what);
+  }
+  const int bytes = wide ? 2 : 1;
+  const int channels = img.channels / bytes;
+  hm.width = img.width;
+  hm.height = img.height;
+  const bool colour = channels >= 3;
+  if (colour && wide) refuse(what, "a colour heightmap of 16-bit samples (16-bit heightmaps are read in grey)");
+  hm.units_per_level = colour ? 3 : 1;
+  hm.max_value = maxval * hm.units_per_level;
+  const size_t n = static_cast<size_t>(img.width) * img.height;
+  hm.values.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    const uint8_t* p = &img.pixels[i * img.channels];
+    auto sample = [&](int c) { return bytes == 2 ? (p[2 * c] << 8) | p[2 * c + 1] : p[c]; };
+    const int v = colour ? sample(0) + sample(1) + sample(2) : sample(0);
+    hm.values[i] = static_cast<uint16_t>(v);
+  }
+  return hm;
 }
 
 }  // namespace vds::io

@@ -117,7 +117,8 @@ Scene read_bsp(const uint8_t* data, size_t size, const std::string& name, const 
 // an archive later in name order overrides an earlier one.
 class Pk3Set {
  public:
-  // Every .pk3 in `dir` (throws if there is none or one is not a zip).
+  // Every .pk3 in `dir` (throws if there is none or one is not a zip), or
+  // the one zip file `dir` names.
   explicit Pk3Set(const std::string& dir);
   ~Pk3Set();
   Pk3Set(const Pk3Set&) = delete;

@@ -37,6 +37,20 @@ Image load_image(const std::string& path, int want_channels = 0);
 // Decodes an in-memory image file (PNG, JPEG, binary PNM or TGA; the kind from its first
 // bytes, TGA when none matches).
 Image decode_image(const uint8_t* data, size_t size, const std::string& what, int want_channels = 0);
+// A heightmap: one height per pixel, in the file's own levels. Grey images
+// give their sample (8-bit, or 16-bit from a 16-bit PNG or a PGM of maxval
+// above 255); colour images the sum of R, G and B (units_per_level 3: a
+// grey drawn in colour keeps the small differences between its channels).
+// Alpha is ignored. Throws as load_image does.
+struct Heightmap {
+  int width = 0;
+  int height = 0;
+  int units_per_level = 1;   // values per level of the file (3 for colour)
+  int max_value = 255;       // the largest value the file's format can hold
+  std::vector<uint16_t> values;
+};
+Heightmap decode_heightmap(const uint8_t* data, size_t size, const std::string& what);
+
 // Writes a PNG (1, 3 or 4 channels). Throws std::runtime_error on failure.
 // The file appears whole or not at all (written beside it, then renamed);
 // what was at `path` before stays until then.

@@ -1,0 +1,464 @@
+// The terrain mode's server side (vds/enc/terrain_server.h).
+#include "vds/enc/terrain_server.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "vds/bytes.h"
+#include "vds/enc/arith_encoder.h"
+#include "vds/enc/dct.h"
+#include "vds/idct.h"
+#include "vds/image_model.h"
+
+namespace vds::enc {
+
+using terrain::Mask;
+using terrain::mask_extent;
+using terrain::mask_holds;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+using image_model::kZigzag;
+
+using V3 = std::array<double, 3>;
+V3 operator+(V3 a, V3 b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+V3 operator-(V3 a, V3 b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+V3 operator*(V3 a, double s) { return {a[0] * s, a[1] * s, a[2] * s}; }
+double dot(V3 a, V3 b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+V3 cross(V3 a, V3 b) { return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}; }
+V3 normalize(V3 a) {
+  const double l = std::sqrt(dot(a, a));
+  return l > 0 ? a * (1 / l) : a;
+}
+
+int round_level(double x) { return static_cast<int>(x < 0 ? -std::floor(-x + 0.5) : std::floor(x + 0.5)); }
+
+// The sample at (x, y) of plane c, clamped to the plane (blocks past the
+// padded edge repeat it).
+uint8_t plane_at(const Planes& p, int c, int x, int y) {
+  x = std::clamp(x, 0, p.plane_width(c) - 1);
+  y = std::clamp(y, 0, p.plane_height(c) - 1);
+  return p.row(c, y)[x];
+}
+
+// Block id -> component, and the block's position in its plane (in blocks).
+void block_place(const terrain::BlockGrid& g, uint32_t id, int* comp, int* bx, int* by) {
+  *comp = g.component(id);
+  uint32_t i = id;
+  int w = g.cells_x;
+  if (*comp > 0) {
+    i -= g.luma_blocks() + (*comp == 2 ? g.chroma_blocks() : 0);
+    w = g.chroma_x();
+  }
+  *bx = static_cast<int>(i % w);
+  *by = static_cast<int>(i / w);
+}
+
+}  // namespace
+
+// --- The terrain as coded ------------------------------------------------------------
+
+TerrainCoding code_terrain(const TerrainMap& map, int quantiser) {
+  if (quantiser < terrain::kMinQuantiser || quantiser > terrain::kMaxQuantiser)
+    throw std::invalid_argument("terrain quantiser " + std::to_string(quantiser) + " (1..62)");
+  TerrainCoding t;
+  t.quantiser = quantiser;
+  const int cx = (map.colour.width + 7) / 8, cy = (map.colour.height + 7) / 8;
+  if (cx > terrain::kMaxCells || cy > terrain::kMaxCells)
+    throw std::invalid_argument(map.name + ": a colour map of more than " + std::to_string(terrain::kMaxCells * 8) +
+                                " pixels on a side");
+  t.grid.cells_x = static_cast<uint16_t>(cx);
+  t.grid.cells_y = static_cast<uint16_t>(cy);
+
+  // The texture, padded to whole cells by repeating the last row and column.
+  io::Image padded(cx * 8, cy * 8, 3);
+  for (int y = 0; y < padded.height; ++y)
+    for (int x = 0; x < padded.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        padded.at(x, y, c) = map.colour.at(std::min(x, map.colour.width - 1), std::min(y, map.colour.height - 1), c);
+  t.texture = rgb_to_planes(padded, ChromaFormat::yuv420);
+
+  // The elevation at the cell corners: texel X of the colour map lies at
+  // sample X (width - 1) / colour width of the heightmap.
+  const double sx = static_cast<double>(map.width - 1) / map.colour.width;
+  const double sy = static_cast<double>(map.height - 1) / map.colour.height;
+  t.cell_m = 8 * sx * map.horizontal_scale;
+  t.metres_per_unit = map.metres_per_unit;
+  t.heights.resize(static_cast<size_t>(cx + 1) * (cy + 1));
+  for (int j = 0; j <= cy; ++j)
+    for (int i = 0; i <= cx; ++i) {
+      const double units = map.height_at(8 * i * sx, 8 * j * sy) / map.metres_per_unit;
+      t.heights[static_cast<size_t>(j) * (cx + 1) + i] = static_cast<uint16_t>(std::clamp(std::lround(units), 0L, 65535L));
+    }
+
+  // Every block's coefficients, quantised once.
+  t.levels.resize(t.grid.blocks());
+  for (uint32_t id = 0; id < t.grid.blocks(); ++id) {
+    int comp, bx, by;
+    block_place(t.grid, id, &comp, &bx, &by);
+    uint8_t px[64];
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) px[y * 8 + x] = plane_at(t.texture, comp, bx * 8 + x, by * 8 + y);
+    int16_t coef[64];
+    fdct8x8(px, 8, coef);
+    auto& lv = t.levels[id];
+    lv[0] = static_cast<int16_t>(std::clamp(round_level(coef[0] / 8.0), -128, 127));
+    for (int n = 1; n < 64; ++n) {
+      const double step = terrain::kIntraMatrix[n] * quantiser / 16.0;
+      lv[n] = static_cast<int16_t>(std::clamp(round_level(coef[n] / step), -terrain::kMaxLevel, terrain::kMaxLevel));
+    }
+  }
+  return t;
+}
+
+std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h) {
+  ArithEncoder ae;
+  terrain::ElevationContexts ctx;
+  terrain::init_elevation_contexts(ctx);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      int k = 3;
+      if (x > 0 && y > 0) {
+        const uint16_t* up = heights + static_cast<size_t>(y - 1) * w;
+        k = terrain::elevation_class(heights[static_cast<size_t>(y) * w + x - 1], up[x], up[x - 1]);
+      }
+      const int r = heights[static_cast<size_t>(y) * w + x] - terrain::elevation_predict(heights, w, x, y);
+      ae.encode_signed(ctx.zero[k], ctx.mag[k], 8, r, 16, 2);
+    }
+  return ae.finish();
+}
+
+void reconstruct_block(const TerrainCoding& t, uint32_t id, Mask held, uint8_t out[64]) {
+  int16_t coef[64];
+  for (int n = 0; n < 64; ++n)
+    coef[n] = mask_holds(held, n & 7, n >> 3) ? terrain::dequantise(t.levels[id][n], n, t.quantiser) : 0;
+  idct8x8_put(coef, out, 8);
+}
+
+Planes reconstruct_texture(const TerrainCoding& t, const std::vector<Mask>& held) {
+  Planes p = t.texture;
+  for (uint32_t id = 0; id < t.grid.blocks(); ++id) {
+    int comp, bx, by;
+    block_place(t.grid, id, &comp, &bx, &by);
+    uint8_t px[64];
+    if (held[id] != 0) reconstruct_block(t, id, held[id], px);
+    else std::fill(px, px + 64, uint8_t{128});
+    for (int y = 0; y < 8; ++y) {
+      const int py = by * 8 + y;
+      if (py >= p.plane_height(comp)) break;
+      for (int x = 0; x < 8; ++x) {
+        const int qx = bx * 8 + x;
+        if (qx < p.plane_width(comp)) p.row(comp, py)[qx] = px[y * 8 + x];
+      }
+    }
+  }
+  return p;
+}
+
+// --- Masks --------------------------------------------------------------------------------
+
+Mask shrink_mask(double cutoff, double cos_alpha, double beta_s) {
+  if (!(cutoff > 0)) return 0;
+  const double kd = std::min(cutoff, 1.0);
+  const double t = kd * std::clamp(cos_alpha, 0.0, 1.0);
+  const double sin_b = std::sin(beta_s), tan_b = std::tan(beta_s);
+  Mask m = 0;
+  for (int v = 0; v < 8; ++v) {
+    const double vv = (v + 0.5) / 8;
+    double limit;
+    if (vv > kd) {
+      limit = -1;
+    } else if (!(beta_s > 0) || sin_b == 0) {
+      limit = vv > t ? -1 : kd;
+    } else if (beta_s >= kPi / 2 || sin_b == 1) {
+      limit = std::min(kd, t);
+    } else {
+      limit = std::min(kd, t - (vv - t) / tan_b);
+    }
+    // Coefficients u with (u + 0.5) / 8 <= limit.
+    const int e = limit < 0 ? 0 : std::clamp(static_cast<int>(std::floor(8 * limit - 0.5)) + 1, 0, 8);
+    m = terrain::mask_with_extent(m, v, e);
+  }
+  if (mask_extent(m, 0) == 0) m = terrain::mask_with_extent(m, 0, 1);  // the DC stays
+  return m;
+}
+
+std::vector<Mask> pose_masks(const TerrainCoding& t, const SceneCamera& cam, const PoseOptions& o,
+                             std::vector<BlockView>* views_out) {
+  const terrain::BlockGrid& g = t.grid;
+  std::vector<Mask> masks(g.blocks(), 0);
+  std::vector<BlockView> views(g.blocks());
+  const double texel_m = t.cell_m / 8;
+  for (int j = 0; j < g.cells_y; ++j) {
+    for (int i = 0; i < g.cells_x; ++i) {
+      const V3 p[4] = {t.point(i, j), t.point(i + 1, j), t.point(i, j + 1), t.point(i + 1, j + 1)};
+      // In front of the camera, and on the screen.
+      double x0 = 1e30, y0 = 1e30, x1 = -1e30, y1 = -1e30;
+      int in_front = 0;
+      for (const V3& q : p) {
+        const V3 r = q - cam.position;
+        const double cz = dot(r, cam.forward);
+        if (cz <= o.near_m) continue;
+        ++in_front;
+        const double sx = cam.cx + cam.focal * dot(r, cam.right) / cz;
+        const double sy = cam.cy + cam.focal * dot(r, cam.down) / cz;
+        x0 = std::min(x0, sx), x1 = std::max(x1, sx), y0 = std::min(y0, sy), y1 = std::max(y1, sy);
+      }
+      if (in_front == 0) continue;
+      if (in_front == 4 && (x1 < 0 || y1 < 0 || x0 > cam.width || y0 > cam.height)) continue;
+      // Facing the viewer.
+      const V3 centre = (p[0] + p[1] + p[2] + p[3]) * 0.25;
+      const V3 n = normalize(cross(p[3] - p[0], p[2] - p[1]));
+      const V3 to_eye = cam.position - centre;
+      if (dot(n, to_eye) <= 0) continue;
+      // Distance to the nearest point of the cell's bounds.
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double lo = std::min({p[0][k], p[1][k], p[2][k], p[3][k]});
+        const double hi = std::max({p[0][k], p[1][k], p[2][k], p[3][k]});
+        const double e = cam.position[k];
+        const double dd = e < lo ? lo - e : (e > hi ? e - hi : 0);
+        d2 += dd * dd;
+      }
+      const double dist = std::max(std::sqrt(d2), 1e-6);
+      const V3 v = normalize(to_eye);
+      const double cos_a = std::clamp(dot(n, v), 0.0, 1.0);
+      // The direction the tilt foreshortens, in texture axes.
+      const V3 d = v - n * dot(v, n);
+      const V3 tu = normalize((p[1] - p[0]) + (p[3] - p[2]));
+      const V3 tv = normalize((p[2] - p[0]) + (p[3] - p[1]));
+      const double du = std::fabs(dot(d, tu)), dv = std::fabs(dot(d, tv));
+      const double beta = (du == 0 && dv == 0) ? 0 : std::atan2(dv, du);
+      const double beta_s = kPi / 2 - beta;
+      const double ppt = o.detail * cam.focal * texel_m / dist;
+      const double pixels = std::min(ppt * ppt * 64 * std::max(cos_a, 0.05), 1.0 * cam.width * cam.height);
+
+      const uint32_t luma = static_cast<uint32_t>(j) * g.cells_x + i;
+      masks[luma] = shrink_mask(ppt, cos_a, beta_s);
+      views[luma] = BlockView{true, ppt, cos_a, beta_s, pixels};
+      // Chroma: texels twice the size, one block for 2 x 2 cells.
+      const uint32_t c = static_cast<uint32_t>(j / 2) * g.chroma_x() + i / 2;
+      const Mask cm = shrink_mask(2 * ppt, cos_a, beta_s);
+      for (int comp = 1; comp <= 2; ++comp) {
+        const uint32_t id = g.luma_blocks() + (comp - 1) * g.chroma_blocks() + c;
+        masks[id] = terrain::mask_union(masks[id], cm);
+        BlockView& cv = views[id];
+        if (!cv.visible || 2 * ppt > cv.cutoff) cv = BlockView{true, 2 * ppt, cos_a, beta_s, cv.pixels};
+        cv.pixels += pixels;
+      }
+    }
+  }
+  if (views_out != nullptr) *views_out = std::move(views);
+  return masks;
+}
+
+// --- Updates ----------------------------------------------------------------------------------
+
+namespace {
+
+struct UpdateWriter {
+  const TerrainCoding& t;
+  ArithEncoder ae;
+  terrain::TextureContexts ctx{};
+  int64_t last_id = -1;
+  int dc_prev[3] = {};
+
+  explicit UpdateWriter(const TerrainCoding& tc) : t(tc) { terrain::init_texture_contexts(ctx); }
+
+  void id(uint32_t id) {
+    ae.encode_exp_golomb(ctx.id_gap, 8, static_cast<uint32_t>(id - last_id - 1), 0);
+    last_id = id;
+  }
+
+  void mask(Mask held, Mask m, bool grow) {
+    int above = 8;
+    for (int v = 0; v < 8; ++v) {
+      const int h = mask_extent(held, v), e = mask_extent(m, v);
+      if (grow) {
+        ae.encode_unary(&ctx.extent[1][v], 1, static_cast<uint32_t>(e - h), static_cast<uint32_t>(above - h));
+      } else {
+        const int cap = std::min(h, above);
+        ae.encode_unary(&ctx.extent[0][v], 1, static_cast<uint32_t>(cap - e), static_cast<uint32_t>(cap));
+      }
+      above = e;
+    }
+  }
+
+  void coefficients(uint32_t id, Mask held, Mask m) {
+    const int comp = t.grid.component(id), cls = comp == 0 ? 0 : 1;
+    const auto& lv = t.levels[id];
+    const bool intra = held == 0;
+    if (intra) {
+      ae.encode_signed(ctx.dc_zero[comp], ctx.dc_mag[comp], 6, lv[0] - dc_prev[comp], 8, 1);
+      dc_prev[comp] = lv[0];
+    }
+    int pos[63], n = 0;
+    for (int k = 1; k < 64; ++k) {
+      const int nat = kZigzag[k];
+      if (mask_holds(m, nat & 7, nat >> 3) && !mask_holds(held, nat & 7, nat >> 3)) pos[n++] = k;
+    }
+    if (n == 0) return;
+    int last = -1;
+    for (int i = 0; i < n; ++i)
+      if (lv[kZigzag[pos[i]]] != 0) last = i;
+    ae.encode_bit(ctx.cbf[intra ? 0 : 1][cls], last >= 0 ? 1 : 0);
+    if (last < 0) return;
+    bool any = false;
+    for (int i = 0; i <= last; ++i) {
+      const int k = pos[i], pc = terrain::position_class(k);
+      const int v = lv[kZigzag[k]];
+      if (!(i == n - 1 && !any)) ae.encode_bit(ctx.sig[cls][pc], v != 0 ? 1 : 0);
+      if (v == 0) continue;
+      ae.encode_ueg(&ctx.level[cls][pc], 1, static_cast<uint32_t>(std::abs(v) - 1), 14, 0);
+      ae.encode_bypass(v < 0 ? 1 : 0);
+      any = true;
+      if (i < n - 1) ae.encode_bit(ctx.last[cls][pc], i == last ? 1 : 0);
+    }
+  }
+};
+
+}  // namespace
+
+std::vector<uint8_t> encode_update(const TerrainCoding& t, const std::vector<Mask>& held, uint32_t frame,
+                                   const std::vector<BlockChange>& shrinks, const std::vector<BlockChange>& grows) {
+  if (shrinks.size() > 0xFFFF || grows.size() > 0xFFFF) throw std::invalid_argument("encode_update: too many blocks");
+  UpdateWriter w(t);
+  for (const BlockChange& s : shrinks) {
+    w.id(s.id);
+    w.mask(held[s.id], s.mask, false);
+  }
+  w.last_id = -1;
+  for (const BlockChange& g : grows) {
+    // A block both shrunk and grown in one update grows from what the
+    // shrink left.
+    Mask before = held[g.id];
+    for (const BlockChange& s : shrinks)
+      if (s.id == g.id) before = s.mask;
+    w.id(g.id);
+    w.mask(before, g.mask, true);
+    w.coefficients(g.id, before, g.mask);
+  }
+  std::vector<uint8_t> body = w.ae.finish();
+  std::vector<uint8_t> out(8 + body.size());
+  store_le32(out.data(), frame);
+  store_le16(out.data() + 4, static_cast<uint32_t>(shrinks.size()));
+  store_le16(out.data() + 6, static_cast<uint32_t>(grows.size()));
+  std::copy(body.begin(), body.end(), out.begin() + 8);
+  return out;
+}
+
+TerrainServer::TerrainServer(const TerrainCoding& t, uint32_t capacity)
+    : t_(t), capacity_(capacity), held_(t.grid.blocks(), 0), last_needed_(t.grid.blocks(), 0) {}
+
+std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t frame, size_t budget,
+                                           const PoseOptions& o, UpdateStats* stats) {
+  std::vector<BlockView> views;
+  const std::vector<Mask> need = pose_masks(t_, camera, o, &views);
+  const uint32_t n = t_.grid.blocks();
+  for (uint32_t b = 0; b < n; ++b)
+    if (need[b] != 0) last_needed_[b] = frame + 1;
+
+  // What the pose lacks, the most visible first.
+  std::vector<uint32_t> wanted;
+  for (uint32_t b = 0; b < n; ++b)
+    if (!terrain::mask_covers(held_[b], need[b])) wanted.push_back(b);
+  std::stable_sort(wanted.begin(), wanted.end(),
+                   [&](uint32_t a, uint32_t b) { return views[a].pixels > views[b].pixels; });
+
+  // Room in the store: blocks the pose does not need, the longest unneeded
+  // first; then what needed blocks hold beyond the need, the least visible first.
+  std::vector<uint32_t> unneeded, excess;
+  for (uint32_t b = 0; b < n; ++b) {
+    if (held_[b] == 0) continue;
+    if (need[b] == 0) unneeded.push_back(b);
+    else if (held_[b] != terrain::mask_intersection(held_[b], need[b])) excess.push_back(b);
+  }
+  std::stable_sort(unneeded.begin(), unneeded.end(),
+                   [&](uint32_t a, uint32_t b) { return last_needed_[a] < last_needed_[b]; });
+  std::stable_sort(excess.begin(), excess.end(),
+                   [&](uint32_t a, uint32_t b) { return views[a].pixels < views[b].pixels; });
+  size_t next_unneeded = 0, next_excess = 0;
+
+  // before[b]: the block after this update's shrinks, which its grow starts from.
+  std::vector<Mask> after = held_, before = held_;
+  std::vector<uint8_t> shrunk(n, 0);
+  uint32_t used = used_;
+  auto shrink_to = [&](uint32_t b, Mask m) {
+    if (m == after[b]) return;
+    used -= static_cast<uint32_t>(terrain::mask_count(after[b]) - terrain::mask_count(m));
+    after[b] = before[b] = m;
+    shrunk[b] = 1;
+  };
+  std::vector<uint32_t> picked;
+  std::vector<uint8_t> is_picked(n, 0);
+  UpdateWriter trial(t_);
+  for (uint32_t b : wanted) {
+    const Mask target = terrain::mask_union(after[b], need[b]);
+    const uint32_t add = static_cast<uint32_t>(terrain::mask_count(target) - terrain::mask_count(after[b]));
+    // The cost of this block, estimated in the order of choice.
+    trial.mask(after[b], target, true);
+    trial.coefficients(b, after[b], target);
+    if (8 + trial.ae.finished_size() + picked.size() / 2 > budget) break;
+    while (used + add > capacity_) {
+      if (next_unneeded < unneeded.size()) {
+        const uint32_t v = unneeded[next_unneeded++];
+        if (!is_picked[v]) shrink_to(v, 0);
+      } else if (next_excess < excess.size()) {
+        const uint32_t v = excess[next_excess++];
+        if (!is_picked[v] && v != b) shrink_to(v, terrain::mask_intersection(after[v], need[v]));
+      } else {
+        break;
+      }
+    }
+    if (used + add > capacity_) break;  // the store is full of what the pose needs
+    used += add;
+    after[b] = target;
+    picked.push_back(b);
+    is_picked[b] = 1;
+  }
+
+  // Shrinks and grows by ascending id; trim the least visible grows while
+  // the coded update is over the budget.
+  // A block shrunk to make room and then grown again is sent as both.
+  std::vector<BlockChange> shrinks;
+  for (uint32_t b = 0; b < n; ++b)
+    if (shrunk[b]) shrinks.push_back({b, before[b]});
+  std::vector<uint8_t> out;
+  for (;;) {
+    std::vector<BlockChange> grows;
+    for (uint32_t b : picked) grows.push_back({b, after[b]});
+    std::sort(grows.begin(), grows.end(), [](const BlockChange& a, const BlockChange& b) { return a.id < b.id; });
+    if (shrinks.empty() && grows.empty()) break;
+    out = encode_update(t_, held_, frame, shrinks, grows);
+    if (out.size() <= budget || picked.empty()) break;
+    const size_t drop = std::max<size_t>(1, picked.size() / 16);
+    for (size_t k = 0; k < drop && !picked.empty(); ++k) {
+      const uint32_t b = picked.back();
+      picked.pop_back();
+      used -= static_cast<uint32_t>(terrain::mask_count(after[b]) - terrain::mask_count(before[b]));
+      after[b] = before[b];
+    }
+  }
+  if (stats != nullptr) {
+    *stats = UpdateStats{};
+    stats->shrinks = static_cast<uint32_t>(shrinks.size());
+    stats->grows = static_cast<uint32_t>(picked.size());
+    for (const BlockChange& s : shrinks)
+      stats->dropped += static_cast<uint32_t>(terrain::mask_count(held_[s.id]) - terrain::mask_count(s.mask));
+    for (uint32_t b : picked) {
+      if (before[b] == 0) ++stats->intra;
+      stats->coefficients += static_cast<uint32_t>(terrain::mask_count(after[b]) - terrain::mask_count(before[b]));
+    }
+    for (uint32_t b = 0; b < n; ++b)
+      if (!terrain::mask_covers(after[b], need[b])) ++stats->wanted;
+    stats->bytes = out.size();
+  }
+  held_ = std::move(after);
+  used_ = used;
+  return out;
+}
+
+}  // namespace vds::enc

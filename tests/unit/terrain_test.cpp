@@ -1,0 +1,426 @@
+// Terrain mode: maps in (Trigger Rally levels, heightmaps of any depth),
+// the elevation coder, the shrinking masks against a double-precision
+// reading of the paper's rule, and the texture updates: the client's store
+// equals the server's mirror after every update, nothing is sent twice
+// unless it was dropped, nothing is missing after eviction, every update
+// keeps its byte budget and every prefix of one is refused.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "vds/enc/stream_writer.h"
+#include "vds/enc/terrain_map.h"
+#include "vds/enc/terrain_server.h"
+#include "vds/io/image.h"
+#include "vds/terrain.h"
+#include "xorshift.h"
+
+namespace {
+
+using vds::Status;
+using vds::terrain::Mask;
+namespace enc = vds::enc;
+namespace terrain = vds::terrain;
+
+constexpr double kPi = 3.14159265358979323846;
+
+// --- Maps -------------------------------------------------------------------------------
+
+std::vector<uint8_t> bytes_of(const std::string& s) { return {s.begin(), s.end()}; }
+
+std::string level_xml(const std::string& terrain_attrs) {
+  return "<?xml version=\"1.0\" ?>\n<level name=\"T\">\n <terrain " + terrain_attrs + " >\n </terrain>\n</level>\n";
+}
+
+TEST(TerrainMap, ParsesATriggerRallyLevel) {
+  const auto b = bytes_of(level_xml(
+      "heightmap=\"h.png\" colormap=\"c.jpg\" tilesize=\"64\" horizontalscale=\"2.5\" verticalscale=\"0.3\""));
+  const enc::TerrainLevel t = enc::parse_level(b.data(), b.size(), "x.level");
+  EXPECT_EQ(t.heightmap, "h.png");
+  EXPECT_EQ(t.colormap, "c.jpg");
+  EXPECT_DOUBLE_EQ(t.horizontal_scale, 2.5);
+  EXPECT_DOUBLE_EQ(t.vertical_scale, 0.3);
+}
+
+TEST(TerrainMap, RefusesBadLevelsNamingTheFileAndTheFault) {
+  const struct {
+    std::string text, says;
+  } cases[] = {
+      {"", "empty"},
+      {"not xml <", "not an XML document"},
+      {"<other/>", "no <level>"},
+      {"<level></level>", "no <terrain>"},
+      {level_xml("colormap=\"c.jpg\" horizontalscale=\"1\" verticalscale=\"1\""), "no heightmap"},
+      {level_xml("heightmap=\"h.png\" colormap=\"c.jpg\" horizontalscale=\"-1\" verticalscale=\"1\""),
+       "horizontalscale=\"-1\""},
+      {level_xml("heightmap=\"h.png\" colormap=\"c.jpg\" horizontalscale=\"1\" verticalscale=\"nan\""),
+       "verticalscale=\"nan\""},
+      {level_xml("heightmap=\"h.png\" colormap=\"c.jpg\" horizontalscale=\"1x\" verticalscale=\"1\""),
+       "horizontalscale=\"1x\""},
+      {level_xml("heightmap=\"../h.png\" colormap=\"c.jpg\" horizontalscale=\"1\" verticalscale=\"1\""),
+       "not a file name beside the level"},
+      {level_xml("heightmap=\"h.png\" colormap=\"/etc/passwd\" horizontalscale=\"1\" verticalscale=\"1\""),
+       "not a file name beside the level"},
+  };
+  for (const auto& c : cases) {
+    const auto b = bytes_of(c.text);
+    try {
+      enc::parse_level(b.data(), b.size(), "bad.level");
+      ADD_FAILURE() << "accepted: " << c.text;
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("bad.level: ", 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.says), std::string::npos) << e.what();
+    }
+  }
+}
+
+// A binary PGM of 16-bit samples.
+std::vector<uint8_t> pgm16(int w, int h, const std::vector<uint16_t>& v) {
+  const std::string head = "P5\n" + std::to_string(w) + " " + std::to_string(h) + "\n65535\n";
+  std::vector<uint8_t> out(head.begin(), head.end());
+  for (uint16_t s : v) {
+    out.push_back(static_cast<uint8_t>(s >> 8));
+    out.push_back(static_cast<uint8_t>(s & 255));
+  }
+  return out;
+}
+
+std::vector<uint8_t> png_bytes(const vds::io::Image& img, const std::string& name) {
+  const std::string path = std::string(VDS_TEST_TMP) + "/" + name;
+  vds::io::save_png(path, img);
+  return enc::read_file(path);
+}
+
+TEST(TerrainMap, ReadsSixteenBitAndColourHeightmaps) {
+  std::vector<uint16_t> v(5 * 4);
+  for (size_t i = 0; i < v.size(); ++i) v[i] = static_cast<uint16_t>(i * 3000 + 7);
+  const auto h = pgm16(5, 4, v);
+  vds::io::Image colour(16, 16, 3);
+  for (size_t i = 0; i < colour.pixels.size(); ++i) colour.pixels[i] = static_cast<uint8_t>(i * 7);
+  const auto c = png_bytes(colour, "terrain_colour.png");
+  const enc::TerrainMap m = enc::read_terrain(h.data(), h.size(), "h.pgm", c.data(), c.size(), "c.png", 2.0, 0.01);
+  EXPECT_EQ(m.width, 5);
+  EXPECT_EQ(m.height, 4);
+  EXPECT_EQ(m.heights, v);  // every 16-bit level kept
+  EXPECT_DOUBLE_EQ(m.metres_per_unit, 0.01);
+  EXPECT_NEAR(m.height_at(1, 0), v[1] * 0.01, 1e-9);
+  EXPECT_NEAR(m.height_at(0.5, 0), (v[0] + v[1]) * 0.005, 1e-9);
+
+  // A colour heightmap: R + G + B, a third of a level each.
+  vds::io::Image rgb(4, 4, 3);
+  for (int i = 0; i < 16; ++i) {
+    rgb.pixels[3 * i] = static_cast<uint8_t>(10 * i);
+    rgb.pixels[3 * i + 1] = static_cast<uint8_t>(10 * i + 1);
+    rgb.pixels[3 * i + 2] = static_cast<uint8_t>(10 * i);
+  }
+  const auto hr = png_bytes(rgb, "terrain_rgb_heights.png");
+  const enc::TerrainMap r = enc::read_terrain(hr.data(), hr.size(), "h.png", c.data(), c.size(), "c.png", 1.0, 0.3);
+  EXPECT_EQ(r.heights[5], 30 * 5 + 1);
+  EXPECT_DOUBLE_EQ(r.metres_per_unit, 0.1);
+}
+
+TEST(TerrainMap, RefusesMapsItCannotUse) {
+  vds::io::Image colour(16, 16, 3);
+  const auto c = png_bytes(colour, "terrain_colour2.png");
+  const auto one = pgm16(1, 1, {5});
+  const auto ok = pgm16(2, 2, {1, 2, 3, 4});
+  const auto tiny = png_bytes(vds::io::Image(4, 4, 3), "terrain_tiny.png");
+  auto refuses = [&](const std::vector<uint8_t>& h, const std::vector<uint8_t>& col, double hs, const char* file,
+                     const char* says) {
+    try {
+      enc::read_terrain(h.data(), h.size(), "h.pgm", col.data(), col.size(), "c.png", hs, 1.0);
+      ADD_FAILURE() << "accepted (" << says << ")";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(file, 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  };
+  refuses(one, c, 1.0, "h.pgm", "1x1 heightmap");
+  refuses(ok, tiny, 1.0, "c.png", "4x4 colour map");
+  refuses(ok, c, 0.0, "h.pgm", "scales must be positive");
+  refuses({}, c, 1.0, "h.pgm", "empty");
+  const std::vector<uint8_t> short_pgm = {'P', '5', '\n', '9', ' ', '9', '\n', '2', '5', '5', '\n', 1, 2};
+  refuses(short_pgm, c, 1.0, "h.pgm", "follow its header");
+  EXPECT_THROW(enc::load_terrain(std::string(VDS_TEST_TMP) + "/no such map.level"), std::runtime_error);
+  EXPECT_THROW(enc::load_terrain("../escape"), std::runtime_error);
+}
+
+// The installed Trigger Rally maps (scripts/fetch-data.sh installs them).
+TEST(TerrainMap, ReadsTriggerRallyMapsFromTheirArchive) {
+  const enc::TerrainMap m = enc::load_terrain("altitude");
+  EXPECT_EQ(m.name, "altitude");
+  EXPECT_EQ(m.width, 1024);
+  EXPECT_EQ(m.height, 1024);
+  EXPECT_EQ(m.colour.width, 1024);
+  EXPECT_GT(m.horizontal_scale, 0);
+  const enc::TerrainMap rgb = enc::load_terrain(enc::trigger_rally_zip() + ":bender");  // an RGB heightmap
+  uint16_t top = 0;
+  for (uint16_t h : rgb.heights) top = std::max(top, h);
+  EXPECT_GT(top, 255);  // R + G + B
+  EXPECT_LE(top, 765);
+  EXPECT_THROW(enc::load_terrain("no-such-map"), std::runtime_error);
+}
+
+// --- Elevation -------------------------------------------------------------------------
+
+TEST(TerrainElevation, RoundTripsExactlyAndRefusesEveryPrefix) {
+  const int w = 33, h = 29;
+  std::vector<uint16_t> v(static_cast<size_t>(w) * h);
+  vds::test::Xorshift32 rng{5};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double s = 20000 + 15000 * std::sin(x * 0.2) * std::cos(y * 0.15);
+      v[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(s + (rng.next() % 9));
+    }
+  v[0] = 0;
+  v[5] = 65535;  // the extremes, next to each other's neighbours
+  v[6] = 0;
+  const std::vector<uint8_t> coded = enc::encode_elevation(v.data(), w, h);
+  std::vector<uint16_t> out(v.size(), 1);
+  ASSERT_EQ(terrain::decode_elevation(coded.data(), coded.size(), w, h, out.data()), Status::ok);
+  EXPECT_EQ(out, v);
+  EXPECT_LT(coded.size(), v.size() * 2);  // under 16 bits a point, on steep ground
+  for (size_t n = 0; n < coded.size(); ++n)
+    EXPECT_NE(terrain::decode_elevation(coded.data(), n, w, h, out.data()), Status::ok) << n;
+  std::vector<uint8_t> longer = coded;
+  longer.push_back(0x55);
+  EXPECT_EQ(terrain::decode_elevation(longer.data(), longer.size(), w, h, out.data()), Status::malformed);
+}
+
+// --- Masks ----------------------------------------------------------------------------------
+
+// The paper's rule (section 4.5) coefficient by coefficient, in double, as
+// written, with the DC kept.
+bool reference_keeps(int u, int v, double kd, double cos_a, double beta_s) {
+  if (u == 0 && v == 0) return kd > 0;
+  if (!(kd > 0)) return false;
+  kd = std::min(kd, 1.0);
+  const double U = (u + 0.5) / 8, V = (v + 0.5) / 8, T = kd * cos_a;
+  if (U > kd || V > kd) return false;
+  const double s = std::sin(beta_s);
+  if (beta_s == 0 && V > T) return false;
+  if (beta_s == 0) return true;
+  if (beta_s == kPi / 2 && U > T) return false;
+  if (beta_s == kPi / 2) return true;
+  return !(U > T - (V - T) / std::tan(beta_s)) || s == 0;
+}
+
+// How far (u, v) is from changing the reference's answer (ties are where
+// two correct implementations may round differently).
+double boundary_distance(int u, int v, double kd, double cos_a, double beta_s) {
+  kd = std::min(kd, 1.0);
+  const double U = (u + 0.5) / 8, V = (v + 0.5) / 8, T = kd * cos_a;
+  double d = std::min(std::fabs(U - kd), std::fabs(V - kd));
+  if (beta_s > 0 && beta_s < kPi / 2) d = std::min(d, std::fabs(U - (T - (V - T) / std::tan(beta_s))));
+  else d = std::min(d, beta_s == 0 ? std::fabs(V - T) : std::fabs(U - T));
+  return d;
+}
+
+TEST(TerrainMask, MatchesTheDoubleReferenceOfThePapersRule) {
+  vds::test::Xorshift32 rng{11};
+  int compared = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double kd = (rng.next() % 1500) / 1000.0;
+    const double cos_a = (rng.next() % 1001) / 1000.0;
+    const int b = static_cast<int>(rng.next() % 92);  // 0 and 90 degrees exactly, and between
+    const double beta_s = b == 91 ? kPi / 2 : b * kPi / 180;
+    const Mask m = enc::shrink_mask(kd, cos_a, beta_s);
+    ASSERT_TRUE(terrain::mask_valid(m)) << std::hex << m;
+    for (int v = 0; v < 8; ++v)
+      for (int u = 0; u < 8; ++u) {
+        if (!(u == 0 && v == 0) && boundary_distance(u, v, kd, cos_a, beta_s) < 1e-9) continue;
+        ASSERT_EQ(terrain::mask_holds(m, u, v), reference_keeps(u, v, kd, cos_a, beta_s))
+            << "u " << u << " v " << v << " k/D " << kd << " cos " << cos_a << " beta_s " << beta_s;
+        ++compared;
+      }
+  }
+  EXPECT_GT(compared, 1000000);
+}
+
+TEST(TerrainMask, ShapesFollowDepthTiltAndRotation) {
+  EXPECT_EQ(enc::shrink_mask(1.0, 1.0, kPi / 4), terrain::kFullMask);      // a texel a pixel, facing
+  EXPECT_EQ(enc::shrink_mask(3.0, 1.0, 0.3), terrain::kFullMask);          // magnified
+  EXPECT_EQ(enc::shrink_mask(0.0, 1.0, 0.3), 0u);                          // nothing
+  EXPECT_EQ(enc::shrink_mask(0.01, 1.0, 0.3), 0x00000001u);                // far: the DC alone
+  EXPECT_EQ(enc::shrink_mask(0.5, 1.0, kPi / 2), 0x00004444u);             // depth: a 4x4 corner
+  EXPECT_EQ(enc::shrink_mask(1.0, 0.5, kPi / 2), 0x44444444u);             // tilted along u: half the u's
+  EXPECT_EQ(enc::shrink_mask(1.0, 0.5, 0.0), 0x00008888u);                 // along v: half the v's
+  // Nearer never needs less.
+  for (double kd = 0.05; kd < 1.2; kd += 0.05)
+    EXPECT_TRUE(terrain::mask_covers(enc::shrink_mask(kd + 0.05, 0.7, 0.6), enc::shrink_mask(kd, 0.7, 0.6)));
+  // Union and intersection row by row.
+  EXPECT_EQ(terrain::mask_union(0x00004444u, 0x00000088u), 0x00004488u);
+  EXPECT_EQ(terrain::mask_intersection(0x00004444u, 0x00000088u), 0x00000044u);
+  EXPECT_EQ(terrain::mask_count(terrain::kFullMask), 64);
+  EXPECT_FALSE(terrain::mask_valid(0x00000010u));  // a row longer than the one above
+  EXPECT_FALSE(terrain::mask_valid(0x00000009u));  // an extent past 8
+}
+
+// --- Updates -----------------------------------------------------------------------------
+
+// A small terrain: 24 x 20 cells of a coloured, hilly map.
+enc::TerrainMap test_map() {
+  enc::TerrainMap m;
+  m.name = "test";
+  m.width = 97;
+  m.height = 81;
+  m.horizontal_scale = 2;
+  m.metres_per_unit = 0.05;
+  m.heights.resize(static_cast<size_t>(m.width) * m.height);
+  for (int y = 0; y < m.height; ++y)
+    for (int x = 0; x < m.width; ++x)
+      m.heights[static_cast<size_t>(y) * m.width + x] =
+          static_cast<uint16_t>(600 + 300 * std::sin(x * 0.08) + 250 * std::cos(y * 0.11 + x * 0.03));
+  m.colour = vds::io::Image(192, 160, 3);
+  for (int y = 0; y < 160; ++y)
+    for (int x = 0; x < 192; ++x) {
+      m.colour.at(x, y, 0) = static_cast<uint8_t>(128 + 100 * std::sin(x * 0.3) * std::cos(y * 0.2));
+      m.colour.at(x, y, 1) = static_cast<uint8_t>((x * 3 + y) & 255);
+      m.colour.at(x, y, 2) = static_cast<uint8_t>(((x / 6 + y / 6) & 1) ? 200 : 40);
+    }
+  return m;
+}
+
+// A flight over it: out, a turn, a climb, and back where it began.
+enc::SceneCamera flight_camera(const enc::TerrainCoding& t, int f, int frames) {
+  const double w = t.grid.cells_x * t.cell_m, d = t.grid.cells_y * t.cell_m;
+  const double s = static_cast<double>(f % frames) / frames;
+  const double a = 2 * kPi * s;
+  enc::CameraPose p;
+  p.x = w * (0.5 + 0.35 * std::cos(a));
+  p.y = d * (0.5 + 0.35 * std::sin(a));
+  p.z = 60 + 80 * std::sin(a) * std::sin(a);
+  p.yaw_deg = std::fmod(a * 180 / kPi + 90 + 360, 360);
+  p.pitch_deg = -25;
+  return enc::scene_camera(p, 70, 240, 180);
+}
+
+// The client side: the masks and coefficients the updates leave.
+struct Client {
+  std::vector<Mask> masks;
+  std::vector<std::array<int16_t, 64>> levels;
+  std::map<std::pair<uint32_t, int>, int> received;  // (block, coefficient) -> times
+  explicit Client(uint32_t blocks) : masks(blocks, 0), levels(blocks) {}
+  static Mask held(void* ctx, uint32_t id) { return static_cast<Client*>(ctx)->masks[id]; }
+  Status apply(const std::vector<uint8_t>& u, const terrain::BlockGrid& g) {
+    terrain::TextureUpdateReader r;
+    Status s = r.init(u.data(), u.size(), g, &Client::held, this);
+    if (s != Status::ok) return s;
+    terrain::BlockUpdate b;
+    while ((s = r.next(&b)) == Status::ok) {
+      auto& lv = levels[b.id];
+      for (int n = 0; n < 64; ++n) {
+        const bool had = terrain::mask_holds(b.held, n & 7, n >> 3), has = terrain::mask_holds(b.mask, n & 7, n >> 3);
+        if (!has) lv[n] = 0;
+        if (has && !had) {
+          lv[n] = b.levels[n];
+          ++received[{b.id, n}];
+        }
+      }
+      masks[b.id] = b.mask;
+    }
+    return s == Status::more_input && r.done() ? Status::ok : s;
+  }
+};
+
+TEST(TerrainUpdates, TheClientHoldsWhatTheServerMirrorsAndNothingIsSentTwiceUnlessDropped) {
+  const enc::TerrainCoding t = enc::code_terrain(test_map(), 6);
+  const uint32_t blocks = t.grid.blocks();
+  const uint32_t capacity = 6000;  // well under what the flight sees: the store evicts
+  enc::TerrainServer server(t, capacity);
+  Client client(blocks);
+  std::map<std::pair<uint32_t, int>, int> dropped;
+  const int frames = 120;
+  const size_t budget = 600;
+  uint32_t grows = 0, shrinks = 0;
+  for (int f = 0; f < 2 * frames; ++f) {
+    const std::vector<Mask> before = server.held();
+    enc::UpdateStats st;
+    const std::vector<uint8_t> u = server.update(flight_camera(t, f, frames), static_cast<uint32_t>(f), budget, {}, &st);
+    ASSERT_LE(u.size(), budget);
+    ASSERT_LE(server.used(), capacity);
+    grows += st.grows;
+    shrinks += st.shrinks;
+    if (u.empty()) continue;
+    ASSERT_EQ(client.apply(u, t.grid), Status::ok) << "frame " << f;
+    ASSERT_EQ(client.masks, server.held()) << "frame " << f;
+    for (uint32_t b = 0; b < blocks; ++b)
+      for (int n = 0; n < 64; ++n)
+        if (terrain::mask_holds(before[b], n & 7, n >> 3) && !terrain::mask_holds(server.held()[b], n & 7, n >> 3))
+          ++dropped[{b, n}];
+  }
+  EXPECT_GT(grows, 500u);
+  EXPECT_GT(shrinks, 50u);  // the store was full
+  // What the client holds is the encoder's quantised coefficients.
+  for (uint32_t b = 0; b < blocks; ++b)
+    for (int n = 0; n < 64; ++n)
+      ASSERT_EQ(client.levels[b][n], terrain::mask_holds(client.masks[b], n & 7, n >> 3) ? t.levels[b][n] : 0);
+  // Sent n times means dropped n - 1 or n times in between.
+  size_t resent = 0;
+  for (const auto& [key, times] : client.received) {
+    const int d = dropped.count(key) ? dropped.at(key) : 0;
+    const bool held_now = terrain::mask_holds(client.masks[key.first], key.second & 7, key.second >> 3);
+    ASSERT_EQ(times - (held_now ? 1 : 0), d) << "block " << key.first << " coefficient " << key.second;
+    if (times > 1) ++resent;
+  }
+  EXPECT_GT(resent, 0u);  // the second lap resends what eviction dropped
+}
+
+TEST(TerrainUpdates, AStillViewerGetsEverythingItNeedsAndThenNothing) {
+  const enc::TerrainCoding t = enc::code_terrain(test_map(), 6);
+  enc::TerrainServer server(t, 1u << 20);
+  Client client(t.grid.blocks());
+  const enc::SceneCamera cam = flight_camera(t, 10, 100);
+  const std::vector<Mask> need = enc::pose_masks(t, cam, {});
+  uint32_t visible = 0;
+  for (Mask m : need) visible += m != 0;
+  EXPECT_GT(visible, 100u);
+  int updates = 0;
+  for (int f = 0; f < 200; ++f) {
+    enc::UpdateStats st;
+    const auto u = server.update(cam, static_cast<uint32_t>(f), 500, {}, &st);
+    if (u.empty()) break;
+    ++updates;
+    ASSERT_EQ(client.apply(u, t.grid), Status::ok);
+  }
+  EXPECT_GT(updates, 3);  // the budget spreads the first view over several updates
+  EXPECT_LT(updates, 200);
+  for (uint32_t b = 0; b < t.grid.blocks(); ++b) ASSERT_TRUE(terrain::mask_covers(client.masks[b], need[b])) << b;
+  EXPECT_TRUE(server.update(cam, 999, 500, {}).empty());
+}
+
+TEST(TerrainUpdates, EveryPrefixAndEveryBitFlipIsRefusedOrStaysInRange) {
+  const enc::TerrainCoding t = enc::code_terrain(test_map(), 10);
+  enc::TerrainServer server(t, 1u << 20);
+  const auto u = server.update(flight_camera(t, 3, 100), 3, 1500, {});
+  ASSERT_GT(u.size(), 100u);
+  for (size_t n = 0; n < u.size(); ++n) {
+    Client c(t.grid.blocks());
+    EXPECT_NE(c.apply(std::vector<uint8_t>(u.begin(), u.begin() + static_cast<long>(n)), t.grid), Status::ok) << n;
+  }
+  vds::test::Xorshift32 rng{3};
+  for (int i = 0; i < 300; ++i) {
+    std::vector<uint8_t> bad = u;
+    bad[rng.next() % bad.size()] ^= static_cast<uint8_t>(1u << (rng.next() % 8));
+    Client c(t.grid.blocks());
+    c.apply(bad, t.grid);  // whatever it says, the masks it leaves are valid
+    for (Mask m : c.masks) ASSERT_TRUE(terrain::mask_valid(m));
+  }
+}
+
+TEST(TerrainUpdates, ReconstructionApproachesTheSourceAsMasksGrow) {
+  const enc::TerrainCoding t = enc::code_terrain(test_map(), 2);
+  std::vector<Mask> dc(t.grid.blocks(), 0x1), full(t.grid.blocks(), terrain::kFullMask);
+  const double p_dc = enc::planes_psnr(enc::reconstruct_texture(t, dc), t.texture);
+  const double p_full = enc::planes_psnr(enc::reconstruct_texture(t, full), t.texture);
+  EXPECT_GT(p_full, 40.0);
+  EXPECT_LT(p_dc, p_full - 8);
+}
+
+}  // namespace
