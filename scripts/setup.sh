@@ -15,7 +15,7 @@ PACKAGES=(
   libdraco-dev draco libcli11-dev libpng-dev libassimp-dev libzip-dev libtinyxml2-dev
   libsdl2-dev
   # anchors the benchmarks and conformance tests compare against
-  libjpeg-turbo-progs libturbojpeg0-dev
+  libjpeg-turbo-progs libturbojpeg0-dev libwebp-dev
   # the video codecs the walkthrough is measured against (x264, x265, SVT-AV1, libaom)
   ffmpeg
   # measurement and plots

@@ -48,5 +48,6 @@ void add_encode_frames(CLI::App& app);
 void add_frames(CLI::App& app);
 void add_encode_image(CLI::App& app);
 void add_decode_image(CLI::App& app);
+void add_fly(CLI::App& app);
 
 }  // namespace vds::cli

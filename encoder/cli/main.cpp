@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   vds::cli::add_path(app);
   vds::cli::add_render(app);
   vds::cli::add_encode_walk(app);
+  vds::cli::add_fly(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -80,6 +80,7 @@ TerrainCoding code_terrain(const TerrainMap& map, int quantiser) {
       for (int c = 0; c < 3; ++c)
         padded.at(x, y, c) = map.colour.at(std::min(x, map.colour.width - 1), std::min(y, map.colour.height - 1), c);
   t.texture = rgb_to_planes(padded, ChromaFormat::yuv420);
+  t.colour = std::move(padded);
 
   // The elevation at the cell corners: texel X of the colour map lies at
   // sample X (width - 1) / colour width of the heightmap.
@@ -140,7 +141,25 @@ void reconstruct_block(const TerrainCoding& t, uint32_t id, Mask held, uint8_t o
 
 Planes reconstruct_texture(const TerrainCoding& t, const std::vector<Mask>& held) {
   Planes p = t.texture;
+  update_texture(t, std::vector<Mask>(held.size(), ~Mask{0}), held, &p);
+  return p;
+}
+
+double terrain_height(const TerrainCoding& t, double x, double y) {
+  const double gi = std::clamp(x / t.cell_m, 0.0, static_cast<double>(t.grid.cells_x));
+  const double gj = std::clamp(t.grid.cells_y - y / t.cell_m, 0.0, static_cast<double>(t.grid.cells_y));
+  const int i0 = std::min(static_cast<int>(gi), t.grid.cells_x - 1), j0 = std::min(static_cast<int>(gj), t.grid.cells_y - 1);
+  const double fi = gi - i0, fj = gj - j0;
+  const double top = t.height_m(i0, j0) * (1 - fi) + t.height_m(i0 + 1, j0) * fi;
+  const double bottom = t.height_m(i0, j0 + 1) * (1 - fi) + t.height_m(i0 + 1, j0 + 1) * fi;
+  return top * (1 - fj) + bottom * fj;
+}
+
+void update_texture(const TerrainCoding& t, const std::vector<Mask>& before, const std::vector<Mask>& held,
+                    Planes* texture) {
+  Planes& p = *texture;
   for (uint32_t id = 0; id < t.grid.blocks(); ++id) {
+    if (before[id] == held[id]) continue;
     int comp, bx, by;
     block_place(t.grid, id, &comp, &bx, &by);
     uint8_t px[64];
@@ -155,7 +174,6 @@ Planes reconstruct_texture(const TerrainCoding& t, const std::vector<Mask>& held
       }
     }
   }
-  return p;
 }
 
 // --- Masks --------------------------------------------------------------------------------
@@ -211,7 +229,8 @@ std::vector<Mask> pose_masks(const TerrainCoding& t, const SceneCamera& cam, con
       if (in_front == 4 && (x1 < 0 || y1 < 0 || x0 > cam.width || y0 > cam.height)) continue;
       // Facing the viewer.
       const V3 centre = (p[0] + p[1] + p[2] + p[3]) * 0.25;
-      const V3 n = normalize(cross(p[3] - p[0], p[2] - p[1]));
+      V3 n = normalize(cross(p[3] - p[0], p[2] - p[1]));
+      if (n[2] < 0) n = n * -1;  // a height field faces up
       const V3 to_eye = cam.position - centre;
       if (dot(n, to_eye) <= 0) continue;
       // Distance to the nearest point of the cell's bounds.
@@ -238,7 +257,7 @@ std::vector<Mask> pose_masks(const TerrainCoding& t, const SceneCamera& cam, con
 
       const uint32_t luma = static_cast<uint32_t>(j) * g.cells_x + i;
       masks[luma] = shrink_mask(ppt, cos_a, beta_s);
-      views[luma] = BlockView{true, ppt, cos_a, beta_s, pixels};
+      views[luma] = BlockView{true, ppt, cos_a, beta_s, pixels, dist};
       // Chroma: texels twice the size, one block for 2 x 2 cells.
       const uint32_t c = static_cast<uint32_t>(j / 2) * g.chroma_x() + i / 2;
       const Mask cm = shrink_mask(2 * ppt, cos_a, beta_s);
@@ -246,7 +265,7 @@ std::vector<Mask> pose_masks(const TerrainCoding& t, const SceneCamera& cam, con
         const uint32_t id = g.luma_blocks() + (comp - 1) * g.chroma_blocks() + c;
         masks[id] = terrain::mask_union(masks[id], cm);
         BlockView& cv = views[id];
-        if (!cv.visible || 2 * ppt > cv.cutoff) cv = BlockView{true, 2 * ppt, cos_a, beta_s, cv.pixels};
+        if (!cv.visible || 2 * ppt > cv.cutoff) cv = BlockView{true, 2 * ppt, cos_a, beta_s, cv.pixels, dist};
         cv.pixels += pixels;
       }
     }
@@ -350,6 +369,18 @@ std::vector<uint8_t> encode_update(const TerrainCoding& t, const std::vector<Mas
   return out;
 }
 
+double TerrainServer::stage_score(uint32_t b, Mask from, Mask to, double pixels) const {
+  double energy = 0, bits = 4;
+  for (int k = 0; k < 64; ++k) {
+    if (!mask_holds(to, k & 7, k >> 3) || mask_holds(from, k & 7, k >> 3)) continue;
+    const int l = t_.levels[b][k];
+    const double c = terrain::dequantise(l, k, t_.quantiser);
+    energy += c * c;
+    bits += l == 0 ? 0.5 : 5 + 2 * std::log2(1.0 + std::abs(l));
+  }
+  return pixels / 64 * energy / bits;
+}
+
 TerrainServer::TerrainServer(const TerrainCoding& t, uint32_t capacity)
     : t_(t), capacity_(capacity), held_(t.grid.blocks(), 0), last_needed_(t.grid.blocks(), 0) {}
 
@@ -361,12 +392,32 @@ std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t f
   for (uint32_t b = 0; b < n; ++b)
     if (need[b] != 0) last_needed_[b] = frame + 1;
 
-  // What the pose lacks, the most visible first.
-  std::vector<uint32_t> wanted;
-  for (uint32_t b = 0; b < n; ++b)
-    if (!terrain::mask_covers(held_[b], need[b])) wanted.push_back(b);
-  std::stable_sort(wanted.begin(), wanted.end(),
-                   [&](uint32_t a, uint32_t b) { return views[a].pixels > views[b].pixels; });
+  // What the pose lacks, in stages of each block's need (its DC, then the
+  // lowest 2x2, 4x4 and 8x8 frequencies), ranked by the squared error a
+  // stage removes from the screen per bit it costs (estimated): the
+  // coefficients' energy (an orthonormal transform: their squares are the
+  // block's squared error; a block held empty shows mid-grey, which its DC
+  // corrects) times the screen pixels a texel covers.
+  struct Want {
+    uint32_t block;
+    Mask target;
+    double score;
+  };
+  std::vector<Want> wanted;
+  constexpr Mask kBox[4] = {0x00000001u, 0x00000022u, 0x00004444u, terrain::kFullMask};
+  for (uint32_t b = 0; b < n; ++b) {
+    if (terrain::mask_covers(held_[b], need[b])) continue;
+    Mask prev = held_[b];
+    for (int st = 0; st < 4; ++st) {
+      // The stage's part of the need (what the block holds beyond it may
+      // be dropped to make room before the stage is sent, and stays dropped).
+      const Mask part = terrain::mask_intersection(need[b], kBox[st]);
+      const Mask target = terrain::mask_union(prev, part);
+      if (target != prev) wanted.push_back({b, part, stage_score(b, prev, target, views[b].pixels)});
+      prev = target;
+    }
+  }
+  std::stable_sort(wanted.begin(), wanted.end(), [](const Want& a, const Want& b) { return a.score > b.score; });
 
   // Room in the store: blocks the pose does not need, the longest unneeded
   // first; then what needed blocks hold beyond the need, the least visible first.
@@ -395,8 +446,10 @@ std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t f
   std::vector<uint32_t> picked;
   std::vector<uint8_t> is_picked(n, 0);
   UpdateWriter trial(t_);
-  for (uint32_t b : wanted) {
-    const Mask target = terrain::mask_union(after[b], need[b]);
+  for (const Want& w : wanted) {
+    const uint32_t b = w.block;
+    const Mask target = terrain::mask_union(after[b], w.target);
+    if (target == after[b]) continue;
     const uint32_t add = static_cast<uint32_t>(terrain::mask_count(target) - terrain::mask_count(after[b]));
     // The cost of this block, estimated in the order of choice.
     trial.mask(after[b], target, true);
@@ -416,7 +469,7 @@ std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t f
     if (used + add > capacity_) break;  // the store is full of what the pose needs
     used += add;
     after[b] = target;
-    picked.push_back(b);
+    if (!is_picked[b]) picked.push_back(b);
     is_picked[b] = 1;
   }
 
@@ -452,8 +505,11 @@ std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t f
       if (before[b] == 0) ++stats->intra;
       stats->coefficients += static_cast<uint32_t>(terrain::mask_count(after[b]) - terrain::mask_count(before[b]));
     }
-    for (uint32_t b = 0; b < n; ++b)
+    for (uint32_t b = 0; b < n; ++b) {
       if (!terrain::mask_covers(after[b], need[b])) ++stats->wanted;
+      stats->needed += static_cast<uint32_t>(terrain::mask_count(need[b]));
+      stats->needed_blocks += need[b] != 0;
+    }
     stats->bytes = out.size();
   }
   held_ = std::move(after);

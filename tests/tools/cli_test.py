@@ -118,5 +118,32 @@ check(code == 2 and "--preroll" in err and not os.path.exists(os.path.join(TMP, 
 code, out, err = run("encode-walk", "scene.obj", "--path", "p.txt", "-o", os.path.join(TMP, "w.vds"), "--window", "16")
 check(code == 2 and "--window" in err, "encode-walk refuses a window under 256 bytes")
 
+
+# vds fly: a user's heightmap and colour map, a short flight; refusals name the file.
+hm = os.path.join(TMP, "fly_heights.pgm")
+with open(hm, "wb") as f:
+    f.write(b"P5\n33 33\n65535\n")
+    for y in range(33):
+        for x in range(33):
+            v = 20000 + 300 * ((x * 7 + y * 3) % 17)
+            f.write(bytes([v >> 8, v & 255]))
+col = os.path.join(TMP, "fly_colour.ppm")
+with open(col, "wb") as f:
+    f.write(b"P6\n64 64\n255\n" + bytes(((x * 4) & 255, (y * 4) & 255, ((x ^ y) * 8) & 255)[c]
+                                          for y in range(64) for x in range(64) for c in range(3)))
+flyout = os.path.join(TMP, "fly")
+code, out, err = run("fly", "--heightmap", hm, "--colour", col, "--scale", "4,0.001", "--frames", "12", "--rate", "0",
+                     "--out", flyout)
+check(code == 0 and "8x8 cells" in out and "overall:" in out and os.path.exists(os.path.join(flyout, "sheet.png"))
+      and len(open(os.path.join(flyout, "frames.csv")).read().splitlines()) == 13, "vds fly replays a flight over a user's map")
+code, out, err = run("fly", "--heightmap", hm, "--colour", col, "--frames", "12")
+check(code == 2 and "--scale" in err, "vds fly asks for the scales of a user's heightmap")
+code, out, err = run("fly", os.path.join(TMP, "no-such.level"))
+check(code == 1 and "no-such.level" in err, "vds fly names a missing level")
+with open(os.path.join(TMP, "bad.level"), "w") as f:
+    f.write("<level><terrain heightmap='h.png' colormap='../c.jpg' horizontalscale='1' verticalscale='1'/></level>")
+code, out, err = run("fly", os.path.join(TMP, "bad.level"))
+check(code == 1 and "bad.level" in err and "not a file name beside the level" in err, "vds fly refuses a level that points outside its folder")
+
 print(f"{len(failures)} failed" if failures else "all CLI checks passed")
 sys.exit(1 if failures else 0)

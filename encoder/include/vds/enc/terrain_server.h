@@ -22,10 +22,13 @@ struct TerrainCoding {
   terrain::BlockGrid grid;
   int quantiser = 8;
   // (cells_x + 1) x (cells_y + 1) heights in units of metres_per_unit; point
-  // (i, j) lies at ground (i, j) * cell_m, on texel (8 i, 8 j).
+  // (i, j) lies on texel (8 i, 8 j), at x = i cell_m east and y = (cells_y
+  // - j) cell_m north (the colour map's top row is north; z is up).
   std::vector<uint16_t> heights;
   double cell_m = 1, metres_per_unit = 1;
-  // The colour map in Y'CbCr 4:2:0, padded to whole cells (edges repeated).
+  // The colour map padded to whole cells (edges repeated), as R'G'B' and
+  // in Y'CbCr 4:2:0.
+  io::Image colour;
   Planes texture;
   // Every block's quantised coefficients (natural order), by block id.
   std::vector<std::array<int16_t, 64>> levels;
@@ -35,7 +38,7 @@ struct TerrainCoding {
   double height_m(int i, int j) const {
     return heights[static_cast<size_t>(j) * points_x() + i] * metres_per_unit;
   }
-  std::array<double, 3> point(int i, int j) const { return {i * cell_m, j * cell_m, height_m(i, j)}; }
+  std::array<double, 3> point(int i, int j) const { return {i * cell_m, (grid.cells_y - j) * cell_m, height_m(i, j)}; }
 };
 
 // Grid, texture and coefficients of a map. Throws std::invalid_argument for
@@ -52,6 +55,12 @@ void reconstruct_block(const TerrainCoding& t, uint32_t id, terrain::Mask held, 
 // The whole texture as the client holds it: blocks it holds nothing of are
 // mid-grey (Y' 128 for luma, 128 for chroma).
 Planes reconstruct_texture(const TerrainCoding& t, const std::vector<terrain::Mask>& held);
+// The same for the blocks whose mask differs between `before` and `held`,
+// in place: `texture` held `before`'s reconstruction.
+void update_texture(const TerrainCoding& t, const std::vector<terrain::Mask>& before,
+                    const std::vector<terrain::Mask>& held, Planes* texture);
+// Ground height (metres) at world (x, y), bilinear over the grid, clamped to it.
+double terrain_height(const TerrainCoding& t, double x, double y);
 
 // --- Masks ------------------------------------------------------------------------------
 
@@ -74,6 +83,7 @@ struct BlockView {
   double cos_alpha = 0;
   double beta_s = 0;
   double pixels = 0;      // screen pixels the block covers (estimate)
+  double distance = 0;    // metres from the eye to the nearest point of the cell (luma blocks)
 };
 
 struct PoseOptions {
@@ -93,11 +103,15 @@ struct UpdateStats {
   uint32_t coefficients = 0;                   // coefficients the update adds
   uint32_t dropped = 0;                        // coefficients the update drops
   uint32_t wanted = 0;                         // blocks the pose still lacks after it
+  uint32_t needed = 0;                         // coefficients the pose needs (held or not)
+  uint32_t needed_blocks = 0;                  // blocks it needs
   size_t bytes = 0;
 };
 
 // Mirrors the client's store: which mask each block holds, and when the
-// pose last needed it. The store holds at most `capacity` coefficients; to
+// pose last needed it. What a pose lacks is sent in stages of each block's
+// need (its DC, the lowest 2x2, 4x4, 8x8 frequencies), the stages that
+// remove the most squared screen error per bit first. The store holds at most `capacity` coefficients; to
 // make room the server drops, in order, blocks the pose does not need (the
 // longest unneeded first), then what held blocks hold beyond the pose's
 // need (the farthest first). The client does what the update says, so its
@@ -114,6 +128,10 @@ class TerrainServer {
   uint32_t capacity() const { return capacity_; }
 
  private:
+  // Squared screen error per estimated bit of growing block b from `from`
+  // to `to` where it covers `pixels` pixels.
+  double stage_score(uint32_t b, terrain::Mask from, terrain::Mask to, double pixels) const;
+
   const TerrainCoding& t_;
   uint32_t capacity_ = 0, used_ = 0;
   std::vector<terrain::Mask> held_;

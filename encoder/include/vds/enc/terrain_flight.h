@@ -1,0 +1,93 @@
+// Flights over a terrain: the scripted flyover every map gets (low and high
+// altitude, turns, a dive), flight scripts, the terrain as a scene the
+// reference renderer draws, and the server's replay of a flight over an
+// ideal link (the client's store after each update, what was sent up and
+// down) with the pictures it gives (docs/terrain.md).
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "vds/enc/camera_path.h"
+#include "vds/enc/scene.h"
+#include "vds/enc/terrain_server.h"
+
+namespace vds::enc {
+
+// The flyover of any map, `frames` long at `fps`: in over one edge low
+// (15 m above the ground), a climb to a third of the map's width, a wide
+// turn, a dive back to 20 m, and out low along a valley-following line.
+// Heights follow the ground (never below 8 m above it).
+CameraPath terrain_flyover(const TerrainCoding& t, int frames, double fps, double hfov_deg = 70);
+
+// A flight script: camera keys (vds path's key format, vds/enc/camera_path.h)
+// in metres over the terrain, interpolated to frames and kept at least 2 m
+// above the ground. Throws naming the file.
+CameraPath read_flight(const std::string& text, const std::string& name, const TerrainCoding& t);
+
+// The terrain as a scene: the grid's cells as two triangles each, textured
+// with `texture` (RGB, the colour map's size padded to whole cells).
+Scene terrain_scene(const TerrainCoding& t);
+
+struct FlightLink {
+  double rate_bytes_per_s = 2000;  // downlink payload bytes a second; 0: unlimited (every pose answered whole)
+  int latency_frames = 2;          // pose up and update down, in frames
+  int poses_per_s = 5;             // how often the client sends its pose
+  size_t pose_bytes = 21;          // a pose message on the line (type, frame, x, y, z, yaw, pitch; framing)
+};
+
+struct FlightFrame {
+  size_t down_bytes = 0;   // update bytes that arrived before this frame
+  size_t up_bytes = 0;     // pose bytes sent at this frame
+  UpdateStats update;      // the update this frame answered (if any)
+  uint32_t held = 0;       // what the client holds: coefficients (vds), cache bytes (tiles)
+  double psnr = 0;         // client's frame (reference renderer, held texture) against the ground truth
+};
+
+struct FlightOptions {
+  FlightLink link;
+  int width = 240, height = 180;
+  uint32_t capacity = 65536;  // client store, coefficients
+  PoseOptions pose;
+  int supersample = 2;
+  // Called per frame with the ground truth and the client's picture.
+  std::function<void(size_t frame, const io::Image& truth, const io::Image& client)> frame_sink;
+  std::function<void(size_t done)> progress;
+};
+
+struct FlightResult {
+  std::vector<FlightFrame> frames;
+  size_t elevation_bytes = 0;
+  size_t first_update_bytes = 0;  // the intra data of the first pose
+  uint32_t first_update_frames = 0;  // frames until the first pose's needs were all sent
+  bool first_update_done = false;    // they were, within the flight
+};
+
+// What a flight sends down: vds's server, or a baseline.
+class FlightSource {
+ public:
+  virtual ~FlightSource() = default;
+  // Answers the camera of pose frame `pose` with at most `budget` bytes
+  // (more than the flight can use when the link is unlimited); fills
+  // ff->update and returns the bytes sent.
+  virtual size_t answer(const SceneCamera& camera, uint32_t pose, size_t budget, FlightFrame* ff) = 0;
+  // The texture the client holds now (R'G'B', the padded colour map's
+  // size), and whether it changed since the last call to texture().
+  virtual bool changed() const = 0;
+  virtual io::Image texture() = 0;
+  // What the client holds (FlightFrame::held).
+  virtual uint32_t held() const = 0;
+};
+
+// The flight loop both fly() and the baselines use.
+FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const FlightOptions& o, FlightSource& source);
+
+// Plays the flight: each frame the server answers the pose of
+// latency_frames before with an update of at most the bytes the link
+// carried since the last one; the update is applied before the frame is
+// drawn. The elevation goes first (its bytes at the link rate delay the
+// first update).
+FlightResult fly(const TerrainCoding& t, const CameraPath& path, const FlightOptions& o);
+
+}  // namespace vds::enc

@@ -1,0 +1,227 @@
+// Flights over a terrain (vds/enc/terrain_flight.h).
+#include "vds/enc/terrain_flight.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+#include <vector>
+
+#include "vds/enc/scene_render.h"
+
+namespace vds::enc {
+
+namespace {
+
+// Keeps every frame at least `clearance` metres above the ground around
+// it and ahead of it (a pilot clears the next ridge before reaching it),
+// smoothly: the floor is spread over a second either way before it lifts
+// the path.
+void keep_above_ground(const TerrainCoding& t, CameraPath* p, double clearance) {
+  const size_t n = p->frames.size();
+  std::vector<double> floor(n);
+  const double step = t.cell_m, radius = std::max(3 * t.cell_m, 60.0), ahead = std::max(10 * t.cell_m, 300.0);
+  for (size_t f = 0; f < n; ++f) {
+    const CameraPose& c = p->frames[f];
+    const double yaw = c.yaw_deg * 3.14159265358979323846 / 180;
+    double g = terrain_height(t, c.x, c.y);
+    for (double dx = -radius; dx <= radius; dx += step)
+      for (double dy = -radius; dy <= radius; dy += step) g = std::max(g, terrain_height(t, c.x + dx, c.y + dy));
+    for (double a = 0; a <= ahead; a += step)
+      g = std::max(g, terrain_height(t, c.x + a * std::cos(yaw), c.y + a * std::sin(yaw)));
+    floor[f] = g + clearance;
+  }
+  const size_t half = static_cast<size_t>(std::max(1.0, p->fps));
+  std::vector<double> spread(n), smooth(n);
+  for (size_t f = 0; f < n; ++f) {
+    double m = floor[f];
+    for (size_t k = f >= half ? f - half : 0; k <= std::min(n - 1, f + half); ++k) m = std::max(m, floor[k]);
+    spread[f] = std::max(p->frames[f].z, m);
+  }
+  for (size_t f = 0; f < n; ++f) {
+    double s = 0;
+    size_t c = 0;
+    for (size_t k = f >= half ? f - half : 0; k <= std::min(n - 1, f + half); ++k, ++c) s += spread[k];
+    smooth[f] = s / static_cast<double>(c);
+  }
+  for (size_t f = 0; f < n; ++f) p->frames[f].z = std::max({p->frames[f].z, smooth[f], floor[f]});
+}
+
+}  // namespace
+
+CameraPath terrain_flyover(const TerrainCoding& t, int frames, double fps, double hfov_deg) {
+  if (frames < 2 || !(fps > 0)) throw std::invalid_argument("terrain_flyover: at least 2 frames at a positive rate");
+  const double w = t.grid.cells_x * t.cell_m, d = t.grid.cells_y * t.cell_m;
+  const double high = std::max(w, d) / 3;
+  // Time (fraction of the flight), position (fractions of the map), height
+  // above the ground, heading and pitch.
+  struct Key {
+    double s, x, y, agl, yaw, pitch;
+  };
+  const Key keys[] = {
+      {0.00, 0.08, 0.15, 15, 45, -8},      // in low over the south-west
+      {0.20, 0.35, 0.40, 25, 45, -10},     // low, across the map
+      {0.40, 0.50, 0.55, high, 60, -35},   // climb high
+      {0.55, 0.62, 0.72, high, 150, -40},  // a wide turn
+      {0.70, 0.42, 0.78, high * 0.75, 240, -55},
+      {0.82, 0.30, 0.60, 20, 260, -25},    // the dive
+      {1.00, 0.18, 0.32, 12, 250, -6},     // out low
+  };
+  CameraKeys k;
+  k.hfov_deg = hfov_deg;
+  k.fps = fps;
+  const double duration = (frames - 1) / fps;
+  for (const Key& e : keys) {
+    CameraKey c;
+    c.time_s = e.s * duration;
+    c.pose.x = e.x * w;
+    c.pose.y = e.y * d;
+    c.pose.z = terrain_height(t, c.pose.x, c.pose.y) + e.agl;
+    c.pose.yaw_deg = e.yaw;
+    c.pose.pitch_deg = e.pitch;
+    k.keys.push_back(c);
+  }
+  CameraPath p = interpolate_keyframes(k);
+  p.frames.resize(static_cast<size_t>(frames), p.frames.back());
+  keep_above_ground(t, &p, 8);
+  return p;
+}
+
+CameraPath read_flight(const std::string& text, const std::string& name, const TerrainCoding& t) {
+  CameraPath p = interpolate_keyframes(read_camera_keys(text, name));
+  keep_above_ground(t, &p, 2);
+  return p;
+}
+
+Scene terrain_scene(const TerrainCoding& t) {
+  Scene s;
+  s.name = "terrain";
+  s.kind = "terrain";
+  s.metres_per_unit = 1;
+  s.overbright = false;
+  const int px = t.points_x(), py = t.points_y();
+  const double tw = t.grid.cells_x * 8.0, th = t.grid.cells_y * 8.0;
+  for (int j = 0; j < py; ++j)
+    for (int i = 0; i < px; ++i) {
+      SceneVertex v;
+      const auto p = t.point(i, j);
+      v.pos = {static_cast<float>(p[0]), static_cast<float>(p[1]), static_cast<float>(p[2])};
+      v.uv = {static_cast<float>(8 * i / tw), static_cast<float>(8 * j / th)};
+      v.color = {255, 255, 255, 255};
+      s.vertices.push_back(v);
+    }
+  for (int j = 0; j < t.grid.cells_y; ++j)
+    for (int i = 0; i < t.grid.cells_x; ++i) {
+      const uint32_t a = static_cast<uint32_t>(j * px + i), b = a + 1, c = a + static_cast<uint32_t>(px), e = c + 1;
+      s.indices.insert(s.indices.end(), {a, c, b, b, c, e});
+    }
+  SceneSurface surf;
+  surf.texture = 0;
+  surf.index_count = static_cast<uint32_t>(s.indices.size());
+  s.surfaces.push_back(surf);
+  SceneTexture tex;
+  tex.name = "terrain";
+  s.textures.push_back(tex);
+  for (const SceneVertex& v : s.vertices)
+    for (int k = 0; k < 3; ++k) {
+      s.min[static_cast<size_t>(k)] = std::min(s.min[static_cast<size_t>(k)], v.pos[static_cast<size_t>(k)]);
+      s.max[static_cast<size_t>(k)] = std::max(s.max[static_cast<size_t>(k)], v.pos[static_cast<size_t>(k)]);
+    }
+  return s;
+}
+
+namespace {
+
+// vds: the terrain server, and the texture its mirror of the client holds.
+class ServerSource : public FlightSource {
+ public:
+  ServerSource(const TerrainCoding& t, const FlightOptions& o)
+      : t_(t), o_(o), server_(t, o.capacity), shown_(t.grid.blocks(), 0), texture_(reconstruct_texture(t, shown_)) {}
+  size_t answer(const SceneCamera& camera, uint32_t pose, size_t budget, FlightFrame* ff) override {
+    return server_.update(camera, pose, budget, o_.pose, &ff->update).size();
+  }
+  uint32_t held() const override { return server_.used(); }
+  bool changed() const override { return server_.held() != shown_; }
+  io::Image texture() override {
+    update_texture(t_, shown_, server_.held(), &texture_);
+    shown_ = server_.held();
+    return planes_to_rgb(texture_);
+  }
+
+ private:
+  const TerrainCoding& t_;
+  const FlightOptions& o_;
+  TerrainServer server_;
+  std::vector<terrain::Mask> shown_;
+  Planes texture_;
+};
+
+io::Image with_alpha(const io::Image& rgb) {
+  io::Image out(rgb.width, rgb.height, 4);
+  for (size_t i = 0, n = static_cast<size_t>(rgb.width) * rgb.height; i < n; ++i) {
+    for (size_t c = 0; c < 3; ++c) out.pixels[4 * i + c] = rgb.pixels[3 * i + c];
+    out.pixels[4 * i + 3] = 255;
+  }
+  return out;
+}
+
+}  // namespace
+
+FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const FlightOptions& o, FlightSource& source) {
+  FlightResult r;
+  r.elevation_bytes = encode_elevation(t.heights.data(), t.points_x(), t.points_y()).size();
+  const Scene scene = terrain_scene(t);
+  RenderOptions ro;
+  ro.width = o.width;
+  ro.height = o.height;
+  ro.supersample = o.supersample;
+  ro.near_m = o.pose.near_m;
+  const SceneRenderer truth(scene, {with_alpha(t.colour)}, ro);
+  std::unique_ptr<SceneRenderer> client;
+  const bool unlimited = !(o.link.rate_bytes_per_s > 0);
+  const double per_frame = unlimited ? 0 : o.link.rate_bytes_per_s / path.fps;
+  double credit = -static_cast<double>(r.elevation_bytes);
+  const int pose_every = std::max(1, static_cast<int>(std::lround(path.fps / std::max(1, o.link.poses_per_s))));
+  bool first_done = false;
+  for (size_t f = 0; f < path.frames.size(); ++f) {
+    FlightFrame ff;
+    if (f % static_cast<size_t>(pose_every) == 0) ff.up_bytes = o.link.pose_bytes;
+    credit = unlimited ? 1e12 : credit + per_frame;
+    // The newest pose the server has: sent at a multiple of pose_every, at
+    // least latency_frames ago.
+    const long lag = static_cast<long>(f) - o.link.latency_frames;
+    if (lag >= 0 && credit >= 1) {
+      const size_t pose = static_cast<size_t>(lag) - static_cast<size_t>(lag) % static_cast<size_t>(pose_every);
+      const SceneCamera cam = scene_camera(path.frames[pose], path.hfov_deg, o.width, o.height);
+      ff.down_bytes = source.answer(cam, static_cast<uint32_t>(pose), static_cast<size_t>(credit), &ff);
+      credit -= static_cast<double>(ff.down_bytes);
+      // A link with nothing to send carries nothing: no credit is saved up.
+      if (ff.update.wanted == 0 || ff.down_bytes == 0) credit = std::min(credit, per_frame);
+      if (!first_done) {
+        r.first_update_bytes += ff.down_bytes;
+        if (ff.update.wanted == 0) {
+          first_done = r.first_update_done = true;
+          r.first_update_frames = static_cast<uint32_t>(f);
+        }
+      }
+    }
+    ff.held = source.held();
+    if (source.changed() || !client)
+      client = std::make_unique<SceneRenderer>(scene, std::vector<io::Image>{with_alpha(source.texture())}, ro);
+    const CameraPose& pose = path.frames[f];
+    const SceneFrame a = truth.render(pose, path.hfov_deg);
+    const SceneFrame b = client->render(pose, path.hfov_deg);
+    ff.psnr = io::psnr(a.rgb, b.rgb);
+    if (o.frame_sink) o.frame_sink(f, a.rgb, b.rgb);
+    r.frames.push_back(ff);
+    if (o.progress) o.progress(f + 1);
+  }
+  return r;
+}
+
+FlightResult fly(const TerrainCoding& t, const CameraPath& path, const FlightOptions& o) {
+  ServerSource s(t, o);
+  return fly_source(t, path, o, s);
+}
+
+}  // namespace vds::enc
