@@ -3,6 +3,7 @@
 #include "vds/terrain.h"
 
 #include "vds/bytes.h"
+#include "vds/idct.h"
 #include "vds/image_model.h"
 
 namespace vds::terrain {
@@ -69,6 +70,40 @@ int16_t dequantise(int level, int natural_index, int quantiser) {
   return static_cast<int16_t>(c);
 }
 
+uint32_t BlockGrid::first(int level, int comp) const {
+  // Level 1 (Y', Cb, Cr), then level 0.
+  uint32_t at = 0;
+  for (int l = 1; l >= 0; --l)
+    for (int c = 0; c < 3; ++c) {
+      if (l == level && c == comp) return at;
+      at += plane_blocks(l, c);
+    }
+  return at;
+}
+
+BlockPlace BlockGrid::place(uint32_t id) const {
+  BlockPlace p;
+  for (int l = 1; l >= 0; --l)
+    for (int c = 0; c < 3; ++c) {
+      const uint32_t n = plane_blocks(l, c);
+      if (id < n) {
+        p.level = static_cast<uint8_t>(l);
+        p.comp = static_cast<uint8_t>(c);
+        p.bx = static_cast<uint16_t>(id % plane_w(l, c));
+        p.by = static_cast<uint16_t>(id / plane_w(l, c));
+        return p;
+      }
+      id -= n;
+    }
+  return p;
+}
+
+void coarse_plane(const int16_t levels[64], Mask held, int quantiser, int16_t out[64]) {
+  int16_t coef[64];
+  for (int n = 0; n < 64; ++n) coef[n] = mask_holds(held, n & 7, n >> 3) ? dequantise(levels[n], n, quantiser) : 0;
+  idct8x8(coef, out);
+}
+
 // --- Elevation -------------------------------------------------------------------
 
 void init_elevation_contexts(ElevationContexts& c) {
@@ -76,7 +111,8 @@ void init_elevation_contexts(ElevationContexts& c) {
   arith_init_contexts(&c.mag[0][0], 4 * 8);
 }
 
-int elevation_class(int a, int b, int c) {
+int elevation_class(int a, int b, int c, bool both) {
+  if (!both) return 3;
   const int d = (a > c ? a - c : c - a) + (b > c ? b - c : c - b);
   if (d == 0) return 0;
   if (d <= 4) return 1;
@@ -84,43 +120,57 @@ int elevation_class(int a, int b, int c) {
   return 3;
 }
 
-int elevation_predict(const uint16_t* rows, int w, int x, int y) {
-  if (y == 0) return x == 0 ? 0 : rows[x - 1];
-  const uint16_t* up = rows + static_cast<size_t>(y - 1) * w;
-  if (x == 0) return up[0];
-  const int a = rows[static_cast<size_t>(y) * w + x - 1], b = up[x], c = up[x - 1];
+int elevation_median(int a, int b, int c, bool has_left, bool has_up) {
+  if (!has_up) return has_left ? a : 0;
+  if (!has_left) return b;
   const int lo = min_int(a, b), hi = max_int(a, b);
   if (c >= hi) return lo;
   if (c <= lo) return hi;
   return a + b - c;
 }
 
-namespace {
-int neighbour_class(const uint16_t* rows, int w, int x, int y) {
-  if (x == 0 || y == 0) return 3;
-  const uint16_t* up = rows + static_cast<size_t>(y - 1) * w;
-  return elevation_class(rows[static_cast<size_t>(y) * w + x - 1], up[x], up[x - 1]);
-}
-}  // namespace
-
-Status decode_elevation(const uint8_t* data, size_t size, int w, int h, uint16_t* out) {
+Status decode_elevation(const uint8_t* data, size_t size, int w, int h, ElevationPass pass, uint16_t* out) {
   if (out == nullptr || w <= 0 || h <= 0) return Status::invalid_argument;
   ArithDecoder dec;
   Status s = dec.init(data, size);
   if (s != Status::ok) return s;
   ElevationContexts ctx;
   init_elevation_contexts(ctx);
+  s = Status::ok;
+  for_each_elevation_point(w, h, pass, out, [&](int x, int y, int predict, int k) {
+    const int32_t r = dec.decode_signed(ctx.zero[k], ctx.mag[k], 8, 16, 2);
+    if (!dec.ok()) {
+      s = dec.status();
+      return false;
+    }
+    const int32_t v = predict + r;
+    if (v < 0 || v > 65535) {
+      s = Status::malformed;
+      return false;
+    }
+    out[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(v);
+    return true;
+  });
+  return s != Status::ok ? s : dec.finish();
+}
+
+void fill_from_coarse(int w, int h, uint16_t* out) {
   for (int y = 0; y < h; ++y) {
+    const int y0 = y / kCoarseStep * kCoarseStep, y1 = y0 + kCoarseStep < h - 1 ? y0 + kCoarseStep : h - 1;
     for (int x = 0; x < w; ++x) {
-      const int k = neighbour_class(out, w, x, y);
-      const int32_t r = dec.decode_signed(ctx.zero[k], ctx.mag[k], 8, 16, 2);
-      if (!dec.ok()) return dec.status();
-      const int32_t v = elevation_predict(out, w, x, y) + r;
-      if (v < 0 || v > 65535) return Status::malformed;
-      out[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(v);
+      if (elevation_coarse(x, y, w, h)) continue;
+      const int x0 = x / kCoarseStep * kCoarseStep, x1 = x0 + kCoarseStep < w - 1 ? x0 + kCoarseStep : w - 1;
+      auto at = [&](int px, int py) { return static_cast<int64_t>(out[static_cast<size_t>(py) * w + px]); };
+      // (x0, y0) == (x1, y1) in a direction only on a coarse row or column,
+      // whose offset is then 0: a span of 1 weighs the one point.
+      const int64_t fx = x - x0, fy = y - y0, dx = x1 > x0 ? x1 - x0 : 1, dy = y1 > y0 ? y1 - y0 : 1;
+      // Bilinear in integers, rounded to nearest: the denominators are at
+      // most kCoarseStep each.
+      const int64_t num = (at(x0, y0) * (dx - fx) + at(x1, y0) * fx) * (dy - fy) + (at(x0, y1) * (dx - fx) + at(x1, y1) * fx) * fy;
+      const int64_t den = dx * dy;
+      out[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>((num + den / 2) / den);
     }
   }
-  return dec.finish();
 }
 
 // --- Texture updates ---------------------------------------------------------------
@@ -139,9 +189,9 @@ int position_class(int k) {
 }
 
 Status TextureUpdateReader::init(const uint8_t* data, size_t size, const BlockGrid& grid, HeldFn held,
-                                 void* ctx) {
+                                 ShownDcFn shown_dc, void* ctx) {
   *this = TextureUpdateReader{};
-  if ((data == nullptr && size > 0) || held == nullptr || grid.cells_x == 0 || grid.cells_y == 0 ||
+  if ((data == nullptr && size > 0) || held == nullptr || shown_dc == nullptr || grid.cells_x == 0 || grid.cells_y == 0 ||
       grid.cells_x > kMaxCells || grid.cells_y > kMaxCells) {
     return fail(Status::invalid_argument);
   }
@@ -152,6 +202,7 @@ Status TextureUpdateReader::init(const uint8_t* data, size_t size, const BlockGr
   if (shrinks_ + grows_ > 2 * grid.blocks()) return fail(Status::malformed);
   grid_ = grid;
   held_ = held;
+  shown_dc_ = shown_dc;
   held_ctx_ = ctx;
   init_texture_contexts(ctx_);
   status_ = dec_.init(data + 8, size - 8);
@@ -210,15 +261,22 @@ Status TextureUpdateReader::next(BlockUpdate* out) {
   ++read_;
   if (!grow) return Status::ok;
 
-  const int comp = grid_.component(u.id);
-  const int cls = comp == 0 ? 0 : 1;
+  const BlockPlace pl = grid_.place(u.id);
+  const int comp = pl.comp, lv = pl.level;
+  const int cls = (comp == 0 ? 0 : 1) + 2 * lv;
   const bool intra = u.held == 0;
   if (intra) {
-    const int32_t r = dec_.decode_signed(ctx_.dc_zero[comp], ctx_.dc_mag[comp], 6, 8, 1);
+    const int32_t r = dec_.decode_signed(ctx_.dc_zero[lv][comp], ctx_.dc_mag[lv][comp], 6, 8, 1);
     if (!dec_.ok()) return fail(dec_.status());
-    const int32_t dc = dc_prev_[comp] + r;
+    int32_t pred = dc_prev_[comp];
+    if (lv == 0) {
+      pred = shown_dc_(held_ctx_, u.id);
+      if (pred < -128) pred = -128;
+      if (pred > 127) pred = 127;
+    }
+    const int32_t dc = pred + r;
     if (dc < -128 || dc > 127) return fail(Status::malformed);
-    dc_prev_[comp] = dc;
+    if (lv == 1) dc_prev_[comp] = dc;
     u.levels[0] = static_cast<int16_t>(dc);
   }
   // The AC positions this update adds, in zig-zag order.

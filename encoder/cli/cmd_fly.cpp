@@ -104,8 +104,9 @@ void run(const FlyOptions& o) {
   later = down - r.first_update_bytes;
   const size_t later_frames = r.frames.size() - r.first_update_frames - 1;
   psnr /= static_cast<double>(r.frames.size());
-  std::printf("  elevation: %zu bytes for %d points (%.2f bits a point)\n", r.elevation_bytes,
-              t.points_x() * t.points_y(), 8.0 * r.elevation_bytes / (t.points_x() * t.points_y()));
+  std::printf("  elevation: %zu bytes for %d points (%.2f bits a point): %zu coarse first, the rest whole by frame %u\n",
+              r.elevation_bytes, t.points_x() * t.points_y(), 8.0 * r.elevation_bytes / (t.points_x() * t.points_y()),
+              r.coarse_elevation_bytes, r.elevation_frame);
   if (!r.first_update_done) {
     std::printf("  intra: the first pose's data was not all sent within the flight (%zu bytes sent)\n",
                 r.first_update_bytes);
@@ -122,11 +123,11 @@ void run(const FlyOptions& o) {
               "mean %.2f dB\n", psnr);
   if (o.out.empty()) return;
   std::ofstream csv(std::filesystem::path(o.out) / "frames.csv");
-  csv << "frame,down_bytes,up_bytes,grows,intra,shrinks,coefficients_added,coefficients_dropped,blocks_wanted,"
+  csv << "frame,down_bytes,elevation_bytes,up_bytes,grows,intra,shrinks,coefficients_added,coefficients_dropped,blocks_wanted,"
          "coefficients_held,coefficients_needed,blocks_needed,psnr\n";
   for (size_t i = 0; i < r.frames.size(); ++i) {
     const enc::FlightFrame& f = r.frames[i];
-    csv << i << ',' << f.down_bytes << ',' << f.up_bytes << ',' << f.update.grows << ',' << f.update.intra << ','
+    csv << i << ',' << f.down_bytes << ',' << f.elevation_bytes << ',' << f.up_bytes << ',' << f.update.grows << ',' << f.update.intra << ','
         << f.update.shrinks << ',' << f.update.coefficients << ',' << f.update.dropped << ',' << f.update.wanted << ','
         << f.held << ',' << f.update.needed << ',' << f.update.needed_blocks << ',' << f.psnr << '\n';
   }

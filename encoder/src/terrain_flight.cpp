@@ -169,8 +169,19 @@ io::Image with_alpha(const io::Image& rgb) {
 
 FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const FlightOptions& o, FlightSource& source) {
   FlightResult r;
-  r.elevation_bytes = encode_elevation(t.heights.data(), t.points_x(), t.points_y()).size();
+  r.coarse_elevation_bytes =
+      encode_elevation(t.heights.data(), t.points_x(), t.points_y(), terrain::ElevationPass::coarse).size();
+  const size_t fine_bytes =
+      encode_elevation(t.heights.data(), t.points_x(), t.points_y(), terrain::ElevationPass::fine).size();
+  r.elevation_bytes = r.coarse_elevation_bytes + fine_bytes;
   const Scene scene = terrain_scene(t);
+  // The ground the client draws until the fine pass is whole.
+  TerrainCoding rough = t;
+  rough.texture = Planes();
+  rough.levels.clear();
+  terrain::fill_from_coarse(t.points_x(), t.points_y(), rough.heights.data());
+  const Scene coarse_scene = terrain_scene(rough);
+  double fine_left = static_cast<double>(fine_bytes);
   RenderOptions ro;
   ro.width = o.width;
   ro.height = o.height;
@@ -178,27 +189,42 @@ FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const Fl
   ro.near_m = o.pose.near_m;
   const SceneRenderer truth(scene, {with_alpha(t.colour)}, ro);
   std::unique_ptr<SceneRenderer> client;
+  io::Image texture;
   const bool unlimited = !(o.link.rate_bytes_per_s > 0);
   const double per_frame = unlimited ? 0 : o.link.rate_bytes_per_s / path.fps;
-  double credit = -static_cast<double>(r.elevation_bytes);
+  double credit = -static_cast<double>(r.coarse_elevation_bytes);
   const int pose_every = std::max(1, static_cast<int>(std::lround(path.fps / std::max(1, o.link.poses_per_s))));
   bool first_done = false;
   for (size_t f = 0; f < path.frames.size(); ++f) {
     FlightFrame ff;
     if (f % static_cast<size_t>(pose_every) == 0) ff.up_bytes = o.link.pose_bytes;
     credit = unlimited ? 1e12 : credit + per_frame;
+    // The fine elevation shares the link with the texture, half and half,
+    // once the coarse pass is through.
+    bool ground_changed = false;
+    if (fine_left > 0 && credit > 0) {
+      const double share = unlimited ? fine_left : std::min(fine_left, std::min(credit, per_frame / 2));
+      fine_left -= share;
+      credit -= share;
+      ff.elevation_bytes = static_cast<size_t>(std::lround(share));
+      if (fine_left <= 0) {
+        r.elevation_frame = static_cast<uint32_t>(f);
+        ground_changed = true;
+      }
+    }
     // The newest pose the server has: sent at a multiple of pose_every, at
     // least latency_frames ago.
     const long lag = static_cast<long>(f) - o.link.latency_frames;
     if (lag >= 0 && credit >= 1) {
       const size_t pose = static_cast<size_t>(lag) - static_cast<size_t>(lag) % static_cast<size_t>(pose_every);
       const SceneCamera cam = scene_camera(path.frames[pose], path.hfov_deg, o.width, o.height);
-      ff.down_bytes = source.answer(cam, static_cast<uint32_t>(pose), static_cast<size_t>(credit), &ff);
-      credit -= static_cast<double>(ff.down_bytes);
+      const size_t sent = source.answer(cam, static_cast<uint32_t>(pose), static_cast<size_t>(credit), &ff);
+      ff.down_bytes = sent;
+      credit -= static_cast<double>(sent);
       // A link with nothing to send carries nothing: no credit is saved up.
-      if (ff.update.wanted == 0 || ff.down_bytes == 0) credit = std::min(credit, per_frame);
+      if (ff.update.wanted == 0 || sent == 0) credit = std::min(credit, per_frame);
       if (!first_done) {
-        r.first_update_bytes += ff.down_bytes;
+        r.first_update_bytes += sent;
         if (ff.update.wanted == 0) {
           first_done = r.first_update_done = true;
           r.first_update_frames = static_cast<uint32_t>(f);
@@ -206,8 +232,10 @@ FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const Fl
       }
     }
     ff.held = source.held();
-    if (source.changed() || !client)
-      client = std::make_unique<SceneRenderer>(scene, std::vector<io::Image>{with_alpha(source.texture())}, ro);
+    if (source.changed() || ground_changed || !client) {
+      if (source.changed() || !client) texture = with_alpha(source.texture());
+      client = std::make_unique<SceneRenderer>(fine_left > 0 ? coarse_scene : scene, std::vector<io::Image>{texture}, ro);
+    }
     const CameraPose& pose = path.frames[f];
     const SceneFrame a = truth.render(pose, path.hfov_deg);
     const SceneFrame b = client->render(pose, path.hfov_deg);

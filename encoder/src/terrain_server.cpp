@@ -44,19 +44,6 @@ uint8_t plane_at(const Planes& p, int c, int x, int y) {
   return p.row(c, y)[x];
 }
 
-// Block id -> component, and the block's position in its plane (in blocks).
-void block_place(const terrain::BlockGrid& g, uint32_t id, int* comp, int* bx, int* by) {
-  *comp = g.component(id);
-  uint32_t i = id;
-  int w = g.cells_x;
-  if (*comp > 0) {
-    i -= g.luma_blocks() + (*comp == 2 ? g.chroma_blocks() : 0);
-    w = g.chroma_x();
-  }
-  *bx = static_cast<int>(i % w);
-  *by = static_cast<int>(i / w);
-}
-
 }  // namespace
 
 // --- The terrain as coded ------------------------------------------------------------
@@ -95,40 +82,48 @@ TerrainCoding code_terrain(const TerrainMap& map, int quantiser) {
       t.heights[static_cast<size_t>(j) * (cx + 1) + i] = static_cast<uint16_t>(std::clamp(std::lround(units), 0L, 65535L));
     }
 
-  // Every block's coefficients, quantised once.
+  // Every block's coefficients, quantised once: level 0 from the texture,
+  // level 1 from the level-0 DC planes (edges repeated).
   t.levels.resize(t.grid.blocks());
-  for (uint32_t id = 0; id < t.grid.blocks(); ++id) {
-    int comp, bx, by;
-    block_place(t.grid, id, &comp, &bx, &by);
-    uint8_t px[64];
-    for (int y = 0; y < 8; ++y)
-      for (int x = 0; x < 8; ++x) px[y * 8 + x] = plane_at(t.texture, comp, bx * 8 + x, by * 8 + y);
-    int16_t coef[64];
-    fdct8x8(px, 8, coef);
-    auto& lv = t.levels[id];
+  auto quantise = [&](const int16_t coef[64], std::array<int16_t, 64>& lv) {
     lv[0] = static_cast<int16_t>(std::clamp(round_level(coef[0] / 8.0), -128, 127));
     for (int n = 1; n < 64; ++n) {
       const double step = terrain::kIntraMatrix[n] * quantiser / 16.0;
       lv[n] = static_cast<int16_t>(std::clamp(round_level(coef[n] / step), -terrain::kMaxLevel, terrain::kMaxLevel));
     }
+  };
+  for (int comp = 0; comp < 3; ++comp) {
+    const int w = t.grid.plane_w(0, comp), h = t.grid.plane_h(0, comp);
+    for (int by = 0; by < h; ++by)
+      for (int bx = 0; bx < w; ++bx) {
+        uint8_t px[64];
+        for (int y = 0; y < 8; ++y)
+          for (int x = 0; x < 8; ++x) px[y * 8 + x] = plane_at(t.texture, comp, bx * 8 + x, by * 8 + y);
+        int16_t coef[64];
+        fdct8x8(px, 8, coef);
+        quantise(coef, t.levels[t.grid.id(0, comp, bx, by)]);
+      }
+    for (int by = 0; by < t.grid.plane_h(1, comp); ++by)
+      for (int bx = 0; bx < t.grid.plane_w(1, comp); ++bx) {
+        int16_t dc[64], coef[64];
+        for (int y = 0; y < 8; ++y)
+          for (int x = 0; x < 8; ++x)
+            dc[y * 8 + x] = t.levels[t.grid.id(0, comp, std::min(bx * 8 + x, w - 1), std::min(by * 8 + y, h - 1))][0];
+        fdct8x8(dc, coef);
+        quantise(coef, t.levels[t.grid.id(1, comp, bx, by)]);
+      }
   }
   return t;
 }
 
-std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h) {
+std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h, terrain::ElevationPass pass) {
   ArithEncoder ae;
   terrain::ElevationContexts ctx;
   terrain::init_elevation_contexts(ctx);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      int k = 3;
-      if (x > 0 && y > 0) {
-        const uint16_t* up = heights + static_cast<size_t>(y - 1) * w;
-        k = terrain::elevation_class(heights[static_cast<size_t>(y) * w + x - 1], up[x], up[x - 1]);
-      }
-      const int r = heights[static_cast<size_t>(y) * w + x] - terrain::elevation_predict(heights, w, x, y);
-      ae.encode_signed(ctx.zero[k], ctx.mag[k], 8, r, 16, 2);
-    }
+  terrain::for_each_elevation_point(w, h, pass, heights, [&](int x, int y, int predict, int k) {
+    ae.encode_signed(ctx.zero[k], ctx.mag[k], 8, heights[static_cast<size_t>(y) * w + x] - predict, 16, 2);
+    return true;
+  });
   return ae.finish();
 }
 
@@ -155,22 +150,45 @@ double terrain_height(const TerrainCoding& t, double x, double y) {
   return top * (1 - fj) + bottom * fj;
 }
 
+int shown_dc(const TerrainCoding& t, const std::vector<Mask>& held, uint32_t id) {
+  const terrain::BlockPlace p = t.grid.place(id);
+  const uint32_t coarse = t.grid.id(1, p.comp, p.bx / 8, p.by / 8);
+  if (held[coarse] == 0) return 0;
+  int16_t plane[64];
+  terrain::coarse_plane(t.levels[coarse].data(), held[coarse], t.quantiser, plane);
+  return plane[(p.by % 8) * 8 + p.bx % 8];
+}
+
 void update_texture(const TerrainCoding& t, const std::vector<Mask>& before, const std::vector<Mask>& held,
                     Planes* texture) {
   Planes& p = *texture;
-  for (uint32_t id = 0; id < t.grid.blocks(); ++id) {
-    if (before[id] == held[id]) continue;
-    int comp, bx, by;
-    block_place(t.grid, id, &comp, &bx, &by);
+  int16_t plane[64];
+  uint32_t plane_of = ~0u;
+  for (uint32_t id = t.grid.first(0, 0); id < t.grid.blocks(); ++id) {
+    const terrain::BlockPlace pl = t.grid.place(id);
+    const uint32_t coarse = t.grid.id(1, pl.comp, pl.bx / 8, pl.by / 8);
+    // A block shows its own coefficients, or when it holds none the DC
+    // plane of its level-1 block.
+    const bool own = held[id] != 0;
+    if (before[id] == held[id] && (own || before[coarse] == held[coarse])) continue;
     uint8_t px[64];
-    if (held[id] != 0) reconstruct_block(t, id, held[id], px);
-    else std::fill(px, px + 64, uint8_t{128});
+    if (own) {
+      reconstruct_block(t, id, held[id], px);
+    } else {
+      if (plane_of != coarse) {
+        if (held[coarse] != 0) terrain::coarse_plane(t.levels[coarse].data(), held[coarse], t.quantiser, plane);
+        else std::fill(plane, plane + 64, int16_t{0});
+        plane_of = coarse;
+      }
+      const int v = std::clamp(plane[(pl.by % 8) * 8 + pl.bx % 8] + 128, 0, 255);
+      std::fill(px, px + 64, static_cast<uint8_t>(v));
+    }
     for (int y = 0; y < 8; ++y) {
-      const int py = by * 8 + y;
-      if (py >= p.plane_height(comp)) break;
+      const int py = pl.by * 8 + y;
+      if (py >= p.plane_height(pl.comp)) break;
       for (int x = 0; x < 8; ++x) {
-        const int qx = bx * 8 + x;
-        if (qx < p.plane_width(comp)) p.row(comp, py)[qx] = px[y * 8 + x];
+        const int qx = pl.bx * 8 + x;
+        if (qx < p.plane_width(pl.comp)) p.row(pl.comp, py)[qx] = px[y * 8 + x];
       }
     }
   }
@@ -178,7 +196,7 @@ void update_texture(const TerrainCoding& t, const std::vector<Mask>& before, con
 
 // --- Masks --------------------------------------------------------------------------------
 
-Mask shrink_mask(double cutoff, double cos_alpha, double beta_s) {
+Mask shrink_mask(double cutoff, double cos_alpha, double beta_s, bool keep_dc) {
   if (!(cutoff > 0)) return 0;
   const double kd = std::min(cutoff, 1.0);
   const double t = kd * std::clamp(cos_alpha, 0.0, 1.0);
@@ -200,7 +218,7 @@ Mask shrink_mask(double cutoff, double cos_alpha, double beta_s) {
     const int e = limit < 0 ? 0 : std::clamp(static_cast<int>(std::floor(8 * limit - 0.5)) + 1, 0, 8);
     m = terrain::mask_with_extent(m, v, e);
   }
-  if (mask_extent(m, 0) == 0) m = terrain::mask_with_extent(m, 0, 1);  // the DC stays
+  if (keep_dc && mask_extent(m, 0) == 0) m = terrain::mask_with_extent(m, 0, 1);
   return m;
 }
 
@@ -255,18 +273,21 @@ std::vector<Mask> pose_masks(const TerrainCoding& t, const SceneCamera& cam, con
       const double ppt = o.detail * cam.focal * texel_m / dist;
       const double pixels = std::min(ppt * ppt * 64 * std::max(cos_a, 0.05), 1.0 * cam.width * cam.height);
 
-      const uint32_t luma = static_cast<uint32_t>(j) * g.cells_x + i;
-      masks[luma] = shrink_mask(ppt, cos_a, beta_s);
-      views[luma] = BlockView{true, ppt, cos_a, beta_s, pixels, dist};
-      // Chroma: texels twice the size, one block for 2 x 2 cells.
-      const uint32_t c = static_cast<uint32_t>(j / 2) * g.chroma_x() + i / 2;
-      const Mask cm = shrink_mask(2 * ppt, cos_a, beta_s);
+      // The cell's blocks: its luma block; the chroma blocks of its 2 x 2
+      // cells (texels twice the size); and the level-1 blocks over those,
+      // whose samples are blocks (8 times the size), the DC always kept.
+      auto add = [&](uint32_t id, Mask m, double cutoff) {
+        masks[id] = terrain::mask_union(masks[id], m);
+        BlockView& v = views[id];
+        if (!v.visible || cutoff > v.cutoff) v = BlockView{true, cutoff, cos_a, beta_s, v.pixels, dist};
+        v.pixels += pixels;
+        v.distance = std::min(v.distance, dist);
+      };
+      add(g.cell(i, j), shrink_mask(ppt, cos_a, beta_s, false), ppt);
+      add(g.id(1, 0, i / 8, j / 8), shrink_mask(8 * ppt, cos_a, beta_s, true), 8 * ppt);
       for (int comp = 1; comp <= 2; ++comp) {
-        const uint32_t id = g.luma_blocks() + (comp - 1) * g.chroma_blocks() + c;
-        masks[id] = terrain::mask_union(masks[id], cm);
-        BlockView& cv = views[id];
-        if (!cv.visible || 2 * ppt > cv.cutoff) cv = BlockView{true, 2 * ppt, cos_a, beta_s, cv.pixels, dist};
-        cv.pixels += pixels;
+        add(g.id(0, comp, i / 2, j / 2), shrink_mask(2 * ppt, cos_a, beta_s, false), 2 * ppt);
+        add(g.id(1, comp, i / 16, j / 16), shrink_mask(16 * ppt, cos_a, beta_s, true), 16 * ppt);
       }
     }
   }
@@ -306,13 +327,17 @@ struct UpdateWriter {
     }
   }
 
-  void coefficients(uint32_t id, Mask held, Mask m) {
-    const int comp = t.grid.component(id), cls = comp == 0 ? 0 : 1;
+  // shown: the DC level a level-0 block shows before it holds anything
+  // (its prediction when it grows from nothing).
+  void coefficients(uint32_t id, Mask held, Mask m, int shown) {
+    const terrain::BlockPlace pl = t.grid.place(id);
+    const int comp = pl.comp, lvl = pl.level, cls = (comp == 0 ? 0 : 1) + 2 * lvl;
     const auto& lv = t.levels[id];
     const bool intra = held == 0;
     if (intra) {
-      ae.encode_signed(ctx.dc_zero[comp], ctx.dc_mag[comp], 6, lv[0] - dc_prev[comp], 8, 1);
-      dc_prev[comp] = lv[0];
+      const int pred = lvl == 0 ? std::clamp(shown, -128, 127) : dc_prev[comp];
+      ae.encode_signed(ctx.dc_zero[lvl][comp], ctx.dc_mag[lvl][comp], 6, lv[0] - pred, 8, 1);
+      if (lvl == 1) dc_prev[comp] = lv[0];
     }
     int pos[63], n = 0;
     for (int k = 1; k < 64; ++k) {
@@ -345,20 +370,24 @@ std::vector<uint8_t> encode_update(const TerrainCoding& t, const std::vector<Mas
                                    const std::vector<BlockChange>& shrinks, const std::vector<BlockChange>& grows) {
   if (shrinks.size() > 0xFFFF || grows.size() > 0xFFFF) throw std::invalid_argument("encode_update: too many blocks");
   UpdateWriter w(t);
+  // The client's masks as it reads the update: the shrinks applied, then
+  // each grow in turn (a block both shrunk and grown grows from what the
+  // shrink left; a level-0 block's prediction sees the level-1 grows
+  // before it).
+  std::vector<Mask> work = held;
   for (const BlockChange& s : shrinks) {
     w.id(s.id);
-    w.mask(held[s.id], s.mask, false);
+    w.mask(work[s.id], s.mask, false);
+    work[s.id] = s.mask;
   }
   w.last_id = -1;
   for (const BlockChange& g : grows) {
-    // A block both shrunk and grown in one update grows from what the
-    // shrink left.
-    Mask before = held[g.id];
-    for (const BlockChange& s : shrinks)
-      if (s.id == g.id) before = s.mask;
+    const Mask before = work[g.id];
     w.id(g.id);
     w.mask(before, g.mask, true);
-    w.coefficients(g.id, before, g.mask);
+    const bool level0 = g.id >= t.grid.first(0, 0);
+    w.coefficients(g.id, before, g.mask, level0 && before == 0 ? shown_dc(t, work, g.id) : 0);
+    work[g.id] = g.mask;
   }
   std::vector<uint8_t> body = w.ae.finish();
   std::vector<uint8_t> out(8 + body.size());
@@ -369,11 +398,12 @@ std::vector<uint8_t> encode_update(const TerrainCoding& t, const std::vector<Mas
   return out;
 }
 
-double TerrainServer::stage_score(uint32_t b, Mask from, Mask to, double pixels) const {
+double TerrainServer::stage_score(uint32_t b, Mask from, Mask to, double pixels, int shown) const {
   double energy = 0, bits = 4;
   for (int k = 0; k < 64; ++k) {
     if (!mask_holds(to, k & 7, k >> 3) || mask_holds(from, k & 7, k >> 3)) continue;
-    const int l = t_.levels[b][k];
+    // A DC corrects what the block showed before it.
+    const int l = k == 0 ? t_.levels[b][0] - shown : t_.levels[b][k];
     const double c = terrain::dequantise(l, k, t_.quantiser);
     energy += c * c;
     bits += l == 0 ? 0.5 : 5 + 2 * std::log2(1.0 + std::abs(l));
@@ -405,6 +435,10 @@ std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t f
   };
   std::vector<Want> wanted;
   constexpr Mask kBox[4] = {0x00000001u, 0x00000022u, 0x00004444u, terrain::kFullMask};
+  // What each block shows before its DC arrives.
+  std::vector<int> shown(n, 0);
+  for (uint32_t b = t_.grid.first(0, 0); b < n; ++b)
+    if (held_[b] == 0 && need[b] != 0) shown[b] = shown_dc(t_, held_, b);
   for (uint32_t b = 0; b < n; ++b) {
     if (terrain::mask_covers(held_[b], need[b])) continue;
     Mask prev = held_[b];
@@ -413,7 +447,7 @@ std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t f
       // be dropped to make room before the stage is sent, and stays dropped).
       const Mask part = terrain::mask_intersection(need[b], kBox[st]);
       const Mask target = terrain::mask_union(prev, part);
-      if (target != prev) wanted.push_back({b, part, stage_score(b, prev, target, views[b].pixels)});
+      if (target != prev) wanted.push_back({b, part, stage_score(b, prev, target, views[b].pixels, shown[b])});
       prev = target;
     }
   }
@@ -453,7 +487,7 @@ std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t f
     const uint32_t add = static_cast<uint32_t>(terrain::mask_count(target) - terrain::mask_count(after[b]));
     // The cost of this block, estimated in the order of choice.
     trial.mask(after[b], target, true);
-    trial.coefficients(b, after[b], target);
+    trial.coefficients(b, after[b], target, shown[b]);
     if (8 + trial.ae.finished_size() + picked.size() / 2 > budget) break;
     while (used + add > capacity_) {
       if (next_unneeded < unneeded.size()) {

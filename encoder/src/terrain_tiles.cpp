@@ -76,7 +76,7 @@ class TileSource : public FlightSource {
     const int top = static_cast<int>(levels_.size()) - 1;
     for (int j = 0; j < t_.grid.cells_y; ++j)
       for (int i = 0; i < t_.grid.cells_x; ++i) {
-        const BlockView& v = views[static_cast<size_t>(j) * t_.grid.cells_x + i];
+        const BlockView& v = views[t_.grid.cell(i, j)];
         if (!v.visible) continue;
         const double ppt = v.cutoff / o_.pose.detail;  // screen pixels a full-resolution texel covers
         int level = ppt > 0 ? static_cast<int>(std::floor(std::log2(to_.max_error_px / ppt))) : top;

@@ -2,8 +2,8 @@
 //   0  a Trigger Rally .level file (vds/enc/terrain_map.h: parse_level)
 //   1  a heightmap and colour image pair (read_terrain; the second byte
 //      splits the rest between them)
-//   2  the client's elevation decoder (vds/terrain.h: decode_elevation) on a
-//      grid whose size the next two bytes give
+//   2  the client's elevation decoder (vds/terrain.h: decode_elevation),
+//      both passes, on a grid whose size the next two bytes give
 //   3  the client's texture-update reader on a grid the next two bytes give,
 //      every block it returns applied to a store of masks, over several
 //      updates (the rest split at 0xFF bytes)
@@ -37,6 +37,8 @@ void host_refusal(const std::runtime_error& e, const char* name) {
 struct Store {
   std::vector<vds::terrain::Mask> masks;
   static vds::terrain::Mask held(void* ctx, uint32_t id) { return static_cast<Store*>(ctx)->masks[id]; }
+  // Any value: the reader must stay in range whatever the client shows.
+  static int shown_dc(void*, uint32_t id) { return static_cast<int>(id * 37 % 301) - 150; }
 };
 
 void write_seed(const std::filesystem::path& dir, const char* name, uint8_t kind, const std::vector<uint8_t>& body) {
@@ -59,7 +61,8 @@ void seed(const std::filesystem::path& dir) {
   for (size_t i = 0; i < m.colour.pixels.size(); ++i) m.colour.pixels[i] = static_cast<uint8_t>(i * 13 + (i >> 7));
   const vds::enc::TerrainCoding t = vds::enc::code_terrain(m, 4);
   std::vector<uint8_t> e = {static_cast<uint8_t>(t.points_x() - 1), static_cast<uint8_t>(t.points_y() - 1)};
-  const std::vector<uint8_t> ec = vds::enc::encode_elevation(t.heights.data(), t.points_x(), t.points_y());
+  const std::vector<uint8_t> ec =
+      vds::enc::encode_elevation(t.heights.data(), t.points_x(), t.points_y(), vds::terrain::ElevationPass::coarse);
   e.insert(e.end(), ec.begin(), ec.end());
   write_seed(dir, "elevation", 2, e);
   vds::enc::TerrainServer server(t, 4000);
@@ -101,7 +104,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   } else if (kind == 2) {
     const int w = 1 + rest[0] % 64, h = 1 + rest[1] % 64;
     std::vector<uint16_t> out(static_cast<size_t>(w) * h, 0);
-    vds::terrain::decode_elevation(rest + 2, n - 2, w, h, out.data());
+    // Both passes over the same bytes: the fine pass after whatever the
+    // coarse one left.
+    vds::terrain::decode_elevation(rest + 2, n - 2, w, h, vds::terrain::ElevationPass::coarse, out.data());
+    vds::terrain::decode_elevation(rest + 2, n - 2, w, h, vds::terrain::ElevationPass::fine, out.data());
+    vds::terrain::fill_from_coarse(w, h, out.data());
   } else {
     vds::terrain::BlockGrid g;
     g.cells_x = static_cast<uint16_t>(1 + rest[0] % 40);
@@ -113,7 +120,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       size_t end = at;
       while (end < n && rest[end] != 0xFF) ++end;
       vds::terrain::TextureUpdateReader r;
-      if (r.init(rest + at, end - at, g, &Store::held, &store) == vds::Status::ok) {
+      if (r.init(rest + at, end - at, g, &Store::held, &Store::shown_dc, &store) == vds::Status::ok) {
         vds::terrain::BlockUpdate u;
         while (r.next(&u) == vds::Status::ok) {
           if (!vds::terrain::mask_valid(u.mask) || u.id >= g.blocks()) abort();

@@ -169,36 +169,56 @@ TEST(TerrainMap, ReadsTriggerRallyMapsFromTheirArchive) {
 
 // --- Elevation -------------------------------------------------------------------------
 
-TEST(TerrainElevation, RoundTripsExactlyAndRefusesEveryPrefix) {
-  const int w = 33, h = 29;
-  std::vector<uint16_t> v(static_cast<size_t>(w) * h);
-  vds::test::Xorshift32 rng{5};
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const double s = 20000 + 15000 * std::sin(x * 0.2) * std::cos(y * 0.15);
-      v[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(s + (rng.next() % 9));
-    }
-  v[0] = 0;
-  v[5] = 65535;  // the extremes, next to each other's neighbours
-  v[6] = 0;
-  const std::vector<uint8_t> coded = enc::encode_elevation(v.data(), w, h);
-  std::vector<uint16_t> out(v.size(), 1);
-  ASSERT_EQ(terrain::decode_elevation(coded.data(), coded.size(), w, h, out.data()), Status::ok);
-  EXPECT_EQ(out, v);
-  EXPECT_LT(coded.size(), v.size() * 2);  // under 16 bits a point, on steep ground
-  for (size_t n = 0; n < coded.size(); ++n)
-    EXPECT_NE(terrain::decode_elevation(coded.data(), n, w, h, out.data()), Status::ok) << n;
-  std::vector<uint8_t> longer = coded;
-  longer.push_back(0x55);
-  EXPECT_EQ(terrain::decode_elevation(longer.data(), longer.size(), w, h, out.data()), Status::malformed);
+TEST(TerrainElevation, RoundTripsExactlyInTwoPassesAndRefusesEveryPrefix) {
+  const int w = 33, h = 25;  // h - 1 a multiple of the coarse step, w - 1 too: both edge cases
+  for (const int width : {w, w + 3}) {
+    std::vector<uint16_t> v(static_cast<size_t>(width) * h);
+    vds::test::Xorshift32 rng{5};
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < width; ++x) {
+        const double s = 20000 + 15000 * std::sin(x * 0.2) * std::cos(y * 0.15);
+        v[static_cast<size_t>(y) * width + x] = static_cast<uint16_t>(s + (rng.next() % 9));
+      }
+    v[0] = 0;
+    v[5] = 65535;  // the extremes, next to each other's neighbours
+    v[6] = 0;
+    const auto coarse = enc::encode_elevation(v.data(), width, h, terrain::ElevationPass::coarse);
+    const auto fine = enc::encode_elevation(v.data(), width, h, terrain::ElevationPass::fine);
+    std::vector<uint16_t> out(v.size(), 1);
+    ASSERT_EQ(terrain::decode_elevation(coarse.data(), coarse.size(), width, h, terrain::ElevationPass::coarse, out.data()),
+              Status::ok);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < width; ++x)
+        if (terrain::elevation_coarse(x, y, width, h)) ASSERT_EQ(out[y * width + x], v[y * width + x]) << x << "," << y;
+    // Between the coarse points the client draws the interpolation.
+    std::vector<uint16_t> rough = out;
+    terrain::fill_from_coarse(width, h, rough.data());
+    const int x0 = 8, x1 = 16, y0 = 8;
+    EXPECT_NEAR(rough[y0 * width + 12], (v[y0 * width + x0] + v[y0 * width + x1]) / 2.0, 1.0);
+    EXPECT_EQ(rough[(h - 1) * width + 3],
+              (v[(h - 1) * width] * 5 + v[(h - 1) * width + 8] * 3 + 4) / 8);  // the last row, (h - 1) % 8 == 0
+    ASSERT_EQ(terrain::decode_elevation(fine.data(), fine.size(), width, h, terrain::ElevationPass::fine, out.data()),
+              Status::ok);
+    EXPECT_EQ(out, v);
+    EXPECT_LT(coarse.size() + fine.size(), v.size() * 2);  // under 16 bits a point, on steep ground
+    for (size_t n = 0; n < fine.size(); ++n)
+      EXPECT_NE(terrain::decode_elevation(fine.data(), n, width, h, terrain::ElevationPass::fine, out.data()), Status::ok) << n;
+    for (size_t n = 0; n < coarse.size(); ++n)
+      EXPECT_NE(terrain::decode_elevation(coarse.data(), n, width, h, terrain::ElevationPass::coarse, out.data()),
+                Status::ok) << n;
+    std::vector<uint8_t> longer = fine;
+    longer.push_back(0x55);
+    EXPECT_EQ(terrain::decode_elevation(longer.data(), longer.size(), width, h, terrain::ElevationPass::fine, out.data()),
+              Status::malformed);
+  }
 }
 
 // --- Masks ----------------------------------------------------------------------------------
 
 // The paper's rule (section 4.5) coefficient by coefficient, in double, as
 // written, with the DC kept.
-bool reference_keeps(int u, int v, double kd, double cos_a, double beta_s) {
-  if (u == 0 && v == 0) return kd > 0;
+bool reference_keeps(int u, int v, double kd, double cos_a, double beta_s, bool keep_dc = true) {
+  if (u == 0 && v == 0 && keep_dc) return kd > 0;
   if (!(kd > 0)) return false;
   kd = std::min(kd, 1.0);
   const double U = (u + 0.5) / 8, V = (v + 0.5) / 8, T = kd * cos_a;
@@ -232,11 +252,15 @@ TEST(TerrainMask, MatchesTheDoubleReferenceOfThePapersRule) {
     const double beta_s = b == 91 ? kPi / 2 : b * kPi / 180;
     const Mask m = enc::shrink_mask(kd, cos_a, beta_s);
     ASSERT_TRUE(terrain::mask_valid(m)) << std::hex << m;
+    const Mask paper = enc::shrink_mask(kd, cos_a, beta_s, false);  // the DC by the rule too
+    ASSERT_EQ(paper & ~Mask{0xF}, m & ~Mask{0xF});
     for (int v = 0; v < 8; ++v)
       for (int u = 0; u < 8; ++u) {
         if (!(u == 0 && v == 0) && boundary_distance(u, v, kd, cos_a, beta_s) < 1e-9) continue;
         ASSERT_EQ(terrain::mask_holds(m, u, v), reference_keeps(u, v, kd, cos_a, beta_s))
             << "u " << u << " v " << v << " k/D " << kd << " cos " << cos_a << " beta_s " << beta_s;
+        if (v == 0 && boundary_distance(u, v, kd, cos_a, beta_s) >= 1e-9)
+          ASSERT_EQ(terrain::mask_holds(paper, u, v), reference_keeps(u, v, kd, cos_a, beta_s, false)) << u << " " << kd;
         ++compared;
       }
   }
@@ -248,6 +272,7 @@ TEST(TerrainMask, ShapesFollowDepthTiltAndRotation) {
   EXPECT_EQ(enc::shrink_mask(3.0, 1.0, 0.3), terrain::kFullMask);          // magnified
   EXPECT_EQ(enc::shrink_mask(0.0, 1.0, 0.3), 0u);                          // nothing
   EXPECT_EQ(enc::shrink_mask(0.01, 1.0, 0.3), 0x00000001u);                // far: the DC alone
+  EXPECT_EQ(enc::shrink_mask(0.01, 1.0, 0.3, false), 0u);                  // or, as the paper has it, nothing
   EXPECT_EQ(enc::shrink_mask(0.5, 1.0, kPi / 2), 0x00004444u);             // depth: a 4x4 corner
   EXPECT_EQ(enc::shrink_mask(1.0, 0.5, kPi / 2), 0x44444444u);             // tilted along u: half the u's
   EXPECT_EQ(enc::shrink_mask(1.0, 0.5, 0.0), 0x00008888u);                 // along v: half the v's
@@ -306,11 +331,23 @@ struct Client {
   std::vector<Mask> masks;
   std::vector<std::array<int16_t, 64>> levels;
   std::map<std::pair<uint32_t, int>, int> received;  // (block, coefficient) -> times
-  explicit Client(uint32_t blocks) : masks(blocks, 0), levels(blocks) {}
+  const enc::TerrainCoding* t = nullptr;
+  explicit Client(const enc::TerrainCoding& tc) : masks(tc.grid.blocks(), 0), levels(tc.grid.blocks()), t(&tc) {}
   static Mask held(void* ctx, uint32_t id) { return static_cast<Client*>(ctx)->masks[id]; }
+  // What a level-0 block shows before it holds anything: its sample of its
+  // level-1 block's DC plane, from what this client holds of that block.
+  static int shown_dc(void* ctx, uint32_t id) {
+    const Client& c = *static_cast<Client*>(ctx);
+    const terrain::BlockPlace p = c.t->grid.place(id);
+    const uint32_t coarse = c.t->grid.id(1, p.comp, p.bx / 8, p.by / 8);
+    if (c.masks[coarse] == 0) return 0;
+    int16_t plane[64];
+    terrain::coarse_plane(c.levels[coarse].data(), c.masks[coarse], c.t->quantiser, plane);
+    return plane[(p.by % 8) * 8 + p.bx % 8];
+  }
   Status apply(const std::vector<uint8_t>& u, const terrain::BlockGrid& g) {
     terrain::TextureUpdateReader r;
-    Status s = r.init(u.data(), u.size(), g, &Client::held, this);
+    Status s = r.init(u.data(), u.size(), g, &Client::held, &Client::shown_dc, this);
     if (s != Status::ok) return s;
     terrain::BlockUpdate b;
     while ((s = r.next(&b)) == Status::ok) {
@@ -334,7 +371,7 @@ TEST(TerrainUpdates, TheClientHoldsWhatTheServerMirrorsAndNothingIsSentTwiceUnle
   const uint32_t blocks = t.grid.blocks();
   const uint32_t capacity = 6000;  // well under what the flight sees: the store evicts
   enc::TerrainServer server(t, capacity);
-  Client client(blocks);
+  Client client(t);
   std::map<std::pair<uint32_t, int>, int> dropped;
   const int frames = 120;
   const size_t budget = 600;
@@ -375,7 +412,7 @@ TEST(TerrainUpdates, TheClientHoldsWhatTheServerMirrorsAndNothingIsSentTwiceUnle
 TEST(TerrainUpdates, AStillViewerGetsEverythingItNeedsAndThenNothing) {
   const enc::TerrainCoding t = enc::code_terrain(test_map(), 6);
   enc::TerrainServer server(t, 1u << 20);
-  Client client(t.grid.blocks());
+  Client client(t);
   const enc::SceneCamera cam = flight_camera(t, 10, 100);
   const std::vector<Mask> need = enc::pose_masks(t, cam, {});
   uint32_t visible = 0;
@@ -401,14 +438,14 @@ TEST(TerrainUpdates, EveryPrefixAndEveryBitFlipIsRefusedOrStaysInRange) {
   const auto u = server.update(flight_camera(t, 3, 100), 3, 1500, {});
   ASSERT_GT(u.size(), 100u);
   for (size_t n = 0; n < u.size(); ++n) {
-    Client c(t.grid.blocks());
+    Client c(t);
     EXPECT_NE(c.apply(std::vector<uint8_t>(u.begin(), u.begin() + static_cast<long>(n)), t.grid), Status::ok) << n;
   }
   vds::test::Xorshift32 rng{3};
   for (int i = 0; i < 300; ++i) {
     std::vector<uint8_t> bad = u;
     bad[rng.next() % bad.size()] ^= static_cast<uint8_t>(1u << (rng.next() % 8));
-    Client c(t.grid.blocks());
+    Client c(t);
     c.apply(bad, t.grid);  // whatever it says, the masks it leaves are valid
     for (Mask m : c.masks) ASSERT_TRUE(terrain::mask_valid(m));
   }
@@ -416,11 +453,47 @@ TEST(TerrainUpdates, EveryPrefixAndEveryBitFlipIsRefusedOrStaysInRange) {
 
 TEST(TerrainUpdates, ReconstructionApproachesTheSourceAsMasksGrow) {
   const enc::TerrainCoding t = enc::code_terrain(test_map(), 2);
-  std::vector<Mask> dc(t.grid.blocks(), 0x1), full(t.grid.blocks(), terrain::kFullMask);
-  const double p_dc = enc::planes_psnr(enc::reconstruct_texture(t, dc), t.texture);
-  const double p_full = enc::planes_psnr(enc::reconstruct_texture(t, full), t.texture);
-  EXPECT_GT(p_full, 40.0);
-  EXPECT_LT(p_dc, p_full - 8);
+  const uint32_t fine = t.grid.first(0, 0), n = t.grid.blocks();
+  std::vector<Mask> none(n, 0), coarse_dc(n, 0), coarse(n, 0), dc(n, 0x1), full(n, terrain::kFullMask);
+  for (uint32_t b = 0; b < fine; ++b) coarse_dc[b] = 0x1, coarse[b] = terrain::kFullMask;
+  for (uint32_t b = 0; b < fine; ++b) dc[b] = 0;
+  std::vector<double> p;
+  for (const auto* m : {&none, &coarse_dc, &coarse, &dc, &full})
+    p.push_back(enc::planes_psnr(enc::reconstruct_texture(t, *m), t.texture));
+  // Nothing, the level-1 DCs, the whole level 1 (every block's mean), every
+  // level-0 DC (the same means, exactly), every coefficient.
+  for (size_t k = 1; k < p.size(); ++k) EXPECT_GE(p[k], p[k - 1] - 1e-9) << k;
+  EXPECT_GT(p[1], p[0]);
+  EXPECT_NEAR(p[2], p[3], 1.0);
+  EXPECT_GT(p[4], 40.0);
+  EXPECT_LT(p[3], p[4] - 8);
+  // A level-0 block holding nothing shows its sample of the level-1 plane.
+  const uint32_t b = t.grid.cell(5, 3);
+  const int dcs = enc::shown_dc(t, coarse, b);
+  EXPECT_NEAR(dcs, t.levels[b][0], 4);  // the level-1 plane's AC is quantised
+}
+
+TEST(TerrainUpdates, BlockIdsCoverBothLevelsOnce) {
+  terrain::BlockGrid g;
+  g.cells_x = 37;
+  g.cells_y = 20;
+  EXPECT_EQ(g.plane_w(0, 1), 19);
+  EXPECT_EQ(g.plane_w(1, 0), 5);
+  EXPECT_EQ(g.plane_w(1, 1), 3);
+  EXPECT_EQ(g.first(1, 0), 0u);
+  std::vector<int> seen(g.blocks(), 0);
+  for (int l = 1; l >= 0; --l)
+    for (int c = 0; c < 3; ++c)
+      for (int y = 0; y < g.plane_h(l, c); ++y)
+        for (int x = 0; x < g.plane_w(l, c); ++x) {
+          const uint32_t id = g.id(l, c, x, y);
+          ASSERT_LT(id, g.blocks());
+          ++seen[id];
+          const terrain::BlockPlace p = g.place(id);
+          ASSERT_TRUE(p.level == l && p.comp == c && p.bx == x && p.by == y) << id;
+        }
+  for (int k : seen) ASSERT_EQ(k, 1);
+  EXPECT_EQ(g.cell(4, 2), g.first(0, 0) + 2 * 37 + 4);
 }
 
 }  // namespace

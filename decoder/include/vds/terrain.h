@@ -7,10 +7,10 @@
 // block per 2 x 2 cells. The server sends each block's DCT coefficients as
 // the viewer's pose first needs them (docs/terrain.md):
 //
-//   the elevation   (decode_elevation) once, before any texture: the grid
-//                   coded losslessly, each height predicted from its
-//                   neighbours (the median predictor of LOCO-I) and the
-//                   residual coded with the adaptive binary arithmetic coder.
+//   the elevation   (decode_elevation) before any texture, coarse points
+//                   first: the grid coded losslessly, each height predicted
+//                   from its neighbours (the median predictor of LOCO-I) and
+//                   the residual coded with the adaptive arithmetic coder.
 //   texture updates (TextureUpdateReader) as the pose changes: blocks that
 //                   the client must drop or shrink, then blocks whose held
 //                   coefficient set (their *mask*) grows, with the quantised
@@ -58,19 +58,40 @@ inline bool mask_covers(Mask a, Mask b) { return mask_union(a, b) == a; }
 
 // --- Blocks -------------------------------------------------------------------
 
-// Block ids: the luma blocks in raster order (cells_x x cells_y), then Cb,
-// then Cr ((cells_x + 1) / 2 x (cells_y + 1) / 2 each).
+// Blocks come in two levels. Level 0: the texture's 8x8 blocks, one luma
+// block per cell and a Cb and a Cr block per 2 x 2 cells. Level 1: 8x8
+// blocks of the level-0 DC planes (a plane of each component's block
+// means, in DC levels), so one level-1 block stands for 8 x 8 level-0
+// blocks: the coarse picture far terrain is drawn from, and what a level-0
+// block shows before it holds anything.
+//
+// Block ids: level 1 (Y', Cb, Cr, each in raster order), then level 0.
+struct BlockPlace {
+  uint8_t level = 0, comp = 0;  // comp: 0 Y', 1 Cb, 2 Cr
+  uint16_t bx = 0, by = 0;      // in blocks of its plane
+};
 struct BlockGrid {
   uint16_t cells_x = 0, cells_y = 0;
-  uint32_t luma_blocks() const { return uint32_t{cells_x} * cells_y; }
-  uint16_t chroma_x() const { return static_cast<uint16_t>((cells_x + 1) / 2); }
-  uint16_t chroma_y() const { return static_cast<uint16_t>((cells_y + 1) / 2); }
-  uint32_t chroma_blocks() const { return uint32_t{chroma_x()} * chroma_y(); }
-  uint32_t blocks() const { return luma_blocks() + 2 * chroma_blocks(); }
-  // 0 = Y', 1 = Cb, 2 = Cr.
-  int component(uint32_t id) const {
-    return id < luma_blocks() ? 0 : (id < luma_blocks() + chroma_blocks() ? 1 : 2);
+  // A plane's size in blocks.
+  uint16_t plane_w(int level, int comp) const {
+    const int w = comp == 0 ? cells_x : (cells_x + 1) / 2;
+    return static_cast<uint16_t>(level == 0 ? w : (w + 7) / 8);
   }
+  uint16_t plane_h(int level, int comp) const {
+    const int h = comp == 0 ? cells_y : (cells_y + 1) / 2;
+    return static_cast<uint16_t>(level == 0 ? h : (h + 7) / 8);
+  }
+  uint32_t plane_blocks(int level, int comp) const { return uint32_t{plane_w(level, comp)} * plane_h(level, comp); }
+  // The id of a plane's first block.
+  uint32_t first(int level, int comp) const;
+  uint32_t id(int level, int comp, int bx, int by) const {
+    return first(level, comp) + static_cast<uint32_t>(by) * plane_w(level, comp) + static_cast<uint32_t>(bx);
+  }
+  uint32_t blocks() const { return first(0, 0) + plane_blocks(0, 0) + 2 * plane_blocks(0, 1); }
+  // The level-0 luma block of cell (i, j).
+  uint32_t cell(int i, int j) const { return id(0, 0, i, j); }
+  BlockPlace place(uint32_t id) const;  // id < blocks()
+  int component(uint32_t id) const { return place(id).comp; }
 };
 
 // Limits a client accepts (the stream's header is refused past them).
@@ -88,11 +109,28 @@ inline constexpr int kMaxLevel = 2047;
 
 // --- Elevation ----------------------------------------------------------------
 
-// Decodes a (w x h)-point grid of heights coded by the host's
-// encode_elevation from `data`, row by row into out[y * w + x]. malformed
-// for a residual that leaves 0..65535 or bytes no encoder produces,
-// truncated when the data ends first. Every decoded height is in range.
-Status decode_elevation(const uint8_t* data, size_t size, int w, int h, uint16_t* out);
+// The elevation goes in two passes so that the client can draw the ground
+// long before it holds all of it: the coarse points (every kCoarseStep-th
+// column of every kCoarseStep-th row, the last column and row included),
+// then the rest in raster order. Each height is predicted from its left,
+// upper and upper-left neighbours (in the coarse pass, its neighbours on
+// the coarse grid) by the median predictor of LOCO-I, and the residual is
+// coded with the adaptive arithmetic coder in four context classes by the
+// neighbours' activity.
+inline constexpr int kCoarseStep = 8;
+enum class ElevationPass : uint8_t { coarse = 0, fine = 1 };
+
+// Decodes one pass of a (w x h)-point grid coded by the host's
+// encode_elevation into out[y * w + x]; the fine pass needs the coarse
+// pass's points in `out`. malformed for a residual that leaves 0..65535 or
+// bytes no encoder produces, truncated when the data ends first.
+Status decode_elevation(const uint8_t* data, size_t size, int w, int h, ElevationPass pass, uint16_t* out);
+// The points the fine pass will send, interpolated (bilinear) from the
+// coarse ones: what the client draws until then.
+void fill_from_coarse(int w, int h, uint16_t* out);
+constexpr bool elevation_coarse(int x, int y, int w, int h) {
+  return (x % kCoarseStep == 0 || x == w - 1) && (y % kCoarseStep == 0 || y == h - 1);
+}
 
 // The contexts of the elevation coder (both sides).
 struct ElevationContexts {
@@ -100,13 +138,44 @@ struct ElevationContexts {
   ArithContext mag[4][8];
 };
 void init_elevation_contexts(ElevationContexts& c);
-// Context class of a point from the activity |a - c| + |b - c| of its
-// neighbours (a left, b above, c above-left).
-int elevation_class(int a, int b, int c);
 // The median predictor: min(a, b) if c >= max(a, b), max(a, b) if c <=
-// min(a, b), else a + b - c. Missing neighbours: the first point predicts
-// 0, the first row from the left, the first column from above.
-int elevation_predict(const uint16_t* rows, int w, int x, int y);
+// min(a, b), else a + b - c; with no upper row the left value (0 for the
+// first point), with no left column the upper value.
+int elevation_median(int a, int b, int c, bool has_left, bool has_up);
+// Context class from the activity |a - c| + |b - c| (3 without both
+// neighbours).
+int elevation_class(int a, int b, int c, bool both);
+
+// Visits the points of a pass in coding order: f(x, y, prediction, class)
+// with the prediction from what `out` holds when it is called; f returns
+// false to stop. Shared by the decoder and the host encoder.
+template <class F>
+void for_each_elevation_point(int w, int h, ElevationPass pass, const uint16_t* out, F f) {
+  auto at = [&](int x, int y) { return static_cast<int>(out[static_cast<size_t>(y) * w + x]); };
+  if (pass == ElevationPass::coarse) {
+    const int cw = (w - 1 + kCoarseStep - 1) / kCoarseStep + 1, ch = (h - 1 + kCoarseStep - 1) / kCoarseStep + 1;
+    auto cx = [&](int i) { return i * kCoarseStep < w - 1 ? i * kCoarseStep : w - 1; };
+    auto cy = [&](int j) { return j * kCoarseStep < h - 1 ? j * kCoarseStep : h - 1; };
+    for (int j = 0; j < ch; ++j)
+      for (int i = 0; i < cw; ++i) {
+        const int a = i > 0 ? at(cx(i - 1), cy(j)) : 0, b = j > 0 ? at(cx(i), cy(j - 1)) : 0;
+        const int c = i > 0 && j > 0 ? at(cx(i - 1), cy(j - 1)) : 0;
+        if (!f(cx(i), cy(j), elevation_median(a, b, c, i > 0, j > 0), elevation_class(a, b, c, i > 0 && j > 0))) return;
+      }
+    return;
+  }
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (elevation_coarse(x, y, w, h)) continue;
+      const int a = x > 0 ? at(x - 1, y) : 0, b = y > 0 ? at(x, y - 1) : 0, c = x > 0 && y > 0 ? at(x - 1, y - 1) : 0;
+      if (!f(x, y, elevation_median(a, b, c, x > 0, y > 0), elevation_class(a, b, c, x > 0 && y > 0))) return;
+    }
+}
+
+// The DC plane a level-1 block stands for: the integer IDCT of the
+// coefficients `held` holds of `levels` (natural order), out[8 * y + x] in
+// DC levels (a level-0 block's mean minus 128, rounded).
+void coarse_plane(const int16_t levels[64], Mask held, int quantiser, int16_t out[64]);
 
 // --- Texture updates ------------------------------------------------------------
 
@@ -114,12 +183,13 @@ int elevation_predict(const uint16_t* rows, int w, int x, int y);
 struct TextureContexts {
   ArithContext id_gap[8];            // Exp-Golomb prefix of the gap to the next block id
   ArithContext extent[2][8];         // [shrink / grow] truncated unary of an extent change
-  ArithContext dc_zero[3];           // DC residual, per component class (Y', Cb, Cr)
-  ArithContext dc_mag[3][6];
-  ArithContext cbf[2][2];            // [intra / inter][luma / chroma] any nonzero AC
-  ArithContext sig[2][6];            // [luma / chroma][position class]
-  ArithContext last[2][6];
-  ArithContext level[2][6];          // |level| - 1, prefix contexts
+  ArithContext dc_zero[2][3];        // DC residual, [level][component]
+  ArithContext dc_mag[2][3][6];
+  // [class] below: luma, chroma, level-1 luma, level-1 chroma.
+  ArithContext cbf[2][4];            // [intra / inter][class] any nonzero AC
+  ArithContext sig[4][6];            // [class][position class]
+  ArithContext last[4][6];
+  ArithContext level[4][6];          // |level| - 1, prefix contexts
 };
 void init_texture_contexts(TextureContexts& c);
 // Position class of zig-zag index k (1..63): 1-2, 3-5, 6-9, 10-20, 21-35, 36-63.
@@ -141,11 +211,18 @@ struct BlockUpdate {
 //   (gap, new mask >= held, coefficients).
 // The caller owns the masks: `held(ctx, id)` gives a block's current mask,
 // and every block the reader returns must be applied before the next.
+//
+// A level-0 block grown from nothing codes its DC against what the client
+// shows there (`shown_dc(ctx, id)`: the DC plane of its level-1 block as
+// the client holds it when the block is read, 0 if it holds nothing); a
+// level-1 block grown from nothing against the previous one of its
+// component in the update.
 class TextureUpdateReader {
  public:
   using HeldFn = Mask (*)(void* ctx, uint32_t id);
+  using ShownDcFn = int (*)(void* ctx, uint32_t id);
   // invalid_argument for a bad grid; malformed for a header that cannot be.
-  Status init(const uint8_t* data, size_t size, const BlockGrid& grid, HeldFn held, void* ctx);
+  Status init(const uint8_t* data, size_t size, const BlockGrid& grid, HeldFn held, ShownDcFn shown_dc, void* ctx);
   uint32_t pose_frame() const { return pose_frame_; }
   uint32_t shrinks() const { return shrinks_; }
   uint32_t grows() const { return grows_; }
@@ -165,6 +242,7 @@ class TextureUpdateReader {
   TextureContexts ctx_{};
   BlockGrid grid_{};
   HeldFn held_ = nullptr;
+  ShownDcFn shown_dc_ = nullptr;
   void* held_ctx_ = nullptr;
   uint32_t pose_frame_ = 0, shrinks_ = 0, grows_ = 0, read_ = 0;
   int64_t last_id_ = -1;

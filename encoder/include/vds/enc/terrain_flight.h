@@ -38,7 +38,8 @@ struct FlightLink {
 };
 
 struct FlightFrame {
-  size_t down_bytes = 0;   // update bytes that arrived before this frame
+  size_t down_bytes = 0;       // texture bytes that arrived before this frame
+  size_t elevation_bytes = 0;  // fine elevation bytes that arrived with them
   size_t up_bytes = 0;     // pose bytes sent at this frame
   UpdateStats update;      // the update this frame answered (if any)
   uint32_t held = 0;       // what the client holds: coefficients (vds), cache bytes (tiles)
@@ -58,7 +59,9 @@ struct FlightOptions {
 
 struct FlightResult {
   std::vector<FlightFrame> frames;
-  size_t elevation_bytes = 0;
+  size_t elevation_bytes = 0;         // both passes
+  size_t coarse_elevation_bytes = 0;  // the coarse pass, sent before anything else
+  uint32_t elevation_frame = 0;       // the frame the fine pass was whole by
   size_t first_update_bytes = 0;  // the intra data of the first pose
   uint32_t first_update_frames = 0;  // frames until the first pose's needs were all sent
   bool first_update_done = false;    // they were, within the flight
@@ -83,11 +86,12 @@ class FlightSource {
 // The flight loop both fly() and the baselines use.
 FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const FlightOptions& o, FlightSource& source);
 
-// Plays the flight: each frame the server answers the pose of
-// latency_frames before with an update of at most the bytes the link
-// carried since the last one; the update is applied before the frame is
-// drawn. The elevation goes first (its bytes at the link rate delay the
-// first update).
+// Plays the flight: the coarse elevation first; then each frame the
+// fine elevation takes up to half the bytes the link carried (until it is
+// whole; the client draws the ground interpolated from the coarse points
+// until then) and the server answers the pose of latency_frames before
+// with an update of at most the rest; the update is applied before the
+// frame is drawn.
 FlightResult fly(const TerrainCoding& t, const CameraPath& path, const FlightOptions& o);
 
 }  // namespace vds::enc

@@ -46,8 +46,8 @@ struct TerrainCoding {
 // on a side.
 TerrainCoding code_terrain(const TerrainMap& map, int quantiser);
 
-// The elevation, coded losslessly (vds/terrain.h: decode_elevation).
-std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h);
+// One pass of the elevation, coded losslessly (vds/terrain.h: decode_elevation).
+std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h, terrain::ElevationPass pass);
 
 // A block's texture as the client reconstructs it from the coefficients its
 // mask holds: 64 samples, row-major.
@@ -59,6 +59,9 @@ Planes reconstruct_texture(const TerrainCoding& t, const std::vector<terrain::Ma
 // in place: `texture` held `before`'s reconstruction.
 void update_texture(const TerrainCoding& t, const std::vector<terrain::Mask>& before,
                     const std::vector<terrain::Mask>& held, Planes* texture);
+// The DC level a level-0 block shows while it holds nothing: its sample
+// of its level-1 block's DC plane as `held` holds that (0 if nothing).
+int shown_dc(const TerrainCoding& t, const std::vector<terrain::Mask>& held, uint32_t id);
 // Ground height (metres) at world (x, y), bilinear over the grid, clamped to it.
 double terrain_height(const TerrainCoding& t, double x, double y);
 
@@ -71,10 +74,10 @@ double terrain_height(const TerrainCoding& t, double x, double y);
 // along u, 0 along v). A coefficient (u, v) with U = (u + 0.5) / 8 and
 // V = (v + 0.5) / 8 is dropped when U or V exceeds the cutoff, or beyond the
 // line through (T, T), T = cutoff cos alpha, of slope -1 / tan beta_s (U > T
-// - (V - T) / tan beta_s; V > T at beta_s = 0, U > T at pi/2). A block with
-// a positive cutoff keeps its DC however small it is; cutoff <= 0 gives the
-// empty mask.
-terrain::Mask shrink_mask(double cutoff, double cos_alpha, double beta_s);
+// - (V - T) / tan beta_s; V > T at beta_s = 0, U > T at pi/2). With keep_dc
+// a block with a positive cutoff keeps its DC however small the cutoff;
+// cutoff <= 0 gives the empty mask.
+terrain::Mask shrink_mask(double cutoff, double cos_alpha, double beta_s, bool keep_dc = true);
 
 // How a pose sees one block.
 struct BlockView {
@@ -83,7 +86,7 @@ struct BlockView {
   double cos_alpha = 0;
   double beta_s = 0;
   double pixels = 0;      // screen pixels the block covers (estimate)
-  double distance = 0;    // metres from the eye to the nearest point of the cell (luma blocks)
+  double distance = 1e300;  // metres from the eye to the nearest point of its cells
 };
 
 struct PoseOptions {
@@ -93,6 +96,9 @@ struct PoseOptions {
 
 // The masks a camera needs, one per block (empty for blocks it cannot see:
 // outside the view, behind the camera or facing away), and how it sees each.
+// Level-0 blocks take the paper's rule as it stands (a block too far for
+// its DC needs nothing: its level-1 block stands for it); level-1 blocks
+// the rule at 8 times the cutoff (their samples are blocks), their DC kept.
 std::vector<terrain::Mask> pose_masks(const TerrainCoding& t, const SceneCamera& camera, const PoseOptions& o,
                                       std::vector<BlockView>* views = nullptr);
 
@@ -129,8 +135,9 @@ class TerrainServer {
 
  private:
   // Squared screen error per estimated bit of growing block b from `from`
-  // to `to` where it covers `pixels` pixels.
-  double stage_score(uint32_t b, terrain::Mask from, terrain::Mask to, double pixels) const;
+  // to `to` where it covers `pixels` pixels and shows DC level `shown`
+  // before its own DC arrives.
+  double stage_score(uint32_t b, terrain::Mask from, terrain::Mask to, double pixels, int shown) const;
 
   const TerrainCoding& t_;
   uint32_t capacity_ = 0, used_ = 0;
