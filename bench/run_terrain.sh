@@ -13,7 +13,8 @@
 # Contact sheets (ground truth | vds) and frames.csv per run in WORK.
 #
 # Usage: bench/run_terrain.sh [BUILD_DIR]   (default build/host-release)
-#   MAPS="arizonachase crooked tropic"; QUANTISER=4; DETAIL=1.25; STORE=98304; WORK (default BUILD_DIR/terrain).
+#   MAPS="arizonachase crooked tropic"; QUANTISER=4; DETAIL=1.25; STORE=98304; WORK (default BUILD_DIR/terrain);
+#   REUSE=1 keeps the runs an earlier invocation finished.
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-build/host-release}
@@ -41,6 +42,8 @@ t_${v}_${tq}_$rate:--rate $rate --tiles $v --tile-quality $tq --cache $STORE"
 done
 for map in $MAPS; do
   while IFS=: read -r name args; do
+    # REUSE=1: runs an earlier invocation finished are kept.
+    [ "${REUSE:-0}" = 1 ] && grep -q "rendered PSNR" "$WORK/$map/$name.txt" 2>/dev/null && [ -s "$WORK/$map/$name/frames.csv" ] && continue
     echo "== $map $name ($args)"
     mkdir -p "$WORK/$map"
     # shellcheck disable=SC2086

@@ -30,7 +30,7 @@ struct FlyOptions {
   std::vector<double> scale;
   int frames = 300, quantiser = 4, latency = 2, poses = 5;
   double fps = 20, rate = 2000, detail = 1.25;
-  uint32_t store = 65536;
+  uint32_t store = 98304;
   bool frames_png = false;
 };
 
@@ -155,7 +155,7 @@ void add_fly(CLI::App& app) {
   sub->add_option("--latency", o->latency, "Frames from a pose to its update (default 2)")->check(CLI::Range(0, 1000));
   sub->add_option("--poses", o->poses, "Poses sent up a second (default 5)")->check(CLI::Range(1, 1000));
   sub->add_option("--quantiser", o->quantiser, "Quantiser scale, 1..62 (default 4)")->check(CLI::Range(1, 62));
-  sub->add_option("--store", o->store, "Client store, coefficients (default 65536)")->check(CLI::Range(64u, 1u << 26));
+  sub->add_option("--store", o->store, "Client store, coefficients (default 98304)")->check(CLI::Range(64u, 1u << 26));
   sub->add_option("--detail", o->detail, "Scale of every mask cutoff (default 1.25)")->check(kPositive);
   sub->add_option("--out", o->out, "Folder for frames.csv and the contact sheet");
   sub->add_flag("--frames-png", o->frames_png, "With --out: every frame the client shows, as PNG");

@@ -162,26 +162,63 @@ int shown_dc(const TerrainCoding& t, const std::vector<Mask>& held, uint32_t id)
 void update_texture(const TerrainCoding& t, const std::vector<Mask>& before, const std::vector<Mask>& held,
                     Planes* texture) {
   Planes& p = *texture;
-  int16_t plane[64];
-  uint32_t plane_of = ~0u;
-  for (uint32_t id = t.grid.first(0, 0); id < t.grid.blocks(); ++id) {
-    const terrain::BlockPlace pl = t.grid.place(id);
-    const uint32_t coarse = t.grid.id(1, pl.comp, pl.bx / 8, pl.by / 8);
-    // A block shows its own coefficients, or when it holds none the DC
-    // plane of its level-1 block.
+  const terrain::BlockGrid& g = t.grid;
+  bool coarse_changed = false;
+  for (uint32_t id = 0; id < g.first(0, 0); ++id) coarse_changed = coarse_changed || before[id] != held[id];
+  // Each component's DC plane as level 1 gives it (what a level-0 block
+  // holding nothing shows, bilinear between block centres, as a renderer
+  // sampling that plane with its bilinear filter would draw it).
+  std::vector<int16_t> plane[3];
+  std::vector<uint8_t> valid[3];  // the sample's level-1 block is held
+  {
+    for (int c = 0; c < 3; ++c) {
+      const int w = g.plane_w(0, c), h = g.plane_h(0, c);
+      plane[c].assign(static_cast<size_t>(w) * h, 0);
+      valid[c].assign(static_cast<size_t>(w) * h, 0);
+      for (int cy = 0; cy < g.plane_h(1, c); ++cy)
+        for (int cx = 0; cx < g.plane_w(1, c); ++cx) {
+          const uint32_t coarse = g.id(1, c, cx, cy);
+          if (held[coarse] == 0) continue;
+          int16_t v[64];
+          terrain::coarse_plane(t.levels[coarse].data(), held[coarse], t.quantiser, v);
+          for (int y = 0; y < 8 && cy * 8 + y < h; ++y)
+            for (int x = 0; x < 8 && cx * 8 + x < w; ++x) {
+              plane[c][static_cast<size_t>(cy * 8 + y) * w + cx * 8 + x] = v[y * 8 + x];
+              valid[c][static_cast<size_t>(cy * 8 + y) * w + cx * 8 + x] = 1;
+            }
+        }
+    }
+  }
+  for (uint32_t id = g.first(0, 0); id < g.blocks(); ++id) {
     const bool own = held[id] != 0;
-    if (before[id] == held[id] && (own || before[coarse] == held[coarse])) continue;
+    if (before[id] == held[id] && (own || !coarse_changed)) continue;
+    const terrain::BlockPlace pl = g.place(id);
+    const int w = g.plane_w(0, pl.comp), h = g.plane_h(0, pl.comp);
     uint8_t px[64];
     if (own) {
       reconstruct_block(t, id, held[id], px);
     } else {
-      if (plane_of != coarse) {
-        if (held[coarse] != 0) terrain::coarse_plane(t.levels[coarse].data(), held[coarse], t.quantiser, plane);
-        else std::fill(plane, plane + 64, int16_t{0});
-        plane_of = coarse;
-      }
-      const int v = std::clamp(plane[(pl.by % 8) * 8 + pl.bx % 8] + 128, 0, 255);
-      std::fill(px, px + 64, static_cast<uint8_t>(v));
+      const std::vector<int16_t>& pc = plane[pl.comp];
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+          // Texel centre in block units, relative to block centres.
+          const double fx = pl.bx + (x + 0.5) / 8 - 0.5, fy = pl.by + (y + 0.5) / 8 - 0.5;
+          const int x0 = std::clamp(static_cast<int>(std::floor(fx)), 0, w - 1), y0 = std::clamp(static_cast<int>(std::floor(fy)), 0, h - 1);
+          const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+          const double ax = std::clamp(fx - x0, 0.0, 1.0), ay = std::clamp(fy - y0, 0.0, 1.0);
+          // Samples whose level-1 block the client does not hold take no part.
+          double sum = 0, weight = 0;
+          auto take = [&](int bx, int by, double wgt) {
+            const size_t i = static_cast<size_t>(by) * w + bx;
+            if (valid[pl.comp][i] && wgt > 0) sum += pc[i] * wgt, weight += wgt;
+          };
+          take(x0, y0, (1 - ax) * (1 - ay));
+          take(x1, y0, ax * (1 - ay));
+          take(x0, y1, (1 - ax) * ay);
+          take(x1, y1, ax * ay);
+          const double v = weight > 0 ? sum / weight : 0;
+          px[y * 8 + x] = static_cast<uint8_t>(std::clamp(std::lround(v) + 128, 0L, 255L));
+        }
     }
     for (int y = 0; y < 8; ++y) {
       const int py = pl.by * 8 + y;

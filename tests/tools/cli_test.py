@@ -136,6 +136,13 @@ code, out, err = run("fly", "--heightmap", hm, "--colour", col, "--scale", "4,0.
                      "--out", flyout)
 check(code == 0 and "8x8 cells" in out and "overall:" in out and os.path.exists(os.path.join(flyout, "sheet.png"))
       and len(open(os.path.join(flyout, "frames.csv")).read().splitlines()) == 13, "vds fly replays a flight over a user's map")
+code, out, err = run("fly", "--heightmap", hm, "--colour", col, "--scale", "4,0.001", "--frames", "12", "--rate", "2000",
+                     "--tiles", "webp64", "--out", flyout + "_tiles")
+check(code == 0 and "WebP tiles of 64 texels" in out and "mean" in out
+      and len(open(os.path.join(flyout + "_tiles", "frames.csv")).read().splitlines()) == 13,
+      "vds fly replays the same flight with the tile-pyramid baseline")
+code, out, err = run("fly", "--heightmap", hm, "--colour", col, "--scale", "4,0.001", "--tiles", "png64")
+check(code == 2 and "--tiles" in err, "vds fly refuses a tile variant it does not have")
 code, out, err = run("fly", "--heightmap", hm, "--colour", col, "--frames", "12")
 check(code == 2 and "--scale" in err, "vds fly asks for the scales of a user's heightmap")
 code, out, err = run("fly", os.path.join(TMP, "no-such.level"))
