@@ -137,8 +137,8 @@ class ServerSource : public FlightSource {
  public:
   ServerSource(const TerrainCoding& t, const FlightOptions& o)
       : t_(t), o_(o), server_(t, o.capacity), shown_(t.grid.blocks(), 0), texture_(reconstruct_texture(t, shown_)) {}
-  size_t answer(const SceneCamera& camera, uint32_t pose, size_t budget, FlightFrame* ff) override {
-    return server_.update(camera, pose, budget, o_.pose, &ff->update).size();
+  size_t answer(const std::vector<SceneCamera>& cameras, uint32_t pose, size_t budget, FlightFrame* ff) override {
+    return server_.update(cameras, pose, budget, o_.pose, &ff->update).size();
   }
   uint32_t held() const override { return server_.used(); }
   bool changed() const override { return server_.held() != shown_; }
@@ -155,6 +155,19 @@ class ServerSource : public FlightSource {
   std::vector<terrain::Mask> shown_;
   Planes texture_;
 };
+
+// The pose `steps` pose intervals after b, moving as it moved from a to b
+// (yaw the short way round, pitch kept within the camera's range).
+CameraPose extrapolate(const CameraPose& a, const CameraPose& b, double steps) {
+  CameraPose p;
+  p.x = b.x + (b.x - a.x) * steps;
+  p.y = b.y + (b.y - a.y) * steps;
+  p.z = b.z + (b.z - a.z) * steps;
+  double dyaw = std::fmod(b.yaw_deg - a.yaw_deg + 540.0, 360.0) - 180.0;
+  p.yaw_deg = std::fmod(b.yaw_deg + dyaw * steps + 720.0, 360.0);
+  p.pitch_deg = std::clamp(b.pitch_deg + (b.pitch_deg - a.pitch_deg) * steps, -89.0, 89.0);
+  return p;
+}
 
 io::Image with_alpha(const io::Image& rgb) {
   io::Image out(rgb.width, rgb.height, 4);
@@ -215,10 +228,16 @@ FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const Fl
     // The newest pose the server has: sent at a multiple of pose_every, at
     // least latency_frames ago.
     const long lag = static_cast<long>(f) - o.link.latency_frames;
-    if (lag >= 0 && credit >= 1) {
+    // An update waits until the link has carried min_update_bytes for it
+    // (its 8-byte header and the arithmetic coder's flush are paid per update).
+    if (lag >= 0 && credit >= std::max(1.0, static_cast<double>(o.link.min_update_bytes))) {
       const size_t pose = static_cast<size_t>(lag) - static_cast<size_t>(lag) % static_cast<size_t>(pose_every);
-      const SceneCamera cam = scene_camera(path.frames[pose], path.hfov_deg, o.width, o.height);
-      const size_t sent = source.answer(cam, static_cast<uint32_t>(pose), static_cast<size_t>(credit), &ff);
+      std::vector<SceneCamera> cams = {scene_camera(path.frames[pose], path.hfov_deg, o.width, o.height)};
+      if (o.link.predict && pose >= static_cast<size_t>(pose_every) && f > pose)
+        cams.push_back(scene_camera(extrapolate(path.frames[pose - static_cast<size_t>(pose_every)], path.frames[pose],
+                                                static_cast<double>(f - pose) / pose_every),
+                                    path.hfov_deg, o.width, o.height));
+      const size_t sent = source.answer(cams, static_cast<uint32_t>(pose), static_cast<size_t>(credit), &ff);
       ff.down_bytes = sent;
       credit -= static_cast<double>(sent);
       // A link with nothing to send carries nothing: no credit is saved up.

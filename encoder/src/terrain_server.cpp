@@ -453,8 +453,23 @@ TerrainServer::TerrainServer(const TerrainCoding& t, uint32_t capacity)
 
 std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t frame, size_t budget,
                                            const PoseOptions& o, UpdateStats* stats) {
+  return update(std::vector<SceneCamera>{camera}, frame, budget, o, stats);
+}
+
+std::vector<uint8_t> TerrainServer::update(const std::vector<SceneCamera>& cameras, uint32_t frame, size_t budget,
+                                           const PoseOptions& o, UpdateStats* stats) {
+  if (cameras.empty()) throw std::invalid_argument("TerrainServer::update: no camera");
+  // What any of the cameras needs, seen as the camera that sees it best.
   std::vector<BlockView> views;
-  const std::vector<Mask> need = pose_masks(t_, camera, o, &views);
+  std::vector<Mask> need = pose_masks(t_, cameras[0], o, &views);
+  for (size_t k = 1; k < cameras.size(); ++k) {
+    std::vector<BlockView> v;
+    const std::vector<Mask> m = pose_masks(t_, cameras[k], o, &v);
+    for (size_t b = 0; b < need.size(); ++b) {
+      need[b] = terrain::mask_union(need[b], m[b]);
+      if (v[b].visible && (!views[b].visible || v[b].pixels > views[b].pixels)) views[b] = v[b];
+    }
+  }
   const uint32_t n = t_.grid.blocks();
   for (uint32_t b = 0; b < n; ++b)
     if (need[b] != 0) last_needed_[b] = frame + 1;
@@ -490,19 +505,33 @@ std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t f
   }
   std::stable_sort(wanted.begin(), wanted.end(), [](const Want& a, const Want& b) { return a.score > b.score; });
 
-  // Room in the store: blocks the pose does not need, the longest unneeded
-  // first; then what needed blocks hold beyond the need, the least visible first.
-  std::vector<uint32_t> unneeded, excess;
+  // Room in the store, in tiers: level-0 blocks the pose does not need and
+  // no pose has needed for a second, the longest unneeded first; then what
+  // needed level-0 blocks hold beyond the need, the least visible first;
+  // then level-0 blocks needed within the last second; then level-1 blocks
+  // the pose does not need (a few coefficients that cover much ground:
+  // dropped last). A turning viewer comes back to what it saw a moment ago.
+  const uint32_t recent = frame >= kRecentFrames ? frame + 1 - kRecentFrames : 0;
+  const uint32_t fine = t_.grid.first(0, 0);
+  struct Victim {
+    uint32_t block;
+    int tier;
+    double order;
+  };
+  std::vector<Victim> victims;
   for (uint32_t b = 0; b < n; ++b) {
     if (held_[b] == 0) continue;
-    if (need[b] == 0) unneeded.push_back(b);
-    else if (held_[b] != terrain::mask_intersection(held_[b], need[b])) excess.push_back(b);
+    if (need[b] == 0) {
+      const int tier = b < fine ? 3 : (last_needed_[b] < recent ? 0 : 2);
+      victims.push_back({b, tier, static_cast<double>(last_needed_[b])});
+    } else if (b >= fine && held_[b] != terrain::mask_intersection(held_[b], need[b])) {
+      victims.push_back({b, 1, views[b].pixels});
+    }
   }
-  std::stable_sort(unneeded.begin(), unneeded.end(),
-                   [&](uint32_t a, uint32_t b) { return last_needed_[a] < last_needed_[b]; });
-  std::stable_sort(excess.begin(), excess.end(),
-                   [&](uint32_t a, uint32_t b) { return views[a].pixels < views[b].pixels; });
-  size_t next_unneeded = 0, next_excess = 0;
+  std::stable_sort(victims.begin(), victims.end(), [](const Victim& a, const Victim& b) {
+    return a.tier != b.tier ? a.tier < b.tier : a.order < b.order;
+  });
+  size_t next_victim = 0;
 
   // before[b]: the block after this update's shrinks, which its grow starts from.
   std::vector<Mask> after = held_, before = held_;
@@ -526,16 +555,10 @@ std::vector<uint8_t> TerrainServer::update(const SceneCamera& camera, uint32_t f
     trial.mask(after[b], target, true);
     trial.coefficients(b, after[b], target, shown[b]);
     if (8 + trial.ae.finished_size() + picked.size() / 2 > budget) break;
-    while (used + add > capacity_) {
-      if (next_unneeded < unneeded.size()) {
-        const uint32_t v = unneeded[next_unneeded++];
-        if (!is_picked[v]) shrink_to(v, 0);
-      } else if (next_excess < excess.size()) {
-        const uint32_t v = excess[next_excess++];
-        if (!is_picked[v] && v != b) shrink_to(v, terrain::mask_intersection(after[v], need[v]));
-      } else {
-        break;
-      }
+    while (used + add > capacity_ && next_victim < victims.size()) {
+      const Victim& v = victims[next_victim++];
+      if (is_picked[v.block] || v.block == b) continue;
+      shrink_to(v.block, v.tier == 1 ? terrain::mask_intersection(after[v.block], need[v.block]) : 0);
     }
     if (used + add > capacity_) break;  // the store is full of what the pose needs
     used += add;

@@ -67,25 +67,27 @@ class TileSource : public FlightSource {
     last_wanted_.assign(tiles_.size(), 0);
   }
 
-  size_t answer(const SceneCamera& cam, uint32_t pose, size_t budget, FlightFrame* ff) override {
-    // The tiles this pose wants: per visible cell the coarsest level whose
+  size_t answer(const std::vector<SceneCamera>& cams, uint32_t pose, size_t budget, FlightFrame* ff) override {
+    // The tiles the cameras want: per visible cell the coarsest level whose
     // texels stay within max_error_px, and the tiles above it.
-    std::vector<BlockView> views;
-    pose_masks(t_, cam, o_.pose, &views);
     std::vector<double> dist(tiles_.size(), std::numeric_limits<double>::infinity());
     const int top = static_cast<int>(levels_.size()) - 1;
-    for (int j = 0; j < t_.grid.cells_y; ++j)
-      for (int i = 0; i < t_.grid.cells_x; ++i) {
-        const BlockView& v = views[t_.grid.cell(i, j)];
-        if (!v.visible) continue;
-        const double ppt = v.cutoff / o_.pose.detail;  // screen pixels a full-resolution texel covers
-        int level = ppt > 0 ? static_cast<int>(std::floor(std::log2(to_.max_error_px / ppt))) : top;
-        level = std::clamp(level, 0, top);
-        for (int l = level; l <= top; ++l) {
-          const size_t id = tile_of(l, (8 * i) >> l, (8 * j) >> l);
-          dist[id] = std::min(dist[id], v.distance);
+    for (const SceneCamera& cam : cams) {
+      std::vector<BlockView> views;
+      pose_masks(t_, cam, o_.pose, &views);
+      for (int j = 0; j < t_.grid.cells_y; ++j)
+        for (int i = 0; i < t_.grid.cells_x; ++i) {
+          const BlockView& v = views[t_.grid.cell(i, j)];
+          if (!v.visible) continue;
+          const double ppt = v.cutoff / o_.pose.detail;  // screen pixels a full-resolution texel covers
+          int level = ppt > 0 ? static_cast<int>(std::floor(std::log2(to_.max_error_px / ppt))) : top;
+          level = std::clamp(level, 0, top);
+          for (int l = level; l <= top; ++l) {
+            const size_t id = tile_of(l, (8 * i) >> l, (8 * j) >> l);
+            dist[id] = std::min(dist[id], v.distance);
+          }
         }
-      }
+    }
     for (size_t id = 0; id < tiles_.size(); ++id)
       if (std::isfinite(dist[id])) last_wanted_[id] = pose + 1;
     // A transfer whose tile this pose does not want is cancelled.

@@ -17,6 +17,7 @@
 #include "vds/enc/stream_writer.h"
 #include "vds/enc/terrain_map.h"
 #include "vds/enc/terrain_server.h"
+#include "vds/enc/terrain_tiles.h"
 #include "vds/io/image.h"
 #include "vds/terrain.h"
 #include "xorshift.h"
@@ -496,6 +497,60 @@ TEST(TerrainUpdates, BlockIdsCoverBothLevelsOnce) {
         }
   for (int k : seen) ASSERT_EQ(k, 1);
   EXPECT_EQ(g.cell(4, 2), g.first(0, 0) + 2 * 37 + 4);
+}
+
+TEST(TerrainUpdates, SeveralCamerasGetWhatEachNeeds) {
+  const enc::TerrainCoding t = enc::code_terrain(test_map(), 6);
+  enc::TerrainServer server(t, 1u << 20);
+  const std::vector<enc::SceneCamera> cams = {flight_camera(t, 10, 100), flight_camera(t, 40, 100)};
+  for (int f = 0; f < 400 && !server.update(cams, static_cast<uint32_t>(f), 800, {}).empty(); ++f) {
+  }
+  for (const enc::SceneCamera& c : cams) {
+    const std::vector<Mask> need = enc::pose_masks(t, c, {});
+    for (uint32_t b = 0; b < t.grid.blocks(); ++b) ASSERT_TRUE(terrain::mask_covers(server.held()[b], need[b])) << b;
+  }
+}
+
+// The replay keeps the link's rate and the client's store for vds and for
+// the tile pyramid alike.
+TEST(TerrainFlight, BothClientsKeepTheLinkAndTheirStore) {
+  const enc::TerrainCoding t = enc::code_terrain(test_map(), 6);
+  enc::CameraPath path;
+  path.hfov_deg = 70;
+  path.fps = 20;
+  for (int f = 0; f < 40; ++f) {
+    enc::CameraPose p;
+    p.x = 40 + 3 * f;
+    p.y = 60;
+    p.z = 200;
+    p.yaw_deg = 20;
+    p.pitch_deg = -30;
+    path.frames.push_back(p);
+  }
+  enc::FlightOptions o;
+  o.width = 80;
+  o.height = 60;
+  o.supersample = 1;
+  o.capacity = 3000;
+  o.link.rate_bytes_per_s = 4000;
+  const enc::FlightResult v = enc::fly(t, path, o);
+  enc::TileOptions to = enc::parse_tile_variant("jpeg64");
+  to.cache_bytes = 3 * 64 * 64 * 3 / 2;
+  const enc::FlightResult tl = enc::fly_tiles(t, path, o, to);
+  for (const enc::FlightResult* r : {&v, &tl}) {
+    ASSERT_EQ(r->frames.size(), path.frames.size());
+    double sent = static_cast<double>(r->coarse_elevation_bytes);
+    for (size_t f = 0; f < r->frames.size(); ++f) {
+      sent += static_cast<double>(r->frames[f].down_bytes + r->frames[f].elevation_bytes);
+      ASSERT_LE(sent, 4000.0 * (f + 1) / 20 + 1) << f;  // never ahead of the line
+      ASSERT_GT(r->frames[f].psnr, 5.0);
+    }
+    EXPECT_GT(sent, 1000.0);
+  }
+  for (const enc::FlightFrame& f : v.frames) ASSERT_LE(f.held, o.capacity);
+  for (const enc::FlightFrame& f : tl.frames) ASSERT_LE(f.held, to.cache_bytes);
+  EXPECT_THROW(enc::parse_tile_variant("jpeg128"), std::invalid_argument);
+  EXPECT_THROW(enc::parse_tile_variant("png64"), std::invalid_argument);
 }
 
 }  // namespace

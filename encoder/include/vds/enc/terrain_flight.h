@@ -35,6 +35,12 @@ struct FlightLink {
   int latency_frames = 2;          // pose up and update down, in frames
   int poses_per_s = 5;             // how often the client sends its pose
   size_t pose_bytes = 21;          // a pose message on the line (type, frame, x, y, z, yaw, pitch; framing)
+  // The server also serves where the viewer will be when the update is
+  // drawn, extrapolated from its two newest poses.
+  bool predict = true;
+  // The server answers once the link has carried this many bytes for the
+  // answer (fewer, larger updates spend less on headers).
+  size_t min_update_bytes = 200;
 };
 
 struct FlightFrame {
@@ -71,10 +77,11 @@ struct FlightResult {
 class FlightSource {
  public:
   virtual ~FlightSource() = default;
-  // Answers the camera of pose frame `pose` with at most `budget` bytes
-  // (more than the flight can use when the link is unlimited); fills
-  // ff->update and returns the bytes sent.
-  virtual size_t answer(const SceneCamera& camera, uint32_t pose, size_t budget, FlightFrame* ff) = 0;
+  // Answers pose frame `pose` with at most `budget` bytes (more than the
+  // flight can use when the link is unlimited): what any of `cameras`
+  // needs (the pose's camera, then the prediction); fills ff->update and
+  // returns the bytes sent.
+  virtual size_t answer(const std::vector<SceneCamera>& cameras, uint32_t pose, size_t budget, FlightFrame* ff) = 0;
   // The texture the client holds now (R'G'B', the padded colour map's
   // size), and whether it changed since the last call to texture().
   virtual bool changed() const = 0;

@@ -117,10 +117,12 @@ struct UpdateStats {
 // Mirrors the client's store: which mask each block holds, and when the
 // pose last needed it. What a pose lacks is sent in stages of each block's
 // need (its DC, the lowest 2x2, 4x4, 8x8 frequencies), the stages that
-// remove the most squared screen error per bit first. The store holds at most `capacity` coefficients; to
-// make room the server drops, in order, blocks the pose does not need (the
-// longest unneeded first), then what held blocks hold beyond the pose's
-// need (the farthest first). The client does what the update says, so its
+// remove the most squared screen error per bit first. The store holds at
+// most `capacity` coefficients; to make room the server drops, in order,
+// level-0 blocks no pose has needed for a second (the longest unneeded
+// first), what needed level-0 blocks hold beyond the need (the least
+// visible first), level-0 blocks needed within the second, and level-1
+// blocks the pose does not need. The client does what the update says, so its
 // store equals held() after every update.
 class TerrainServer {
  public:
@@ -129,6 +131,10 @@ class TerrainServer {
   // bytes (a block is sent whole or not at all; the most visible first).
   std::vector<uint8_t> update(const SceneCamera& camera, uint32_t frame, size_t budget, const PoseOptions& o,
                               UpdateStats* stats = nullptr);
+  // The same for what any of several cameras needs (the newest pose and
+  // where the viewer is predicted to be when the update is drawn).
+  std::vector<uint8_t> update(const std::vector<SceneCamera>& cameras, uint32_t frame, size_t budget,
+                              const PoseOptions& o, UpdateStats* stats = nullptr);
   const std::vector<terrain::Mask>& held() const { return held_; }
   uint32_t used() const { return used_; }
   uint32_t capacity() const { return capacity_; }
@@ -138,6 +144,8 @@ class TerrainServer {
   // to `to` where it covers `pixels` pixels and shows DC level `shown`
   // before its own DC arrives.
   double stage_score(uint32_t b, terrain::Mask from, terrain::Mask to, double pixels, int shown) const;
+
+  static constexpr uint32_t kRecentFrames = 20;  // "needed a moment ago": a second at 20 frames/s
 
   const TerrainCoding& t_;
   uint32_t capacity_ = 0, used_ = 0;
