@@ -19,6 +19,8 @@ whose face list is cut short, a face of 255 indices, indices outside the
 vertices, a 4 KB PLY claiming 10^9 vertices, 4,000,000 faces with 4 present,
 a stream declaring a 16384x16384 image, images declaring 65535x65535, and the
 smaller ones (--bytes 0, a short truncated stream, vds info on image chunks).
+The terrain cases (heightmaps, colour maps and levels past their limits,
+a level nested 100,000 deep) guard the terrain importer the same way.
 
 Usage: host_budget.py VDS TMPDIR SANITIZED(0|1) [--report FILE]
   --report writes one line per case: name, exit code, seconds, peak RSS (KiB).
@@ -272,5 +274,35 @@ if REPORT:
     with open(REPORT, "w") as f:
         for name, code, spent, rss in rows:
             f.write(f"{name} {code} {spent:.2f} {rss}\n")
+# Terrain maps (vds fly): heightmaps and levels a user did not make.
+fly_out = os.path.join(TMP, "fly_out")
+colour_ok = write("terrain_c.png", png(16, 16, b"".join(b"\0" + bytes(48) for _ in range(16))))
+
+
+def png16_grey(w, h, rows_data):
+    return (b"\x89PNG\r\n\x1a\n" + png_chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 16, 0, 0, 0, 0)) +
+            png_chunk(b"IDAT", zlib.compress(rows_data)) + png_chunk(b"IEND", b""))
+
+
+def fly(name, heights_path, expect_text, colour=colour_ok, faulty=None):
+    """`faulty`: the file the refusal names (the heightmap unless given)."""
+    run(name, ["fly", "--heightmap", heights_path, "--colour", colour, "--scale", "2,0.01", "--frames", "4", "--out", fly_out],
+        faulty or heights_path, 1, expect_text)
+    check(not os.path.exists(fly_out), f"{name}: nothing written")
+
+
+fly("heightmap16_claims_65535", write("h16_huge.png", png16_grey(65535, 65535, b"\0" * 1000)), "declares a 65535x65535 image")
+fly("heightmap_past_the_cell_limit", write("h_wide.pgm", b"P5\n9000 2\n65535\n" + b"\0" * (9000 * 2 * 2)),
+    "heightmap (2 to 8193 samples on a side are read)")
+fly("heightmap_pgm_cut_short", write("h_cut.pgm", b"P5\n300 300\n65535\n" + b"\0" * 1000), "follow its header")
+c_huge = write("c_huge.png", png(65535, 65535, b"\0" * 1000))
+fly("colour_map_claims_65535", write("h_ok.pgm", b"P5\n4 4\n255\n" + bytes(16)), "declares a 65535x65535 image",
+    colour=c_huge, faulty=c_huge)
+big_level = write("big.level", "<level><terrain heightmap='h.png' colormap='c.png' horizontalscale='1' verticalscale='1'/>"
+                  + "<!--" + "x" * (2 << 20) + "--></level>")
+run("level_of_2_mib", ["fly", big_level, "--out", fly_out], big_level, 1, "at most 1 MiB is read")
+deep = write("deep.level", "<level>" + "<a>" * 100000 + "</a>" * 100000 + "</level>")
+run("level_nested_100000_deep", ["fly", deep, "--out", fly_out], deep, 1, "deep.level")
+
 print(f"{len(failures)} failure(s)")
 sys.exit(1 if failures else 0)
