@@ -19,8 +19,10 @@ namespace {
 
 [[noreturn]] void refuse(const std::string& what, const std::string& why) { throw std::runtime_error(what + ": " + why); }
 
-// The largest map read: the client's cell limit (8 texels a cell) on a side.
-constexpr int kMaxSide = 8193;
+// The largest map read: the client's cell limit (8 texels a cell) on a
+// side, and one more elevation sample than cells.
+constexpr int kMaxColourSide = 8192;
+constexpr int kMaxSide = kMaxColourSide + 1;
 // A .level file larger than this is not a level.
 constexpr size_t kMaxLevelBytes = 1u << 20;
 
@@ -96,9 +98,9 @@ TerrainMap read_terrain(const uint8_t* height_data, size_t height_size, const st
   m.horizontal_scale = horizontal_scale;
   m.metres_per_unit = vertical_scale / hm.units_per_level;
   m.colour = io::decode_image(colour_data, colour_size, colour_name, 3);
-  if (m.colour.width < 8 || m.colour.height < 8 || m.colour.width > kMaxSide || m.colour.height > kMaxSide)
+  if (m.colour.width < 8 || m.colour.height < 8 || m.colour.width > kMaxColourSide || m.colour.height > kMaxColourSide)
     refuse(colour_name, "a " + std::to_string(m.colour.width) + "x" + std::to_string(m.colour.height) +
-                            " colour map (8 to " + std::to_string(kMaxSide) + " pixels on a side are read)");
+                            " colour map (8 to " + std::to_string(kMaxColourSide) + " pixels on a side are read)");
   return m;
 }
 
