@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "vds/enc/scene_render.h"
+#include "vds/ref/scene.h"
+#include "vds/status.h"
 
 namespace vds::enc {
 
@@ -169,6 +171,54 @@ CameraPose extrapolate(const CameraPose& a, const CameraPose& b, double steps) {
   return p;
 }
 
+// The terrain as the client library's renderer draws it: one mesh, the
+// whole colour map as a Y'CbCr 4:2:0 texture, bilinear, no culling.
+ref::Scene client_terrain(const TerrainCoding& t, int width, int height) {
+  ref::Scene s;
+  s.name = "terrain";
+  s.width = width;
+  s.height = height;
+  ref::TextureD tex;
+  tex.name = "terrain";
+  tex.image = t.colour;
+  tex.address = vds::TexAddress::clamp;
+  s.textures.push_back(tex);
+  ref::MeshD mesh;
+  mesh.shading = vds::Shading::texture;
+  mesh.filter = vds::Filter::bilinear;
+  mesh.cull = vds::Cull::none;
+  mesh.texture = 0;
+  for (int j = 0; j < t.points_y(); ++j)
+    for (int i = 0; i < t.points_x(); ++i) {
+      const auto p = t.point(i, j);
+      s.add_vertex({p[0], p[1], p[2]}, {8.0 * i, 8.0 * j});
+    }
+  const int px = t.points_x();
+  for (int j = 0; j < t.grid.cells_y; ++j)
+    for (int i = 0; i < t.grid.cells_x; ++i) {
+      const uint32_t a = static_cast<uint32_t>(j * px + i), b = a + 1, c = a + static_cast<uint32_t>(px), e = c + 1;
+      mesh.indices.insert(mesh.indices.end(), {a, c, b, b, c, e});
+    }
+  s.meshes.push_back(mesh);
+  return s;
+}
+
+ref::CameraD client_camera(const SceneCamera& c, double near_m, double far_m) {
+  ref::CameraD d;
+  for (int k = 0; k < 3; ++k) {
+    d.rotation.m[0][k] = c.right[static_cast<size_t>(k)];
+    d.rotation.m[1][k] = c.down[static_cast<size_t>(k)];
+    d.rotation.m[2][k] = c.forward[static_cast<size_t>(k)];
+  }
+  d.position = {c.position[0], c.position[1], c.position[2]};
+  d.fx = d.fy = c.focal;
+  d.cx = c.cx;
+  d.cy = c.cy;
+  d.near_z = near_m;
+  d.far_z = far_m;
+  return d;
+}
+
 io::Image with_alpha(const io::Image& rgb) {
   io::Image out(rgb.width, rgb.height, 4);
   for (size_t i = 0, n = static_cast<size_t>(rgb.width) * rgb.height; i < n; ++i) {
@@ -201,6 +251,12 @@ FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const Fl
   ro.supersample = o.supersample;
   ro.near_m = o.pose.near_m;
   const SceneRenderer truth(scene, {with_alpha(t.colour)}, ro);
+  // The client library's renderer with the whole texture: rendering loss alone.
+  std::unique_ptr<ref::ClientScene> full;
+  const double far_m = std::hypot(t.grid.cells_x * t.cell_m, t.grid.cells_y * t.cell_m) * 1.5 + 1000;
+  // The client's depth range is at most 4096 near distances (vds/render_camera.h).
+  const double near_m = std::max(o.pose.near_m, far_m / 4000);
+  if (o.client_renderer) full = std::make_unique<ref::ClientScene>(client_terrain(t, o.width, o.height), vds::TexFormat::ycbcr420);
   std::unique_ptr<SceneRenderer> client;
   io::Image texture;
   const bool unlimited = !(o.link.rate_bytes_per_s > 0);
@@ -259,6 +315,14 @@ FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const Fl
     const SceneFrame a = truth.render(pose, path.hfov_deg);
     const SceneFrame b = client->render(pose, path.hfov_deg);
     ff.psnr = io::psnr(a.rgb, b.rgb);
+    if (full) {
+      const ref::ClientFrame c = ref::render_client(
+          *full, ref::to_client(client_camera(scene_camera(pose, path.hfov_deg, o.width, o.height), near_m, far_m)),
+          o.width, o.height, ref::ClientRenderSettings{});
+      if (c.status != vds::Status::ok)
+        throw std::runtime_error(std::string("terrain: the client renderer refused the frame: ") + vds::status_name(c.status));
+      ff.psnr_client_renderer = io::psnr(a.rgb, c.image);
+    }
     if (o.frame_sink) o.frame_sink(f, a.rgb, b.rgb);
     r.frames.push_back(ff);
     if (o.progress) o.progress(f + 1);

@@ -50,6 +50,7 @@ struct FlightFrame {
   UpdateStats update;      // the update this frame answered (if any)
   uint32_t held = 0;       // what the client holds: coefficients (vds), cache bytes (tiles)
   double psnr = 0;         // client's frame (reference renderer, held texture) against the ground truth
+  double psnr_client_renderer = 0;  // the client library's renderer with the whole texture (FlightOptions::client_renderer)
 };
 
 struct FlightOptions {
@@ -58,6 +59,9 @@ struct FlightOptions {
   uint32_t capacity = 65536;  // client store, coefficients
   PoseOptions pose;
   int supersample = 2;
+  // Also draw each frame with the client library's fixed-point renderer
+  // and the whole texture: the rendering loss, apart from the coding loss.
+  bool client_renderer = false;
   // Called per frame with the ground truth and the client's picture.
   std::function<void(size_t frame, const io::Image& truth, const io::Image& client)> frame_sink;
   std::function<void(size_t done)> progress;
