@@ -98,9 +98,13 @@ BlockPlace BlockGrid::place(uint32_t id) const {
   return p;
 }
 
+void dequantise_held(const int16_t levels[64], Mask held, int quantiser, int16_t coef[64]) {
+  for (int n = 0; n < 64; ++n) coef[n] = mask_holds(held, n & 7, n >> 3) ? dequantise(levels[n], n, quantiser) : 0;
+}
+
 void coarse_plane(const int16_t levels[64], Mask held, int quantiser, int16_t out[64]) {
   int16_t coef[64];
-  for (int n = 0; n < 64; ++n) coef[n] = mask_holds(held, n & 7, n >> 3) ? dequantise(levels[n], n, quantiser) : 0;
+  dequantise_held(levels, held, quantiser, coef);
   idct8x8(coef, out);
 }
 
@@ -188,6 +192,15 @@ int position_class(int k) {
   return 5;
 }
 
+int added_positions(Mask held, Mask mask, uint8_t pos[63]) {
+  int n = 0;
+  for (int k = 1; k < 64; ++k) {
+    const int nat = kZigzag[k];
+    if (mask_holds(mask, nat & 7, nat >> 3) && !mask_holds(held, nat & 7, nat >> 3)) pos[n++] = static_cast<uint8_t>(k);
+  }
+  return n;
+}
+
 Status TextureUpdateReader::init(const uint8_t* data, size_t size, const BlockGrid& grid, HeldFn held,
                                  ShownDcFn shown_dc, void* ctx) {
   *this = TextureUpdateReader{};
@@ -263,31 +276,19 @@ Status TextureUpdateReader::next(BlockUpdate* out) {
 
   const BlockPlace pl = grid_.place(u.id);
   const int comp = pl.comp, lv = pl.level;
-  const int cls = (comp == 0 ? 0 : 1) + 2 * lv;
+  const int cls = coefficient_class(pl);
   const bool intra = u.held == 0;
   if (intra) {
     const int32_t r = dec_.decode_signed(ctx_.dc_zero[lv][comp], ctx_.dc_mag[lv][comp], 6, 8, 1);
     if (!dec_.ok()) return fail(dec_.status());
-    int32_t pred = dc_prev_[comp];
-    if (lv == 0) {
-      pred = shown_dc_(held_ctx_, u.id);
-      if (pred < -128) pred = -128;
-      if (pred > 127) pred = 127;
-    }
+    const int32_t pred = lv == 0 ? dc_prediction(shown_dc_(held_ctx_, u.id)) : dc_prev_[comp];
     const int32_t dc = pred + r;
     if (dc < -128 || dc > 127) return fail(Status::malformed);
     if (lv == 1) dc_prev_[comp] = dc;
     u.levels[0] = static_cast<int16_t>(dc);
   }
-  // The AC positions this update adds, in zig-zag order.
   uint8_t pos[63];
-  int n = 0;
-  for (int k = 1; k < 64; ++k) {
-    const int nat = kZigzag[k];
-    if (mask_holds(u.mask, nat & 7, nat >> 3) && !mask_holds(u.held, nat & 7, nat >> 3)) {
-      pos[n++] = static_cast<uint8_t>(k);
-    }
-  }
+  const int n = added_positions(u.held, u.mask, pos);
   if (n == 0) return Status::ok;
   if (dec_.decode_bit(ctx_.cbf[intra ? 0 : 1][cls]) == 0) return dec_.ok() ? Status::ok : fail(dec_.status());
   bool any = false;

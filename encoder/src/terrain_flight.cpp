@@ -49,6 +49,18 @@ void keep_above_ground(const TerrainCoding& t, CameraPath* p, double clearance) 
   for (size_t f = 0; f < n; ++f) p->frames[f].z = std::max({p->frames[f].z, smooth[f], floor[f]});
 }
 
+// The grid's cells as two triangles each, into points in raster order.
+std::vector<uint32_t> cell_triangles(const TerrainCoding& t) {
+  std::vector<uint32_t> indices;
+  const uint32_t px = static_cast<uint32_t>(t.points_x());
+  for (uint32_t j = 0; j < t.grid.cells_y; ++j)
+    for (uint32_t i = 0; i < t.grid.cells_x; ++i) {
+      const uint32_t a = j * px + i, b = a + 1, c = a + px, e = c + 1;
+      indices.insert(indices.end(), {a, c, b, b, c, e});
+    }
+  return indices;
+}
+
 }  // namespace
 
 CameraPath terrain_flyover(const TerrainCoding& t, int frames, double fps, double hfov_deg) {
@@ -112,11 +124,7 @@ Scene terrain_scene(const TerrainCoding& t) {
       v.color = {255, 255, 255, 255};
       s.vertices.push_back(v);
     }
-  for (int j = 0; j < t.grid.cells_y; ++j)
-    for (int i = 0; i < t.grid.cells_x; ++i) {
-      const uint32_t a = static_cast<uint32_t>(j * px + i), b = a + 1, c = a + static_cast<uint32_t>(px), e = c + 1;
-      s.indices.insert(s.indices.end(), {a, c, b, b, c, e});
-    }
+  s.indices = cell_triangles(t);
   SceneSurface surf;
   surf.texture = 0;
   surf.index_count = static_cast<uint32_t>(s.indices.size());
@@ -193,12 +201,7 @@ ref::Scene client_terrain(const TerrainCoding& t, int width, int height) {
       const auto p = t.point(i, j);
       s.add_vertex({p[0], p[1], p[2]}, {8.0 * i, 8.0 * j});
     }
-  const int px = t.points_x();
-  for (int j = 0; j < t.grid.cells_y; ++j)
-    for (int i = 0; i < t.grid.cells_x; ++i) {
-      const uint32_t a = static_cast<uint32_t>(j * px + i), b = a + 1, c = a + static_cast<uint32_t>(px), e = c + 1;
-      mesh.indices.insert(mesh.indices.end(), {a, c, b, b, c, e});
-    }
+  mesh.indices = cell_triangles(t);
   s.meshes.push_back(mesh);
   return s;
 }
@@ -238,10 +241,13 @@ FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const Fl
       encode_elevation(t.heights.data(), t.points_x(), t.points_y(), terrain::ElevationPass::fine).size();
   r.elevation_bytes = r.coarse_elevation_bytes + fine_bytes;
   const Scene scene = terrain_scene(t);
-  // The ground the client draws until the fine pass is whole.
-  TerrainCoding rough = t;
-  rough.texture = Planes();
-  rough.levels.clear();
+  // The ground the client draws until the fine pass is whole (a scene needs
+  // the grid and its heights only).
+  TerrainCoding rough;
+  rough.grid = t.grid;
+  rough.cell_m = t.cell_m;
+  rough.metres_per_unit = t.metres_per_unit;
+  rough.heights = t.heights;
   terrain::fill_from_coarse(t.points_x(), t.points_y(), rough.heights.data());
   const Scene coarse_scene = terrain_scene(rough);
   double fine_left = static_cast<double>(fine_bytes);
@@ -307,8 +313,9 @@ FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const Fl
       }
     }
     ff.held = source.held();
-    if (source.changed() || ground_changed || !client) {
-      if (source.changed() || !client) texture = with_alpha(source.texture());
+    const bool texture_changed = source.changed() || !client;
+    if (texture_changed || ground_changed) {
+      if (texture_changed) texture = with_alpha(source.texture());
       client = std::make_unique<SceneRenderer>(fine_left > 0 ? coarse_scene : scene, std::vector<io::Image>{texture}, ro);
     }
     const CameraPose& pose = path.frames[f];

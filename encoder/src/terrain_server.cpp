@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <stdexcept>
 
 #include "vds/bytes.h"
@@ -34,8 +33,6 @@ V3 normalize(V3 a) {
   return l > 0 ? a * (1 / l) : a;
 }
 
-int round_level(double x) { return static_cast<int>(x < 0 ? -std::floor(-x + 0.5) : std::floor(x + 0.5)); }
-
 // The sample at (x, y) of plane c, clamped to the plane (blocks past the
 // padded edge repeat it).
 uint8_t plane_at(const Planes& p, int c, int x, int y) {
@@ -43,6 +40,44 @@ uint8_t plane_at(const Planes& p, int c, int x, int y) {
   y = std::clamp(y, 0, p.plane_height(c) - 1);
   return p.row(c, y)[x];
 }
+
+// The level-1 DC planes as `held` holds them: what a level-0 block that
+// holds nothing shows, and what its DC is predicted from. A level-1 block's
+// plane is computed when first asked for (64 level-0 blocks share it) and
+// again after forget() (when the caller changes its mask in `held`).
+class CoarsePlanes {
+ public:
+  CoarsePlanes(const TerrainCoding& t, const std::vector<Mask>& held)
+      : t_(t), held_(held), planes_(t.grid.first(0, 0)), known_(t.grid.first(0, 0), 0) {}
+  // Level-0 block `id`'s sample, in DC levels; false (and 0) when the
+  // client holds nothing of its level-1 block.
+  bool sample(uint32_t id, int* v) {
+    int k;
+    const uint32_t c = t_.grid.coarse(id, &k);
+    return lookup(c, k, v);
+  }
+  // The same for the level-0 block at (bx, by) of component `comp`.
+  bool sample(int comp, int bx, int by, int* v) {
+    return lookup(t_.grid.id(1, comp, bx / 8, by / 8), (by % 8) * 8 + bx % 8, v);
+  }
+  void forget(uint32_t coarse) { known_[coarse] = 0; }
+
+ private:
+  bool lookup(uint32_t c, int k, int* v) {
+    *v = 0;
+    if (held_[c] == 0) return false;
+    if (!known_[c]) {
+      terrain::coarse_plane(t_.levels[c].data(), held_[c], t_.quantiser, planes_[c].data());
+      known_[c] = 1;
+    }
+    *v = planes_[c][static_cast<size_t>(k)];
+    return true;
+  }
+  const TerrainCoding& t_;
+  const std::vector<Mask>& held_;
+  std::vector<std::array<int16_t, 64>> planes_;
+  std::vector<uint8_t> known_;
+};
 
 }  // namespace
 
@@ -85,11 +120,13 @@ TerrainCoding code_terrain(const TerrainMap& map, int quantiser) {
   // Every block's coefficients, quantised once: level 0 from the texture,
   // level 1 from the level-0 DC planes (edges repeated).
   t.levels.resize(t.grid.blocks());
+  // Rounded to nearest, halves away from zero.
   auto quantise = [&](const int16_t coef[64], std::array<int16_t, 64>& lv) {
-    lv[0] = static_cast<int16_t>(std::clamp(round_level(coef[0] / 8.0), -128, 127));
+    lv[0] = static_cast<int16_t>(std::clamp(static_cast<int>(std::lround(coef[0] / 8.0)), -128, 127));
     for (int n = 1; n < 64; ++n) {
       const double step = terrain::kIntraMatrix[n] * quantiser / 16.0;
-      lv[n] = static_cast<int16_t>(std::clamp(round_level(coef[n] / step), -terrain::kMaxLevel, terrain::kMaxLevel));
+      lv[n] = static_cast<int16_t>(
+          std::clamp(static_cast<int>(std::lround(coef[n] / step)), -terrain::kMaxLevel, terrain::kMaxLevel));
     }
   };
   for (int comp = 0; comp < 3; ++comp) {
@@ -129,8 +166,7 @@ std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h, ter
 
 void reconstruct_block(const TerrainCoding& t, uint32_t id, Mask held, uint8_t out[64]) {
   int16_t coef[64];
-  for (int n = 0; n < 64; ++n)
-    coef[n] = mask_holds(held, n & 7, n >> 3) ? terrain::dequantise(t.levels[id][n], n, t.quantiser) : 0;
+  terrain::dequantise_held(t.levels[id].data(), held, t.quantiser, coef);
   idct8x8_put(coef, out, 8);
 }
 
@@ -151,12 +187,9 @@ double terrain_height(const TerrainCoding& t, double x, double y) {
 }
 
 int shown_dc(const TerrainCoding& t, const std::vector<Mask>& held, uint32_t id) {
-  const terrain::BlockPlace p = t.grid.place(id);
-  const uint32_t coarse = t.grid.id(1, p.comp, p.bx / 8, p.by / 8);
-  if (held[coarse] == 0) return 0;
-  int16_t plane[64];
-  terrain::coarse_plane(t.levels[coarse].data(), held[coarse], t.quantiser, plane);
-  return plane[(p.by % 8) * 8 + p.bx % 8];
+  int v;
+  CoarsePlanes(t, held).sample(id, &v);
+  return v;
 }
 
 void update_texture(const TerrainCoding& t, const std::vector<Mask>& before, const std::vector<Mask>& held,
@@ -165,30 +198,10 @@ void update_texture(const TerrainCoding& t, const std::vector<Mask>& before, con
   const terrain::BlockGrid& g = t.grid;
   bool coarse_changed = false;
   for (uint32_t id = 0; id < g.first(0, 0); ++id) coarse_changed = coarse_changed || before[id] != held[id];
-  // Each component's DC plane as level 1 gives it (what a level-0 block
-  // holding nothing shows, bilinear between block centres, as a renderer
-  // sampling that plane with its bilinear filter would draw it).
-  std::vector<int16_t> plane[3];
-  std::vector<uint8_t> valid[3];  // the sample's level-1 block is held
-  {
-    for (int c = 0; c < 3; ++c) {
-      const int w = g.plane_w(0, c), h = g.plane_h(0, c);
-      plane[c].assign(static_cast<size_t>(w) * h, 0);
-      valid[c].assign(static_cast<size_t>(w) * h, 0);
-      for (int cy = 0; cy < g.plane_h(1, c); ++cy)
-        for (int cx = 0; cx < g.plane_w(1, c); ++cx) {
-          const uint32_t coarse = g.id(1, c, cx, cy);
-          if (held[coarse] == 0) continue;
-          int16_t v[64];
-          terrain::coarse_plane(t.levels[coarse].data(), held[coarse], t.quantiser, v);
-          for (int y = 0; y < 8 && cy * 8 + y < h; ++y)
-            for (int x = 0; x < 8 && cx * 8 + x < w; ++x) {
-              plane[c][static_cast<size_t>(cy * 8 + y) * w + cx * 8 + x] = v[y * 8 + x];
-              valid[c][static_cast<size_t>(cy * 8 + y) * w + cx * 8 + x] = 1;
-            }
-        }
-    }
-  }
+  // What a level-0 block holding nothing shows: the DC planes as level 1
+  // gives them, bilinear between block centres, as a renderer sampling them
+  // with its bilinear filter would draw them.
+  CoarsePlanes planes(t, held);
   for (uint32_t id = g.first(0, 0); id < g.blocks(); ++id) {
     const bool own = held[id] != 0;
     if (before[id] == held[id] && (own || !coarse_changed)) continue;
@@ -198,7 +211,6 @@ void update_texture(const TerrainCoding& t, const std::vector<Mask>& before, con
     if (own) {
       reconstruct_block(t, id, held[id], px);
     } else {
-      const std::vector<int16_t>& pc = plane[pl.comp];
       for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x) {
           // Texel centre in block units, relative to block centres.
@@ -209,8 +221,8 @@ void update_texture(const TerrainCoding& t, const std::vector<Mask>& before, con
           // Samples whose level-1 block the client does not hold take no part.
           double sum = 0, weight = 0;
           auto take = [&](int bx, int by, double wgt) {
-            const size_t i = static_cast<size_t>(by) * w + bx;
-            if (valid[pl.comp][i] && wgt > 0) sum += pc[i] * wgt, weight += wgt;
+            int v;
+            if (planes.sample(pl.comp, bx, by, &v) && wgt > 0) sum += v * wgt, weight += wgt;
           };
           take(x0, y0, (1 - ax) * (1 - ay));
           take(x1, y0, ax * (1 - ay));
@@ -368,19 +380,16 @@ struct UpdateWriter {
   // (its prediction when it grows from nothing).
   void coefficients(uint32_t id, Mask held, Mask m, int shown) {
     const terrain::BlockPlace pl = t.grid.place(id);
-    const int comp = pl.comp, lvl = pl.level, cls = (comp == 0 ? 0 : 1) + 2 * lvl;
+    const int comp = pl.comp, lvl = pl.level, cls = terrain::coefficient_class(pl);
     const auto& lv = t.levels[id];
     const bool intra = held == 0;
     if (intra) {
-      const int pred = lvl == 0 ? std::clamp(shown, -128, 127) : dc_prev[comp];
+      const int pred = lvl == 0 ? terrain::dc_prediction(shown) : dc_prev[comp];
       ae.encode_signed(ctx.dc_zero[lvl][comp], ctx.dc_mag[lvl][comp], 6, lv[0] - pred, 8, 1);
       if (lvl == 1) dc_prev[comp] = lv[0];
     }
-    int pos[63], n = 0;
-    for (int k = 1; k < 64; ++k) {
-      const int nat = kZigzag[k];
-      if (mask_holds(m, nat & 7, nat >> 3) && !mask_holds(held, nat & 7, nat >> 3)) pos[n++] = k;
-    }
+    uint8_t pos[63];
+    const int n = terrain::added_positions(held, m, pos);
     if (n == 0) return;
     int last = -1;
     for (int i = 0; i < n; ++i)
@@ -412,19 +421,26 @@ std::vector<uint8_t> encode_update(const TerrainCoding& t, const std::vector<Mas
   // shrink left; a level-0 block's prediction sees the level-1 grows
   // before it).
   std::vector<Mask> work = held;
+  CoarsePlanes planes(t, work);
+  const uint32_t fine = t.grid.first(0, 0);
+  auto change = [&](uint32_t id, Mask m) {
+    work[id] = m;
+    if (id < fine) planes.forget(id);
+  };
   for (const BlockChange& s : shrinks) {
     w.id(s.id);
     w.mask(work[s.id], s.mask, false);
-    work[s.id] = s.mask;
+    change(s.id, s.mask);
   }
   w.last_id = -1;
   for (const BlockChange& g : grows) {
     const Mask before = work[g.id];
     w.id(g.id);
     w.mask(before, g.mask, true);
-    const bool level0 = g.id >= t.grid.first(0, 0);
-    w.coefficients(g.id, before, g.mask, level0 && before == 0 ? shown_dc(t, work, g.id) : 0);
-    work[g.id] = g.mask;
+    int shown = 0;
+    if (g.id >= fine && before == 0) planes.sample(g.id, &shown);
+    w.coefficients(g.id, before, g.mask, shown);
+    change(g.id, g.mask);
   }
   std::vector<uint8_t> body = w.ae.finish();
   std::vector<uint8_t> out(8 + body.size());
@@ -489,8 +505,9 @@ std::vector<uint8_t> TerrainServer::update(const std::vector<SceneCamera>& camer
   constexpr Mask kBox[4] = {0x00000001u, 0x00000022u, 0x00004444u, terrain::kFullMask};
   // What each block shows before its DC arrives.
   std::vector<int> shown(n, 0);
+  CoarsePlanes planes(t_, held_);
   for (uint32_t b = t_.grid.first(0, 0); b < n; ++b)
-    if (held_[b] == 0 && need[b] != 0) shown[b] = shown_dc(t_, held_, b);
+    if (held_[b] == 0 && need[b] != 0) planes.sample(b, &shown[b]);
   for (uint32_t b = 0; b < n; ++b) {
     if (terrain::mask_covers(held_[b], need[b])) continue;
     Mask prev = held_[b];
@@ -533,15 +550,14 @@ std::vector<uint8_t> TerrainServer::update(const std::vector<SceneCamera>& camer
   });
   size_t next_victim = 0;
 
-  // before[b]: the block after this update's shrinks, which its grow starts from.
+  // before[b]: the block after this update's shrinks, which its grow
+  // starts from (a block this update shrinks differs from held_ there).
   std::vector<Mask> after = held_, before = held_;
-  std::vector<uint8_t> shrunk(n, 0);
   uint32_t used = used_;
   auto shrink_to = [&](uint32_t b, Mask m) {
     if (m == after[b]) return;
     used -= static_cast<uint32_t>(terrain::mask_count(after[b]) - terrain::mask_count(m));
     after[b] = before[b] = m;
-    shrunk[b] = 1;
   };
   std::vector<uint32_t> picked;
   std::vector<uint8_t> is_picked(n, 0);
@@ -572,7 +588,7 @@ std::vector<uint8_t> TerrainServer::update(const std::vector<SceneCamera>& camer
   // A block shrunk to make room and then grown again is sent as both.
   std::vector<BlockChange> shrinks;
   for (uint32_t b = 0; b < n; ++b)
-    if (shrunk[b]) shrinks.push_back({b, before[b]});
+    if (before[b] != held_[b]) shrinks.push_back({b, before[b]});
   std::vector<uint8_t> out;
   for (;;) {
     std::vector<BlockChange> grows;

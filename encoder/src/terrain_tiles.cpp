@@ -151,8 +151,9 @@ class TileSource : public FlightSource {
         uint8_t* d = &out.at(x, y, 0);
         d[0] = d[1] = d[2] = 128;
         for (int l = 0; l <= top; ++l) {
-          const Tile& tl = tiles_[tile_of(l, x >> l, y >> l)];
-          if (!held_[tile_of(l, x >> l, y >> l)]) continue;
+          const size_t id = tile_of(l, x >> l, y >> l);
+          if (!held_[id]) continue;
+          const Tile& tl = tiles_[id];
           // The texel centre in the tile's level, relative to the tile.
           const double fx = (x + 0.5) / (1 << l) - 0.5 - tl.tx * to_.tile, fy = (y + 0.5) / (1 << l) - 0.5 - tl.ty * to_.tile;
           const int x0 = std::clamp(static_cast<int>(std::floor(fx)), 0, to_.tile - 1), y0 = std::clamp(static_cast<int>(std::floor(fy)), 0, to_.tile - 1);

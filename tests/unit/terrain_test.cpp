@@ -339,12 +339,12 @@ struct Client {
   // level-1 block's DC plane, from what this client holds of that block.
   static int shown_dc(void* ctx, uint32_t id) {
     const Client& c = *static_cast<Client*>(ctx);
-    const terrain::BlockPlace p = c.t->grid.place(id);
-    const uint32_t coarse = c.t->grid.id(1, p.comp, p.bx / 8, p.by / 8);
+    int sample;
+    const uint32_t coarse = c.t->grid.coarse(id, &sample);
     if (c.masks[coarse] == 0) return 0;
     int16_t plane[64];
     terrain::coarse_plane(c.levels[coarse].data(), c.masks[coarse], c.t->quantiser, plane);
-    return plane[(p.by % 8) * 8 + p.bx % 8];
+    return plane[sample];
   }
   Status apply(const std::vector<uint8_t>& u, const terrain::BlockGrid& g) {
     terrain::TextureUpdateReader r;

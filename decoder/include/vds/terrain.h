@@ -92,6 +92,13 @@ struct BlockGrid {
   uint32_t cell(int i, int j) const { return id(0, 0, i, j); }
   BlockPlace place(uint32_t id) const;  // id < blocks()
   int component(uint32_t id) const { return place(id).comp; }
+  // The level-1 block over level-0 block `id`, and (in *sample) the index
+  // of the level-0 block's sample in that block's DC plane (8 * y + x).
+  uint32_t coarse(uint32_t id, int* sample) const {
+    const BlockPlace p = place(id);
+    *sample = (p.by % 8) * 8 + p.bx % 8;
+    return this->id(1, p.comp, p.bx / 8, p.by / 8);
+  }
 };
 
 // Limits a client accepts (the stream's header is refused past them).
@@ -104,6 +111,9 @@ inline constexpr int kMaxQuantiser = 62;
 // saturate to the inverse DCT's 12-bit domain.
 extern const uint8_t kIntraMatrix[64];
 int16_t dequantise(int level, int natural_index, int quantiser);
+// The coefficients of a block that `held` holds, dequantised (natural
+// order), the others 0: what the inverse DCT of a block takes.
+void dequantise_held(const int16_t levels[64], Mask held, int quantiser, int16_t coef[64]);
 // The largest |level| a coefficient may have (a larger one is malformed).
 inline constexpr int kMaxLevel = 2047;
 
@@ -194,6 +204,14 @@ struct TextureContexts {
 void init_texture_contexts(TextureContexts& c);
 // Position class of zig-zag index k (1..63): 1-2, 3-5, 6-9, 10-20, 21-35, 36-63.
 int position_class(int k);
+// Context class of a block's coefficients: luma, chroma, level-1 luma,
+// level-1 chroma.
+constexpr int coefficient_class(const BlockPlace& p) { return (p.comp == 0 ? 0 : 1) + 2 * p.level; }
+// A level-0 DC's prediction: what the block shows, as a DC level.
+constexpr int dc_prediction(int shown) { return shown < -128 ? -128 : (shown > 127 ? 127 : shown); }
+// The AC positions (zig-zag indices 1..63, ascending) `mask` holds and
+// `held` does not: what a grow from `held` to `mask` codes. Returns how many.
+int added_positions(Mask held, Mask mask, uint8_t pos[63]);
 
 // One block of an update, as the reader hands it over.
 struct BlockUpdate {

@@ -243,10 +243,9 @@ Image read_tga(const uint8_t* data, size_t size, const std::string& what) {
 // --- PNM (P5 grey, P6 RGB; maxval up to 65535, read to 8 bits) ------------------
 
 // keep16: a PNM of maxval > 255 keeps its samples, two bytes each
-// (big-endian) in an Image of twice the channels, *wide set, and *maxval_out
-// its maxval.
+// (big-endian) in an Image of twice the channels, and *wide is set.
 Image read_pnm(const uint8_t* data, size_t size, const std::string& what, bool keep16 = false,
-               bool* wide = nullptr, int* maxval_out = nullptr) {
+               bool* wide = nullptr) {
   if (wide != nullptr) *wide = false;
   const bool grey = data[1] == '5';
   size_t at = 2;
@@ -284,7 +283,6 @@ Image read_pnm(const uint8_t* data, size_t size, const std::string& what, bool k
   if (size - at < need)
     refuse(what, "the PNM declares " + std::to_string(w) + "x" + std::to_string(h) + " pixels, " + std::to_string(need) +
                      " bytes, but " + std::to_string(size - at) + " follow its header");
-  if (maxval_out != nullptr) *maxval_out = static_cast<int>(maxval);
   if (keep16 && sample == 2) {
     Image img(static_cast<int>(w), static_cast<int>(h), channels * 2);
     std::memcpy(img.pixels.data(), data + at, need);
@@ -324,13 +322,10 @@ Heightmap decode_heightmap(const uint8_t* data, size_t size, const std::string& 
   Heightmap hm;
   Image img;
   bool wide = false;
-  int maxval = 255;
   if (size >= 8 && png_sig_cmp(data, 0, 8) == 0) {
     img = read_png(data, size, what, true, &wide);
-    if (wide) maxval = 65535;
   } else if (size >= 3 && data[0] == 'P' && (data[1] == '5' || data[1] == '6')) {
-    img = read_pnm(data, size, what, true, &wide, &maxval);
-    if (!wide) maxval = 255;
+    img = read_pnm(data, size, what, true, &wide);
   } else {
     img = decode_image(data, size, what);
   }
@@ -341,7 +336,6 @@ Heightmap decode_heightmap(const uint8_t* data, size_t size, const std::string& 
   const bool colour = channels >= 3;
   if (colour && wide) refuse(what, "a colour heightmap of 16-bit samples (16-bit heightmaps are read in grey)");
   hm.units_per_level = colour ? 3 : 1;
-  hm.max_value = maxval * hm.units_per_level;
   const size_t n = static_cast<size_t>(img.width) * img.height;
   hm.values.resize(n);
   for (size_t i = 0; i < n; ++i) {

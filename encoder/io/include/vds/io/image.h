@@ -46,7 +46,6 @@ struct Heightmap {
   int width = 0;
   int height = 0;
   int units_per_level = 1;   // values per level of the file (3 for colour)
-  int max_value = 255;       // the largest value the file's format can hold
   std::vector<uint16_t> values;
 };
 Heightmap decode_heightmap(const uint8_t* data, size_t size, const std::string& what);
