@@ -81,6 +81,20 @@ TEST(TerrainMap, RefusesBadLevelsNamingTheFileAndTheFault) {
   }
 }
 
+TEST(TerrainMap, EveryPrefixOfALevelIsRefusedNamingTheFile) {
+  const auto b = bytes_of(level_xml("heightmap=\"h.png\" colormap=\"c.jpg\" horizontalscale=\"2.5\" verticalscale=\"0.3\""));
+  size_t accepted = 0;
+  for (size_t n = 0; n < b.size(); ++n) {
+    try {
+      enc::parse_level(b.data(), n, "cut.level");
+      ++accepted;  // a prefix that ends after </level> is the whole level
+    } catch (const std::runtime_error& e) {
+      ASSERT_EQ(std::string(e.what()).rfind("cut.level: ", 0), 0u) << n << ": " << e.what();
+    }
+  }
+  EXPECT_LE(accepted, 2u);  // at most the cuts inside the trailing newline
+}
+
 // A binary PGM of 16-bit samples.
 std::vector<uint8_t> pgm16(int w, int h, const std::vector<uint16_t>& v) {
   const std::string head = "P5\n" + std::to_string(w) + " " + std::to_string(h) + "\n65535\n";
@@ -124,6 +138,33 @@ TEST(TerrainMap, ReadsSixteenBitAndColourHeightmaps) {
   const enc::TerrainMap r = enc::read_terrain(hr.data(), hr.size(), "h.png", c.data(), c.size(), "c.png", 1.0, 0.3);
   EXPECT_EQ(r.heights[5], 30 * 5 + 1);
   EXPECT_DOUBLE_EQ(r.metres_per_unit, 0.1);
+}
+
+TEST(TerrainMap, EveryPrefixOfAHeightmapOrColourMapIsRefusedNamingTheFile) {
+  std::vector<uint16_t> v(6 * 5);
+  for (size_t i = 0; i < v.size(); ++i) v[i] = static_cast<uint16_t>(i * 999);
+  const auto h = pgm16(6, 5, v);
+  vds::io::Image colour(16, 16, 3);
+  for (size_t i = 0; i < colour.pixels.size(); ++i) colour.pixels[i] = static_cast<uint8_t>(i * 5);
+  const auto c = png_bytes(colour, "terrain_colour3.png");
+  for (size_t n = 0; n < h.size(); ++n)
+    EXPECT_THROW(
+        try { enc::read_terrain(h.data(), n, "h.pgm", c.data(), c.size(), "c.png", 1.0, 1.0); } catch (
+            const std::runtime_error& e) {
+          EXPECT_EQ(std::string(e.what()).rfind("h.pgm: ", 0), 0u) << e.what();
+          throw;
+        },
+        std::runtime_error)
+        << n;
+  for (size_t n = 0; n < c.size(); ++n)
+    EXPECT_THROW(
+        try { enc::read_terrain(h.data(), h.size(), "h.pgm", c.data(), n, "c.png", 1.0, 1.0); } catch (
+            const std::runtime_error& e) {
+          EXPECT_EQ(std::string(e.what()).rfind("c.png: ", 0), 0u) << e.what();
+          throw;
+        },
+        std::runtime_error)
+        << n;
 }
 
 TEST(TerrainMap, RefusesMapsItCannotUse) {
