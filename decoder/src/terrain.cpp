@@ -133,8 +133,10 @@ int elevation_median(int a, int b, int c, bool has_left, bool has_up) {
   return a + b - c;
 }
 
-Status decode_elevation(const uint8_t* data, size_t size, int w, int h, ElevationPass pass, uint16_t* out) {
-  if (out == nullptr || w <= 0 || h <= 0) return Status::invalid_argument;
+Status decode_elevation(const uint8_t* data, size_t size, int w, int h, ElevationPass pass, uint16_t* out, int y0,
+                        int y1) {
+  if (y1 < 0) y1 = h;
+  if (out == nullptr || w <= 0 || h <= 0 || y0 < 0 || y0 > y1 || y1 > h) return Status::invalid_argument;
   ArithDecoder dec;
   Status s = dec.init(data, size);
   if (s != Status::ok) return s;
@@ -154,7 +156,7 @@ Status decode_elevation(const uint8_t* data, size_t size, int w, int h, Elevatio
     }
     out[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>(v);
     return true;
-  });
+  }, y0, y1);
   return s != Status::ok ? s : dec.finish();
 }
 

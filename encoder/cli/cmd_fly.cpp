@@ -12,11 +12,15 @@
 #include <memory>
 #include <string>
 
+#include "board_run.h"
 #include "commands.h"
+#include "serve_report.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/enc/terrain_flight.h"
 #include "vds/enc/terrain_map.h"
 #include "vds/enc/terrain_server.h"
+#include "vds/enc/terrain_stream.h"
+#include "vds/enc/frames.h"
 #include "vds/enc/terrain_tiles.h"
 #include "vds/io/image.h"
 
@@ -32,6 +36,13 @@ struct FlyOptions {
   double fps = 20, rate = 2000, detail = 1.25;
   uint32_t store = 98304;
   bool frames_png = false;
+  // encode-terrain
+  std::string output;
+  int cache_log2 = 4, cells = 64;
+  bool psnr = false;
+  // serve-terrain
+  BoardArgs board;
+  std::string link, stream_out;
 };
 
 enc::TerrainMap load_map(const FlyOptions& o) {
@@ -44,16 +55,18 @@ enc::TerrainMap load_map(const FlyOptions& o) {
   return enc::load_terrain(o.map);
 }
 
+enc::CameraPath load_flight(const FlyOptions& o, const enc::TerrainCoding& t) {
+  if (!o.flight.empty()) {
+    const std::vector<uint8_t> b = enc::read_file(o.flight);
+    return enc::read_flight(std::string(b.begin(), b.end()), o.flight, t);
+  }
+  return enc::terrain_flyover(t, o.frames, o.fps);
+}
+
 void run(const FlyOptions& o) {
   const enc::TerrainMap map = load_map(o);
   const enc::TerrainCoding t = enc::code_terrain(map, o.quantiser);
-  enc::CameraPath path;
-  if (!o.flight.empty()) {
-    const std::vector<uint8_t> b = enc::read_file(o.flight);
-    path = enc::read_flight(std::string(b.begin(), b.end()), o.flight, t);
-  } else {
-    path = enc::terrain_flyover(t, o.frames, o.fps);
-  }
+  const enc::CameraPath path = load_flight(o, t);
   std::printf("%s: %dx%d colour map, %dx%d cells of %.2f m, heights to %.1f m; %zu frames at %g frames/s\n",
               map.name.c_str(), map.colour.width, map.colour.height, t.grid.cells_x, t.grid.cells_y, t.cell_m,
               *std::max_element(t.heights.begin(), t.heights.end()) * t.metres_per_unit, path.frames.size(), path.fps);
@@ -146,11 +159,129 @@ void run(const FlyOptions& o) {
   std::printf("  %s/frames.csv, %s (ground truth | vds)\n", o.out.c_str(), sheet_path.c_str());
 }
 
-}  // namespace
+enc::TerrainStreamOptions stream_options(const FlyOptions& o, size_t frames) {
+  enc::TerrainStreamOptions so;
+  so.link.rate_bytes_per_s = o.rate;
+  so.link.latency_frames = o.latency;
+  so.link.poses_per_s = o.poses;
+  so.store_units = o.store;
+  so.cache_log2 = o.cache_log2;
+  so.max_cells = o.cells;
+  so.pose.detail = o.detail;
+  so.progress = [frames](size_t done) {
+    if (done % 25 == 0 || done == frames) std::fprintf(stderr, "\r  frame %zu of %zu", done, frames);
+    if (done == frames) std::fprintf(stderr, "\n");
+  };
+  return so;
+}
 
-void add_fly(CLI::App& app) {
-  auto o = std::make_shared<FlyOptions>();
-  CLI::App* sub = app.add_subcommand("fly", "Replay a flight over a terrain on the server: updates, ratios, pictures (docs/terrain.md)");
+// `vds encode-terrain`: the terrain stream for a scripted flight, then its
+// replay through the client library (every frame's CRC; with --psnr each
+// frame against the ground truth).
+void run_encode(const FlyOptions& o) {
+  const enc::TerrainMap map = load_map(o);
+  const enc::TerrainCoding t = enc::code_terrain(map, o.quantiser);
+  const enc::CameraPath path = load_flight(o, t);
+  const enc::TerrainStreamOptions so = stream_options(o, path.frames.size());
+  const enc::TerrainStreamResult r = enc::write_terrain_stream(t, path, so);
+  enc::write_file(o.output, r.bytes);
+  size_t texture = 0, elevation = 0;
+  for (const enc::TerrainStreamFrame& f : r.frames) texture += f.texture_bytes, elevation += f.elevation_bytes;
+  std::printf("%s: %zu frames, %zu bytes (%zu before the first frame; fine elevation %zu, whole by frame %u; "
+              "texture updates %zu)\n",
+              o.output.c_str(), r.frames.size(), r.bytes.size(), r.opening_bytes, elevation, r.elevation_frame, texture);
+  std::vector<io::Image> shown;
+  const std::vector<uint32_t> crcs = enc::client_frame_crcs(r.bytes, &shown);
+  uint32_t all = 0;
+  for (uint32_t c : crcs) all = all * 31 + c;
+  std::printf("  the client library plays it: %zu frames (CRCs hashed: %08x)\n", crcs.size(), all);
+  if (o.psnr || !o.out.empty()) {
+    enc::TerrainSender sender(t, path, so);
+    const enc::TerrainTruth truth(t, so.width, so.height);
+    double sum = 0;
+    std::vector<io::Image> sheet;
+    const size_t tiles = std::min<size_t>(8, shown.size());
+    if (!o.out.empty()) std::filesystem::create_directories(o.out);
+    for (size_t f = 0; f < shown.size(); ++f) {
+      const io::Image g = truth.render(sender.metres(sender.pose(static_cast<uint32_t>(f))), sender.hfov_deg());
+      sum += io::psnr(g, shown[f]);
+      for (size_t k = 0; k < tiles; ++k)
+        if (sheet_frame(k, tiles, shown.size()) == f) sheet.push_back(io::side_by_side({&g, &shown[f]}));
+      if (o.frames_png && !o.out.empty()) {
+        char name[32];
+        std::snprintf(name, sizeof name, "frame_%04zu.png", f);
+        io::save_png((std::filesystem::path(o.out) / name).string(), shown[f]);
+      }
+    }
+    std::printf("  what the client shows against the ground truth: mean %.2f dB\n", sum / static_cast<double>(shown.size()));
+    if (!o.out.empty()) {
+      std::vector<const io::Image*> ptrs;
+      for (const io::Image& im : sheet) ptrs.push_back(&im);
+      const std::string sheet_path = (std::filesystem::path(o.out) / "sheet.png").string();
+      io::save_png(sheet_path, io::grid(ptrs, 2));
+      std::printf("  %s (ground truth | client)\n", sheet_path.c_str());
+    }
+  }
+}
+
+// `vds serve-terrain`: the server live. The client plays the flight the
+// stream's TFLY gives it and sends its pose up every pose period; the
+// server answers the newest pose it has received as the frames fall due.
+// Afterwards the stream as sent is replayed through the client library and
+// every frame the board showed must equal the replay's.
+void run_serve_terrain(const FlyOptions& o) {
+  const enc::TerrainMap map = load_map(o);
+  const enc::TerrainCoding t = enc::code_terrain(map, o.quantiser);
+  const enc::CameraPath path = load_flight(o, t);
+  enc::TerrainLive live(t, path, stream_options(o, path.frames.size()));
+  struct Adapter : link::LiveStream {
+    enc::TerrainLive& live;
+    explicit Adapter(enc::TerrainLive& l) : live(l) {}
+    void pose(const uint8_t* d, size_t n) override { live.pose(d, n); }
+    bool produce(uint64_t ms, std::vector<uint8_t>& out) override { return live.produce(ms, out); }
+  } adapter(live);
+  std::vector<uint8_t> made;
+  const std::string name = map.name + " (live)";
+  const auto serve = [&](const link::ServeOptions& so, const std::function<void(const std::string&)>& say) {
+    made.clear();
+    return link::serve_live(adapter, so, &made, say);
+  };
+  BoardResult r;
+  if (!o.board.board.empty()) {
+    r = run_on_board(o.board, name, serve);
+  } else {
+    if (o.link.empty()) throw Failure(kExitUsage, "give --board host|qemu, or --link to a client");
+    r.options.link = o.link;
+    r.options.baud = o.board.baud;
+    r.options.timeout_s = o.board.timeout;
+    try {
+      r.report = serve(r.options, [](const std::string& m) { std::fprintf(stderr, "vds serve-terrain: %s\n", m.c_str()); });
+    } catch (const link::BackendError& e) {
+      throw backend_failure(e);
+    }
+  }
+  if (!o.stream_out.empty()) enc::write_file(o.stream_out, made);
+  size_t texture = 0;
+  uint32_t answered = 0;
+  for (const enc::TerrainStreamFrame& f : live.frames()) texture += f.texture_bytes, answered += f.texture_bytes != 0;
+  std::printf("%s: %zu frames made, %zu bytes; %u poses received (%u refused); %u updates, %zu bytes of texture\n",
+              name.c_str(), live.frames().size(), made.size(), live.poses_received(), live.poses_refused(), answered, texture);
+  std::vector<uint32_t> want;
+  try {
+    want = enc::client_frame_crcs(made);
+  } catch (const std::exception& e) {
+    throw Failure(kExitBadInput, name + ": the stream as sent does not replay: " + e.what());
+  }
+  if (!o.board.board.empty()) {
+    check_board_frames(o.board, name, r, want);
+  } else {
+    print_serve_report(name, r.options, r.report);
+    check_serve_report(r.report);
+  }
+  if (live.poses_received() == 0) throw Failure(kExitBadInput, name + ": no pose came up the link");
+}
+
+void map_options(CLI::App* sub, FlyOptions* o) {
   sub->add_option("map", o->map, "A Trigger Rally map name, ZIP:NAME, a .level file or a folder with one");
   sub->add_option("--heightmap", o->heightmap, "Instead of a map: a heightmap (8/16-bit grey PNG or PGM, or colour: R+G+B)");
   sub->add_option("--colour", o->colour, "With --heightmap: the colour map");
@@ -163,10 +294,55 @@ void add_fly(CLI::App& app) {
   sub->add_option("--latency", o->latency, "Frames from a pose to its update (default 2)")->check(CLI::Range(0, 1000));
   sub->add_option("--poses", o->poses, "Poses sent up a second (default 5)")->check(CLI::Range(1, 1000));
   sub->add_option("--quantiser", o->quantiser, "Quantiser scale, 1..62 (default 4)")->check(CLI::Range(1, 62));
-  sub->add_option("--store", o->store, "Client store, coefficients (default 98304)")->check(CLI::Range(64u, 1u << 26));
   sub->add_option("--detail", o->detail, "Scale of every mask cutoff (default 1.25)")->check(kPositive);
   sub->add_option("--out", o->out, "Folder for frames.csv and the contact sheet");
   sub->add_flag("--frames-png", o->frames_png, "With --out: every frame the client shows, as PNG");
+}
+
+}  // namespace
+
+void add_encode_terrain(CLI::App& app) {
+  auto o = std::make_shared<FlyOptions>();
+  o->store = 16384;
+  CLI::App* sub = app.add_subcommand("encode-terrain", "Write the terrain stream of a scripted flight and replay it through the client library (docs/terrain.md)");
+  map_options(sub, o.get());
+  sub->add_option("-o,--output", o->output, "The stream to write")->required();
+  sub->add_option("--store", o->store, "Client block store, 2-byte units: a held block costs its coefficients + 6 (default 16384)")
+      ->check(CLI::Range(64u, 1u << 26));
+  sub->add_option("--cache-log2", o->cache_log2, "The client's transformed-block window, 2^n cells a side (default 4)")
+      ->check(CLI::Range(1, 6));
+  sub->add_option("--cells", o->cells, "Cells the client draws with their own texels a frame (default 64)")->check(CLI::Range(1, 4096));
+  sub->add_flag("--psnr", o->psnr, "Also each frame the client shows against the ground truth");
+  sub->callback([o] { run_encode(*o); });
+}
+
+void add_serve_terrain(CLI::App& app) {
+  auto o = std::make_shared<FlyOptions>();
+  o->store = 16384;
+  CLI::App* sub = app.add_subcommand("serve-terrain", "Serve a terrain live to a client board, answering the poses it sends up (docs/terrain.md)");
+  map_options(sub, o.get());
+  sub->add_option("--store", o->store, "Client block store, 2-byte units: a held block costs its coefficients + 6 (default 16384)")
+      ->check(CLI::Range(64u, 1u << 26));
+  sub->add_option("--cache-log2", o->cache_log2, "The client's transformed-block window, 2^n cells a side (default 4)")
+      ->check(CLI::Range(1, 6));
+  sub->add_option("--cells", o->cells, "Cells the client draws with their own texels a frame (default 64)")->check(CLI::Range(1, 4096));
+  sub->add_option("--board", o->board.board, "host: the host-native board on a pseudo-terminal; qemu: the Cortex-M4 board in QEMU")
+      ->check(CLI::IsMember({"host", "qemu"}));
+  sub->add_option("--link", o->link, "Without --board: the client's link (pty:PATH, tcp:HOST:PORT, tcp-listen:PORT, usb:VID:PID)");
+  sub->add_option("--baud", o->board.baud, "Line rate (default 115200)")->check(CLI::Range(1200u, 4000000u));
+  sub->add_option("--board-out", o->board.out, "With --board: the board's log and frame CRCs; on the host board also its frames");
+  sub->add_option("--firmware", o->board.firmware, "With --board: the board's client firmware");
+  sub->add_option("--qemu", o->board.qemu, "QEMU's Arm system emulator")->capture_default_str();
+  sub->add_option("--timeout", o->board.timeout, "Give up after this many seconds (default 600)");
+  sub->add_option("--stream-out", o->stream_out, "Write the stream as it was sent");
+  sub->callback([o] { run_serve_terrain(*o); });
+}
+
+void add_fly(CLI::App& app) {
+  auto o = std::make_shared<FlyOptions>();
+  CLI::App* sub = app.add_subcommand("fly", "Replay a flight over a terrain on the server: updates, ratios, pictures (docs/terrain.md)");
+  map_options(sub, o.get());
+  sub->add_option("--store", o->store, "Client store, 2-byte units: a held block costs its coefficients + 6 (default 98304)")->check(CLI::Range(64u, 1u << 26));
   sub->add_option("--tiles", o->tiles, "The baseline instead of vds: a tile pyramid, jpeg64, jpeg256, webp64 or webp256")
       ->check(CLI::IsMember({"jpeg64", "jpeg256", "webp64", "webp256"}));
   sub->add_option("--tile-quality", o->tile_quality, "With --tiles: the codec's quality, 1..100 (default 75)")

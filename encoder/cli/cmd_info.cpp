@@ -11,6 +11,7 @@
 #include "vds/bytes.h"
 #include "vds/container.h"
 #include "vds/image.h"
+#include "vds/terrain_client.h"
 #include "vds/walk.h"
 #include "vds/jpeg.h"
 #include "vds/enc/mesh_encoder.h"
@@ -176,6 +177,29 @@ void run_info(const InfoOptions& o) {
       } else {
         row.note = "walkthrough parameters (malformed)";
       }
+      c->rows.push_back(row);
+      return ChunkResult::consumed;
+    }
+    if (type == chunk::kTerrainParams) {
+      terrain::Params t;
+      if (terrain::params_from_bytes(payload, size, &t) == Status::ok) {
+        row.note = "terrain: " + std::to_string(t.cells_x) + "x" + std::to_string(t.cells_y) + " cells, quantiser " +
+                   std::to_string(t.quantiser) + ", a store of " + std::to_string(t.store_units * 2u) + " bytes, " +
+                   std::to_string(1 << t.cache_log2) + "-cell block cache, pose every " + std::to_string(t.pose_period) +
+                   " frames";
+      } else {
+        row.note = "terrain parameters (malformed)";
+      }
+      c->rows.push_back(row);
+      return ChunkResult::consumed;
+    }
+    if (type == chunk::kTerrainFlight || type == chunk::kTerrainElevation || type == chunk::kTerrainTexture ||
+        type == chunk::kTerrainFrame) {
+      row.note = type == chunk::kTerrainFlight      ? "terrain: the flight's camera keys"
+                 : type == chunk::kTerrainElevation ? (size > 0 && payload[0] == 0 ? "terrain: the coarse elevation"
+                                                                                    : "terrain: rows of the fine elevation")
+                 : type == chunk::kTerrainTexture   ? "terrain: a texture update"
+                                                    : "terrain: draw a frame";
       c->rows.push_back(row);
       return ChunkResult::consumed;
     }

@@ -49,5 +49,7 @@ void add_frames(CLI::App& app);
 void add_encode_image(CLI::App& app);
 void add_decode_image(CLI::App& app);
 void add_fly(CLI::App& app);
+void add_encode_terrain(CLI::App& app);
+void add_serve_terrain(CLI::App& app);
 
 }  // namespace vds::cli

@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   vds::cli::add_render(app);
   vds::cli::add_encode_walk(app);
   vds::cli::add_fly(app);
+  vds::cli::add_encode_terrain(app);
+  vds::cli::add_serve_terrain(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -166,19 +166,6 @@ class ServerSource : public FlightSource {
   Planes texture_;
 };
 
-// The pose `steps` pose intervals after b, moving as it moved from a to b
-// (yaw the short way round, pitch kept within the camera's range).
-CameraPose extrapolate(const CameraPose& a, const CameraPose& b, double steps) {
-  CameraPose p;
-  p.x = b.x + (b.x - a.x) * steps;
-  p.y = b.y + (b.y - a.y) * steps;
-  p.z = b.z + (b.z - a.z) * steps;
-  double dyaw = std::fmod(b.yaw_deg - a.yaw_deg + 540.0, 360.0) - 180.0;
-  p.yaw_deg = std::fmod(b.yaw_deg + dyaw * steps + 720.0, 360.0);
-  p.pitch_deg = std::clamp(b.pitch_deg + (b.pitch_deg - a.pitch_deg) * steps, -89.0, 89.0);
-  return p;
-}
-
 // The terrain as the client library's renderer draws it: one mesh, the
 // whole colour map as a Y'CbCr 4:2:0 texture, bilinear, no culling.
 ref::Scene client_terrain(const TerrainCoding& t, int width, int height) {
@@ -232,6 +219,31 @@ io::Image with_alpha(const io::Image& rgb) {
 }
 
 }  // namespace
+
+TerrainTruth::TerrainTruth(const TerrainCoding& t, int width, int height, int supersample, double near_m) {
+  RenderOptions ro;
+  ro.width = width;
+  ro.height = height;
+  ro.supersample = supersample;
+  ro.near_m = near_m;
+  renderer_ = std::make_unique<SceneRenderer>(terrain_scene(t), std::vector<io::Image>{with_alpha(t.colour)}, ro);
+}
+
+TerrainTruth::~TerrainTruth() = default;
+
+io::Image TerrainTruth::render(const CameraPose& pose, double hfov_deg) const { return renderer_->render(pose, hfov_deg).rgb; }
+
+CameraPose extrapolate(const CameraPose& a, const CameraPose& b, double steps) {
+  CameraPose p;
+  p.x = b.x + (b.x - a.x) * steps;
+  p.y = b.y + (b.y - a.y) * steps;
+  p.z = b.z + (b.z - a.z) * steps;
+  double dyaw = std::fmod(b.yaw_deg - a.yaw_deg + 540.0, 360.0) - 180.0;
+  p.yaw_deg = std::fmod(b.yaw_deg + dyaw * steps + 720.0, 360.0);
+  p.pitch_deg = std::clamp(b.pitch_deg + (b.pitch_deg - a.pitch_deg) * steps, -89.0, 89.0);
+  return p;
+}
+
 
 FlightResult fly_source(const TerrainCoding& t, const CameraPath& path, const FlightOptions& o, FlightSource& source) {
   FlightResult r;

@@ -1,6 +1,8 @@
 // The terrain mode's server side (vds/enc/terrain_server.h).
 #include "vds/enc/terrain_server.h"
 
+#include "vds/terrain_client.h"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -10,6 +12,7 @@
 #include "vds/enc/dct.h"
 #include "vds/idct.h"
 #include "vds/image_model.h"
+#include "vds/terrain_client.h"
 
 namespace vds::enc {
 
@@ -153,14 +156,15 @@ TerrainCoding code_terrain(const TerrainMap& map, int quantiser) {
   return t;
 }
 
-std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h, terrain::ElevationPass pass) {
+std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h, terrain::ElevationPass pass, int y0,
+                                      int y1) {
   ArithEncoder ae;
   terrain::ElevationContexts ctx;
   terrain::init_elevation_contexts(ctx);
   terrain::for_each_elevation_point(w, h, pass, heights, [&](int x, int y, int predict, int k) {
     ae.encode_signed(ctx.zero[k], ctx.mag[k], 8, heights[static_cast<size_t>(y) * w + x] - predict, 16, 2);
     return true;
-  });
+  }, y0, y1);
   return ae.finish();
 }
 
@@ -556,7 +560,7 @@ std::vector<uint8_t> TerrainServer::update(const std::vector<SceneCamera>& camer
   uint32_t used = used_;
   auto shrink_to = [&](uint32_t b, Mask m) {
     if (m == after[b]) return;
-    used -= static_cast<uint32_t>(terrain::mask_count(after[b]) - terrain::mask_count(m));
+    used -= terrain::store_cost(after[b]) - terrain::store_cost(m);
     after[b] = before[b] = m;
   };
   std::vector<uint32_t> picked;
@@ -566,7 +570,7 @@ std::vector<uint8_t> TerrainServer::update(const std::vector<SceneCamera>& camer
     const uint32_t b = w.block;
     const Mask target = terrain::mask_union(after[b], w.target);
     if (target == after[b]) continue;
-    const uint32_t add = static_cast<uint32_t>(terrain::mask_count(target) - terrain::mask_count(after[b]));
+    const uint32_t add = terrain::store_cost(target) - terrain::store_cost(after[b]);
     // The cost of this block, estimated in the order of choice.
     trial.mask(after[b], target, true);
     trial.coefficients(b, after[b], target, shown[b]);
@@ -601,7 +605,7 @@ std::vector<uint8_t> TerrainServer::update(const std::vector<SceneCamera>& camer
     for (size_t k = 0; k < drop && !picked.empty(); ++k) {
       const uint32_t b = picked.back();
       picked.pop_back();
-      used -= static_cast<uint32_t>(terrain::mask_count(after[b]) - terrain::mask_count(before[b]));
+      used -= terrain::store_cost(after[b]) - terrain::store_cost(before[b]);
       after[b] = before[b];
     }
   }

@@ -1,10 +1,12 @@
-// Walkthrough playback on the board: reads vds walkthrough streams from
-// host files (walk_case0.vds, walk_case1.vds, ... until one is missing)
-// and plays each through vds::Player as the client does, from a workspace
+// Walkthrough and terrain playback on the board: reads vds streams from
+// host files (walk_case0.vds, walk_case1.vds, ... until one is missing,
+// then terrain_case0.vds, ...) and plays each through vds::Player as the
+// client does, from a workspace
 // as large as the board's RAM allows (the arena's high-water mark says
 // what the stream needed). Per frame it prints a "frame" line: the
 // frame's CRC and its instruction counts (parse, decode, display: the
-// player's frame records); per stream an "m4 walk" summary. The host board
+// player's frame records); per stream an "m4 walk" (or "m4 terrain")
+// summary. The host board
 // and the Cortex-M4 board must print the same CRCs (bench/run_walk_m4.sh
 // compares them, and the CRCs with the encoder's replay).
 #include <cstddef>
@@ -56,8 +58,9 @@ void on_frame(void*, const vds::PlayedFrame& f) {
   board::log(l.str(" display=").dec(f.display).str("\n").c_str());
 }
 
-// Plays one stream file; false when it does not exist.
-bool run_file(const char* path, int* failures) {
+// Plays one stream file; false when it does not exist. `label`: "walk"
+// or "terrain", for the summary lines.
+bool run_file(const char* path, const char* label, int* failures) {
   if (!vds::fw::host_file_exists(path)) return false;
   vds::Arena arena(g_workspace, sizeof g_workspace);
   g_run = Run{};
@@ -70,15 +73,15 @@ bool run_file(const char* path, int* failures) {
   const Status s = vds::fw::play_host_file(player, player.init(arena, config, cb), path, g_read, kReadBytes);
   const char* base = vds::fw::file_name(path);
   Line l;
-  l.str("m4 walk stream=").str(base).str(" status=").str(vds::status_name(s)).str(" frames=").dec(g_run.frames);
+  l.str("m4 ").str(label).str(" stream=").str(base).str(" status=").str(vds::status_name(s)).str(" frames=").dec(g_run.frames);
   l.str(" instructions=").dec(g_run.total).str(" worst=").dec(g_run.worst).str(" worst_frame=").dec(g_run.worst_frame);
   board::log(l.str("\n").c_str());
   Line parts;
-  parts.str("m4 walk_parts stream=").str(base).str(" parse=").dec(g_run.parse).str(" decode=").dec(g_run.decode);
+  parts.str("m4 ").str(label).str("_parts stream=").str(base).str(" parse=").dec(g_run.parse).str(" decode=").dec(g_run.decode);
   parts.str(" display=").dec(g_run.display).str(" workspace=").dec(arena.high_water()).str(" chunk_buffer=").dec(kChunkBytes);
   board::log(parts.str("\n").c_str());
   if (s != Status::ok) {
-    board::log(Line().str("m4 walk error: ").str(player.error_detail()).str("\n").c_str());
+    board::log(Line().str("m4 ").str(label).str(" error: ").str(player.error_detail()).str("\n").c_str());
     ++*failures;
   }
   return true;
@@ -89,8 +92,10 @@ bool run_file(const char* path, int* failures) {
 extern "C" int vds_app_main() {
   board::init();
   int failures = 0;
-  if (vds::fw::run_cases("walk_case", [&](const char* name) { return run_file(name, &failures); }) == 0) {
-    board::log("m4 walk error: no walk_case0.vds in the working folder\n");
+  const int walks = vds::fw::run_cases("walk_case", [&](const char* name) { return run_file(name, "walk", &failures); });
+  const int terrains = vds::fw::run_cases("terrain_case", [&](const char* name) { return run_file(name, "terrain", &failures); });
+  if (walks + terrains == 0) {
+    board::log("m4 walk error: no walk_case0.vds or terrain_case0.vds in the working folder\n");
     return 1;
   }
   return failures == 0 ? 0 : 1;

@@ -180,6 +180,12 @@ Status start_stream() {
   cb.wait_until = wait_until;
   if (board::instruction_resolution() != 0) cb.clock = [](void*) { return board::instructions(); };
   cb.notice = notice;
+  // What a mode sends up: the terrain viewer's pose, on the pose channel
+  // (a datagram: the newest replaces one not yet sent).
+  cb.send_up = [](void*, uint8_t kind, const uint8_t* data, size_t n) {
+    if (kind != vds::terrain::kSendPose) return false;
+    return g.link.send_datagram(link::channel::kPose, data, n) == Status::ok;
+  };
   return g.player.init(g.arena, vds::kClientPlayerConfig, cb);
 }
 

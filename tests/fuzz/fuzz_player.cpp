@@ -1,9 +1,10 @@
 // libFuzzer: the client's player (vds/player.h) on hostile streams, fed in
 // pieces of sizes the input chooses. The first byte picks the stream:
-// chunks of the input's bytes in a valid images- or model-mode container
-// (every CRC right, so the modes themselves see the bytes), raw bytes, or
-// a valid image, JPEG-image or model stream whose chunk payloads the
-// input's bytes flip (CRCs recomputed, so the decoders meet the damage);
+// chunks of the input's bytes in a valid images-, model- or terrain-mode
+// container (every CRC right, so the modes themselves see the bytes), raw
+// bytes, or a valid image, JPEG-image, model or terrain stream whose chunk
+// payloads the input's bytes flip (CRCs recomputed, so the decoders meet
+// the damage);
 // and the band format (RGB565 or RGB888) and whether a prediction is given.
 // Invariants: no crash or sanitizer report; every band lies inside its
 // frame and is at most config.band_rows high; bands come only between a
@@ -20,6 +21,7 @@
 #include "vds/enc/frames.h"
 #include "vds/enc/mesh_encoder.h"
 #include "vds/enc/stream_writer.h"
+#include "vds/enc/terrain_stream.h"
 #include "vds/image.h"
 #include "vds/mesh.h"
 #include "vds/player.h"
@@ -55,6 +57,10 @@ std::vector<uint8_t> container(vds::StreamMode mode, const uint8_t* data, size_t
   }
   return w.finish();
 }
+
+// The terrain chunks of a valid stream's header, in the order and with the
+// payloads the input gives.
+std::vector<uint8_t> container_terrain(const uint8_t* data, size_t size);
 
 // A valid stream's chunks (after HEAD), rewrapped with the input's bytes
 // XORed over their payloads.
@@ -129,13 +135,78 @@ const std::vector<uint8_t>& valid_model() {
   return s;
 }
 
+// A terrain flight of 8 frames over a 13 x 11-point heightmap with a
+// 96 x 80 colour map (12 x 10 cells), drawn 64 x 48.
+const std::vector<uint8_t>& valid_terrain() {
+  static const std::vector<uint8_t> s = [] {
+    vds::enc::TerrainMap m;
+    m.name = "fuzz";
+    m.width = 13;
+    m.height = 11;
+    m.horizontal_scale = 4;
+    m.metres_per_unit = 0.1;
+    for (int y = 0; y < m.height; ++y)
+      for (int x = 0; x < m.width; ++x) m.heights.push_back(static_cast<uint16_t>(100 + 37 * ((x * 7 + y * 3) % 11)));
+    m.colour = vds::io::Image(96, 80, 3);
+    for (size_t i = 0; i < m.colour.pixels.size(); ++i) m.colour.pixels[i] = static_cast<uint8_t>(i * 13 + (i >> 7));
+    const vds::enc::TerrainCoding t = vds::enc::code_terrain(m, 6);
+    vds::enc::CameraPath path;
+    path.fps = 20;
+    path.hfov_deg = 70;
+    for (int f = 0; f < 8; ++f) {
+      vds::enc::CameraPose p;
+      p.x = 5 + 3 * f;
+      p.y = 10;
+      p.z = 30;
+      p.yaw_deg = 30 + 10 * f;
+      p.pitch_deg = -30;
+      path.frames.push_back(p);
+    }
+    vds::enc::TerrainStreamOptions o;
+    o.width = 64;
+    o.height = 48;
+    o.store_units = 2000;
+    o.max_cells = 16;
+    o.cache_log2 = 2;
+    o.link.latency_frames = 0;
+    o.link.rate_bytes_per_s = 0;
+    return vds::enc::write_terrain_stream(t, path, o).bytes;
+  }();
+  return s;
+}
+
+}  // namespace
+
+namespace {
+std::vector<uint8_t> container_terrain(const uint8_t* data, size_t size) {
+  const std::vector<uint8_t>& valid = valid_terrain();
+  vds::StreamHeader h{};
+  uint32_t head_len = 0;
+  std::memcpy(&head_len, valid.data() + vds::kPreambleBytes + 4, 4);
+  if (vds::header_from_bytes(valid.data() + vds::kPreambleBytes + vds::kChunkHeadBytes, head_len, valid[4], valid[5], &h) !=
+      vds::Status::ok)
+    abort();
+  vds::enc::StreamWriter w(h);
+  const uint32_t types[] = {vds::chunk::kTerrainParams, vds::chunk::kTerrainFlight, vds::chunk::kTerrainElevation,
+                            vds::chunk::kTerrainTexture, vds::chunk::kTerrainFrame};
+  size_t at = 0;
+  while (at + 2 <= size) {
+    const uint8_t pick = data[at];
+    const size_t len = data[at + 1] % 64;
+    at += 2;
+    const size_t n = len < size - at ? len : size - at;
+    w.add_chunk(types[pick % 5], std::vector<uint8_t>(data + at, data + at + n));
+    at += n;
+  }
+  return w.finish();
+}
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 2) return 0;
-  const uint8_t kind = data[0] % 6;
-  const bool rgb888 = (data[0] / 6) & 1;
-  const bool predict = (data[0] / 12) & 1;
+  const uint8_t kind = data[0] % 8;
+  const bool rgb888 = (data[0] / 8) & 1;
+  const bool predict = (data[0] / 16) & 1;
   const uint8_t piece = static_cast<uint8_t>(data[1] | 1);
   data += 2;
   size -= 2;
@@ -145,7 +216,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       : kind == 2 ? std::vector<uint8_t>(data, data + size)
       : kind == 3 ? flipped(valid_images(), data, size)
       : kind == 4 ? flipped(valid_jpeg_images(), data, size)
-                  : flipped(valid_model(), data, size);
+      : kind == 5 ? flipped(valid_model(), data, size)
+      : kind == 6 ? flipped(valid_terrain(), data, size)
+                  : container_terrain(data, size);
   static std::vector<uint8_t> ws(256 * 1024);
   vds::Arena arena(ws.data(), ws.size());
   Watch watch;

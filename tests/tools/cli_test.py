@@ -145,6 +145,19 @@ code, out, err = run("fly", "--heightmap", hm, "--colour", col, "--scale", "4,0.
 check(code == 2 and "--tiles" in err, "vds fly refuses a tile variant it does not have")
 code, out, err = run("fly", "--heightmap", hm, "--colour", col, "--frames", "12")
 check(code == 2 and "--scale" in err, "vds fly asks for the scales of a user's heightmap")
+# vds encode-terrain: the same map's stream, replayed through the client library; vds serve-terrain
+# needs a client.
+tstream = os.path.join(TMP, "terrain.vds")
+code, out, err = run("encode-terrain", "--heightmap", hm, "--colour", col, "--scale", "4,0.001", "--frames", "12",
+                     "-o", tstream, "--psnr", "--out", flyout + "_stream")
+check(code == 0 and "the client library plays it: 12 frames" in out and "ground truth: mean" in out
+      and os.path.exists(os.path.join(flyout + "_stream", "sheet.png")), "vds encode-terrain writes a stream the client plays")
+code, out, err = run("frames", tstream)
+check(code == 0, "vds frames replays a terrain stream")
+code, out, err = run("encode-terrain", "--heightmap", hm, "--colour", col, "--scale", "4,0.001", "-o", tstream, "--cache-log2", "9")
+check(code == 2 and "--cache-log2" in err, "vds encode-terrain refuses a cache it cannot have")
+code, out, err = run("serve-terrain", "--heightmap", hm, "--colour", col, "--scale", "4,0.001", "--frames", "12")
+check(code == 2 and "--board" in err, "vds serve-terrain asks for a board or a link")
 code, out, err = run("fly", os.path.join(TMP, "no-such.level"))
 check(code == 1 and "no-such.level" in err, "vds fly names a missing level")
 with open(os.path.join(TMP, "bad.level"), "w") as f:

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "jpeg_sample_422.h"
@@ -134,14 +135,19 @@ TEST(Player, EveryPrefixFailsCleanlyOnlyTheWholeSucceeds) {
   }
 }
 
-TEST(Player, AModeTheClientDoesNotPlayIsRefusedAtTheHeader) {
-  vds::StreamHeader h = vds::enc::default_header(vds::StreamMode::terrain, 64, 48);
-  vds::enc::StreamWriter w(h);
-  const std::vector<uint8_t> s = w.finish();
-  Seen seen;
-  vds::Player p;
-  EXPECT_EQ(play(s, seen, 16, 1u << 20, &p), Status::unsupported_feature);
-  EXPECT_EQ(seen.begun, 0u);
+TEST(Player, AStreamItsModeCannotPlayIsRefusedAtTheHeader) {
+  // Walkthrough and terrain streams draw with a camera over a known number
+  // of frames: a header without them is refused before anything else.
+  for (vds::StreamMode mode : {vds::StreamMode::terrain, vds::StreamMode::walkthrough}) {
+    vds::StreamHeader h = vds::enc::default_header(mode, 64, 48);
+    vds::enc::StreamWriter w(h);
+    const std::vector<uint8_t> s = w.finish();
+    Seen seen;
+    vds::Player p;
+    EXPECT_EQ(play(s, seen, 16, 1u << 20, &p), Status::malformed);
+    EXPECT_NE(std::string(p.error_detail()).find("camera"), std::string::npos);
+    EXPECT_EQ(seen.begun, 0u);
+  }
 }
 
 // The image stream's chunks under a HEAD that declares another frame size.

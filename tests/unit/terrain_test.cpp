@@ -20,6 +20,7 @@
 #include "vds/enc/terrain_tiles.h"
 #include "vds/io/image.h"
 #include "vds/terrain.h"
+#include "terrain_maps.h"
 #include "xorshift.h"
 
 namespace {
@@ -332,28 +333,6 @@ TEST(TerrainMask, ShapesFollowDepthTiltAndRotation) {
 // --- Updates -----------------------------------------------------------------------------
 
 // A small terrain: 24 x 20 cells of a coloured, hilly map.
-enc::TerrainMap test_map() {
-  enc::TerrainMap m;
-  m.name = "test";
-  m.width = 97;
-  m.height = 81;
-  m.horizontal_scale = 2;
-  m.metres_per_unit = 0.05;
-  m.heights.resize(static_cast<size_t>(m.width) * m.height);
-  for (int y = 0; y < m.height; ++y)
-    for (int x = 0; x < m.width; ++x)
-      m.heights[static_cast<size_t>(y) * m.width + x] =
-          static_cast<uint16_t>(600 + 300 * std::sin(x * 0.08) + 250 * std::cos(y * 0.11 + x * 0.03));
-  m.colour = vds::io::Image(192, 160, 3);
-  for (int y = 0; y < 160; ++y)
-    for (int x = 0; x < 192; ++x) {
-      m.colour.at(x, y, 0) = static_cast<uint8_t>(128 + 100 * std::sin(x * 0.3) * std::cos(y * 0.2));
-      m.colour.at(x, y, 1) = static_cast<uint8_t>((x * 3 + y) & 255);
-      m.colour.at(x, y, 2) = static_cast<uint8_t>(((x / 6 + y / 6) & 1) ? 200 : 40);
-    }
-  return m;
-}
-
 // A flight over it: out, a turn, a climb, and back where it began.
 enc::SceneCamera flight_camera(const enc::TerrainCoding& t, int f, int frames) {
   const double w = t.grid.cells_x * t.cell_m, d = t.grid.cells_y * t.cell_m;
@@ -409,7 +388,7 @@ struct Client {
 };
 
 TEST(TerrainUpdates, TheClientHoldsWhatTheServerMirrorsAndNothingIsSentTwiceUnlessDropped) {
-  const enc::TerrainCoding t = enc::code_terrain(test_map(), 6);
+  const enc::TerrainCoding t = enc::code_terrain(vds::test::terrain_test_map(), 6);
   const uint32_t blocks = t.grid.blocks();
   const uint32_t capacity = 6000;  // well under what the flight sees: the store evicts
   enc::TerrainServer server(t, capacity);
@@ -452,7 +431,7 @@ TEST(TerrainUpdates, TheClientHoldsWhatTheServerMirrorsAndNothingIsSentTwiceUnle
 }
 
 TEST(TerrainUpdates, AStillViewerGetsEverythingItNeedsAndThenNothing) {
-  const enc::TerrainCoding t = enc::code_terrain(test_map(), 6);
+  const enc::TerrainCoding t = enc::code_terrain(vds::test::terrain_test_map(), 6);
   enc::TerrainServer server(t, 1u << 20);
   Client client(t);
   const enc::SceneCamera cam = flight_camera(t, 10, 100);
@@ -475,7 +454,7 @@ TEST(TerrainUpdates, AStillViewerGetsEverythingItNeedsAndThenNothing) {
 }
 
 TEST(TerrainUpdates, EveryPrefixAndEveryBitFlipIsRefusedOrStaysInRange) {
-  const enc::TerrainCoding t = enc::code_terrain(test_map(), 10);
+  const enc::TerrainCoding t = enc::code_terrain(vds::test::terrain_test_map(), 10);
   enc::TerrainServer server(t, 1u << 20);
   const auto u = server.update(flight_camera(t, 3, 100), 3, 1500, {});
   ASSERT_GT(u.size(), 100u);
@@ -494,7 +473,7 @@ TEST(TerrainUpdates, EveryPrefixAndEveryBitFlipIsRefusedOrStaysInRange) {
 }
 
 TEST(TerrainUpdates, ReconstructionApproachesTheSourceAsMasksGrow) {
-  const enc::TerrainCoding t = enc::code_terrain(test_map(), 2);
+  const enc::TerrainCoding t = enc::code_terrain(vds::test::terrain_test_map(), 2);
   const uint32_t fine = t.grid.first(0, 0), n = t.grid.blocks();
   std::vector<Mask> none(n, 0), coarse_dc(n, 0), coarse(n, 0), dc(n, 0x1), full(n, terrain::kFullMask);
   for (uint32_t b = 0; b < fine; ++b) coarse_dc[b] = 0x1, coarse[b] = terrain::kFullMask;
@@ -541,7 +520,7 @@ TEST(TerrainUpdates, BlockIdsCoverBothLevelsOnce) {
 }
 
 TEST(TerrainUpdates, SeveralCamerasGetWhatEachNeeds) {
-  const enc::TerrainCoding t = enc::code_terrain(test_map(), 6);
+  const enc::TerrainCoding t = enc::code_terrain(vds::test::terrain_test_map(), 6);
   enc::TerrainServer server(t, 1u << 20);
   const std::vector<enc::SceneCamera> cams = {flight_camera(t, 10, 100), flight_camera(t, 40, 100)};
   for (int f = 0; f < 400 && !server.update(cams, static_cast<uint32_t>(f), 800, {}).empty(); ++f) {
@@ -555,7 +534,7 @@ TEST(TerrainUpdates, SeveralCamerasGetWhatEachNeeds) {
 // The replay keeps the link's rate and the client's store for vds and for
 // the tile pyramid alike.
 TEST(TerrainFlight, BothClientsKeepTheLinkAndTheirStore) {
-  const enc::TerrainCoding t = enc::code_terrain(test_map(), 6);
+  const enc::TerrainCoding t = enc::code_terrain(vds::test::terrain_test_map(), 6);
   enc::CameraPath path;
   path.hfov_deg = 70;
   path.fps = 20;

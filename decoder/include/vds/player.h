@@ -62,6 +62,7 @@
 #include "vds/model_view.h"
 #include "vds/render.h"
 #include "vds/status.h"
+#include "vds/terrain_client.h"
 #include "vds/walk.h"
 #include "vds/walk_geometry.h"
 
@@ -160,6 +161,17 @@ struct PlayerMode {
 // more bytes than can finish as many chunks (12 bytes of framing at least)
 // as frames may still complete.
 size_t chunk_per_frame_feed_limit(uint32_t frames_room);
+// The renderer's band sink for a mode drawing a frame: hands the band to
+// the player (ctx) as one of the frame's bands.
+bool render_band_to_player(void* player, const Band& band);
+// The renderer's configuration for a mode drawing whole frames into the
+// player's bands: the frame's size, band_rows-high bands, 16-bit depth, and
+// the caches given.
+RenderConfig band_render_config(const StreamHeader& h, const PlayerConfig& c, uint32_t vertex_cache,
+                                uint32_t triangle_cache);
+// A mode that draws with a camera along a known number of frames: false
+// (with `what` in the error) when the header has no camera or no frame count.
+bool header_has_camera_and_frames(Player& p, const StreamHeader& h, const char* what);
 }  // namespace detail
 
 class Player {
@@ -172,6 +184,9 @@ class Player {
   // Workspace a walkthrough needs beyond the parser for its frame size and
   // parameters (what its HEAD declares).
   static size_t walk_workspace_bytes(const StreamHeader& h, const WalkParams& w, const PlayerConfig& config);
+  // Workspace a terrain stream needs beyond the parser (what its HEAD and
+  // TERH declare).
+  static size_t terrain_workspace_bytes(const StreamHeader& h, const terrain::Params& t, const PlayerConfig& config);
 
   Status init(Arena& arena, const PlayerConfig& config, const PlayerCallbacks& callbacks);
   Status feed(const uint8_t* data, size_t n);
@@ -189,6 +204,9 @@ class Player {
   // residual against it). For encoders mirroring the client.
   const Texture* walk_view(uint8_t slot) const;
   bool walk_view_predicted() const;
+  // Terrain: the client's block store (nullptr before TERH). For servers
+  // checking their mirror.
+  const terrain::BlockStore* terrain_store() const;
 
   bool have_header() const { return parser_.have_header(); }
   const StreamHeader& header() const { return parser_.header(); }
@@ -260,6 +278,7 @@ class Player {
   WalkGeometry walk_geometry;
   WalkFrameDecoder walk_frames;
   struct WalkPlay* walk = nullptr;  // decoder/src/player/mode_walk.cpp
+  struct TerrainPlay* terrain = nullptr;  // decoder/src/player/mode_terrain.cpp
 
  private:
   static bool on_header(void* ctx, const StreamHeader& h);

@@ -134,7 +134,11 @@ enum class ElevationPass : uint8_t { coarse = 0, fine = 1 };
 // encode_elevation into out[y * w + x]; the fine pass needs the coarse
 // pass's points in `out`. malformed for a residual that leaves 0..65535 or
 // bytes no encoder produces, truncated when the data ends first.
-Status decode_elevation(const uint8_t* data, size_t size, int w, int h, ElevationPass pass, uint16_t* out);
+// The fine pass may be sent in pieces of whole rows, rows [y0, y1) each
+// coded on its own (fresh contexts), in order: a piece needs the rows above
+// it. The coarse pass takes the whole grid (y0 = 0, y1 = h).
+Status decode_elevation(const uint8_t* data, size_t size, int w, int h, ElevationPass pass, uint16_t* out,
+                        int y0 = 0, int y1 = -1);
 // The points the fine pass will send, interpolated (bilinear) from the
 // coarse ones: what the client draws until then.
 void fill_from_coarse(int w, int h, uint16_t* out);
@@ -158,9 +162,10 @@ int elevation_class(int a, int b, int c, bool both);
 
 // Visits the points of a pass in coding order: f(x, y, prediction, class)
 // with the prediction from what `out` holds when it is called; f returns
-// false to stop. Shared by the decoder and the host encoder.
+// false to stop. The fine pass visits rows [y0, y1) only. Shared by the
+// decoder and the host encoder.
 template <class F>
-void for_each_elevation_point(int w, int h, ElevationPass pass, const uint16_t* out, F f) {
+void for_each_elevation_point(int w, int h, ElevationPass pass, const uint16_t* out, F f, int y0 = 0, int y1 = -1) {
   auto at = [&](int x, int y) { return static_cast<int>(out[static_cast<size_t>(y) * w + x]); };
   if (pass == ElevationPass::coarse) {
     const int cw = (w - 1 + kCoarseStep - 1) / kCoarseStep + 1, ch = (h - 1 + kCoarseStep - 1) / kCoarseStep + 1;
@@ -174,7 +179,8 @@ void for_each_elevation_point(int w, int h, ElevationPass pass, const uint16_t* 
       }
     return;
   }
-  for (int y = 0; y < h; ++y)
+  if (y1 < 0 || y1 > h) y1 = h;
+  for (int y = y0 < 0 ? 0 : y0; y < y1; ++y)
     for (int x = 0; x < w; ++x) {
       if (elevation_coarse(x, y, w, h)) continue;
       const int a = x > 0 ? at(x - 1, y) : 0, b = y > 0 ? at(x, y - 1) : 0, c = x > 0 && y > 0 ? at(x - 1, y - 1) : 0;

@@ -9,10 +9,6 @@
 namespace vds {
 namespace {
 
-bool render_band(void* ctx, const Band& b) {
-  return static_cast<Player*>(ctx)->band(PixelRect{0, b.y, b.width, b.height, b.pixels, static_cast<ptrdiff_t>(b.stride)});
-}
-
 bool start(Player& p, const StreamHeader&) {
   if (p.config().format != PixelFormat::rgb565) {
     p.fail(Status::unsupported_feature, "the model view draws RGB565 bands only");
@@ -99,7 +95,7 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
     } else {
       const uint64_t display_before = p.display_total();
       const uint64_t d0 = p.work_clock();
-      const Status d = p.view.draw(p.mesh.mesh(), p.model_frames.angle(), render_band, &p);
+      const Status d = p.view.draw(p.mesh.mesh(), p.model_frames.angle(), detail::render_band_to_player, &p);
       p.model_frames.mark_drawn(p.mesh);
       // Drawing counts as display: the bands have added their part, add the renderer's.
       p.add_display((p.work_clock() - d0) - (p.display_total() - display_before));

@@ -58,15 +58,7 @@ Texture with_border(const Texture& t) {
 }
 
 RenderConfig render_config(const StreamHeader& h, const WalkParams& w, const PlayerConfig& c) {
-  RenderConfig rc;
-  rc.width = h.width;
-  rc.height = h.height;
-  rc.band_height = static_cast<uint16_t>(c.band_rows < h.height ? c.band_rows : h.height);
-  rc.format = c.format;
-  rc.depth = DepthFormat::d16;
-  rc.vertex_cache = 3u * w.slots;
-  rc.triangle_cache = w.slots;
-  return rc;
+  return detail::band_render_config(h, c, 3u * w.slots, w.slots);
 }
 
 bool cameras_equal(const Camera& a, const Camera& b) {
@@ -77,17 +69,9 @@ bool cameras_equal(const Camera& a, const Camera& b) {
          a.position.z.raw() == b.position.z.raw() && a.fx.raw() == b.fx.raw() && a.fy.raw() == b.fy.raw();
 }
 
-bool render_band(void* ctx, const Band& b) {
-  return static_cast<Player*>(ctx)->band(PixelRect{0, b.y, b.width, b.height, b.pixels, static_cast<ptrdiff_t>(b.stride)});
-}
-
 bool start(Player& p, const StreamHeader& h) {
   p.walk = nullptr;
-  if (h.focal_x_q16 == 0 || h.near_q16 == 0 || h.frame_count == 0) {
-    p.fail(Status::malformed, "a walkthrough needs a camera and a frame count in its header");
-    return false;
-  }
-  return true;  // set up at WLKP
+  return detail::header_has_camera_and_frames(p, h, "a walkthrough needs a camera and a frame count in its header");  // set up at WLKP
 }
 
 bool setup(Player& p, const uint8_t* payload, uint32_t size) {
@@ -189,7 +173,7 @@ Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
     m.texture = &w.view_tex[v];
     m.num_triangles = w.view_ready[v] && plane_homography(cam, w.view_cam[v], tri, &m.view_map) == Status::ok ? 1 : 0;
   }
-  return w.renderer.render(cam, draw_list(w, n), 0, render_band, &p);
+  return w.renderer.render(cam, draw_list(w, n), 0, detail::render_band_to_player, &p);
 }
 
 // A view's prediction: the band's RGB565 rows into the slot's Y'CbCr

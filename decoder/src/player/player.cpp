@@ -11,6 +11,30 @@ namespace detail {
 extern const PlayerMode kImagesMode;
 extern const PlayerMode kModelMode;
 extern const PlayerMode kWalkMode;
+extern const PlayerMode kTerrainMode;
+
+bool render_band_to_player(void* player, const Band& b) {
+  return static_cast<Player*>(player)->band(PixelRect{0, b.y, b.width, b.height, b.pixels, static_cast<ptrdiff_t>(b.stride)});
+}
+
+RenderConfig band_render_config(const StreamHeader& h, const PlayerConfig& c, uint32_t vertex_cache,
+                                uint32_t triangle_cache) {
+  RenderConfig rc;
+  rc.width = h.width;
+  rc.height = h.height;
+  rc.band_height = static_cast<uint16_t>(c.band_rows < h.height ? c.band_rows : h.height);
+  rc.format = c.format;
+  rc.depth = DepthFormat::d16;
+  rc.vertex_cache = vertex_cache;
+  rc.triangle_cache = triangle_cache;
+  return rc;
+}
+
+bool header_has_camera_and_frames(Player& p, const StreamHeader& h, const char* what) {
+  if (h.focal_x_q16 != 0 && h.near_q16 != 0 && h.frame_count != 0) return true;
+  p.fail(Status::malformed, what);
+  return false;
+}
 
 size_t chunk_per_frame_feed_limit(uint32_t frames_room) {
   constexpr size_t kMinChunk = kChunkHeadBytes + kChunkTailBytes;
@@ -22,7 +46,8 @@ size_t chunk_per_frame_feed_limit(uint32_t frames_room) {
 namespace {
 
 // The modes this build plays, by the stream header's mode.
-const detail::PlayerMode* const kModes[] = {&detail::kImagesMode, &detail::kModelMode, &detail::kWalkMode};
+const detail::PlayerMode* const kModes[] = {&detail::kImagesMode, &detail::kModelMode, &detail::kWalkMode,
+                                                  &detail::kTerrainMode};
 
 const detail::PlayerMode* find_mode(StreamMode m) {
   for (const detail::PlayerMode* mode : kModes)
@@ -58,6 +83,7 @@ Status Player::init(Arena& arena, const PlayerConfig& config, const PlayerCallba
   model_frames = ModelFrames{};
   model_started = false;
   walk = nullptr;
+  terrain = nullptr;
   ChunkSink sink;
   sink.ctx = this;
   sink.on_header = on_header;

@@ -23,7 +23,12 @@ namespace {
 // A client whose workspace is full reports early: the host writes no more.
 struct Server {
   explicit Server(const std::vector<uint8_t>& s) : stream(s) {}
+  // A live stream: made while it is served, into `made`.
+  explicit Server(LiveStream& l) : stream(made), live(&l), complete(false) {}
+  std::vector<uint8_t> made;
   const std::vector<uint8_t>& stream;
+  LiveStream* live = nullptr;
+  bool complete = true;  // the stream is whole (a file always)
   uint64_t written = 0;
   uint32_t epoch = 0;
   uint64_t started_ms = 0;
@@ -52,6 +57,14 @@ struct Server {
       frames.clear();
       started_ms = now;
     }
+    if (live != nullptr) {
+      // The client's poses, then what is due by now. A new session starts
+      // the client again from the first byte of what was made.
+      uint8_t pose[64];
+      size_t n = 0;
+      while (h.read_datagram(channel::kPose, pose, sizeof pose, &n) == Status::ok) live->pose(pose, n);
+      if (!complete) complete = live->produce(now - started_ms, made);
+    }
     while (written < stream.size() && !wants_no_more()) {
       size_t acc = 0;
       if (h.write(channel::kStream, stream.data() + written, stream.size() - written, &acc) != Status::ok || acc == 0)
@@ -73,7 +86,9 @@ struct Server {
       if (decode(st, n, &stats) == Status::ok) have_stats = true;
     while (!receipt && ctl.next(h, channel::kControl)) receipt = decode(ctl.bytes, kDoneReportBytes, &report) == Status::ok;
   }
-  bool acked(Link& h) const { return h.established() && written == stream.size() && h.unacked(channel::kStream) == 0; }
+  bool acked(Link& h) const {
+    return complete && h.established() && written == stream.size() && h.unacked(channel::kStream) == 0;
+  }
   // The client has reported that its workspace is full.
   bool wants_no_more() const { return receipt && report.reason == DoneReason::workspace_full; }
   // The report's status is ok and its byte count and CRC are the stream's,
@@ -153,16 +168,18 @@ uint32_t seed_from_clock() {
 
 }  // namespace
 
-ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions& o,
-                         const std::function<void(const std::string&)>& log) {
+namespace {
+
+ServeReport serve(Server& srv, const ServeOptions& o, const std::function<void(const std::string&)>& log) {
+  const std::vector<uint8_t>& stream = srv.stream;
   ServeReport rep;
   rep.bytes = stream.size();
   rep.stream_crc = crc32c(stream.data(), stream.size());
   const uint32_t seed = o.nonce_seed != 0 ? o.nonce_seed : seed_from_clock();
-  Server srv(stream);
   srv.log = log;
 
   if (o.link == "loopback") {
+    if (srv.live != nullptr) throw std::runtime_error("a live stream needs a client that plays it: a board, not loopback");
     // Size the client's workspace from the stream's own header.
     StreamHeader hdr{};
     if (stream.size() < kPreambleBytes + kChunkHeadBytes + kHeaderPayloadV1 ||
@@ -239,6 +256,10 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
       // separate channel), then say goodbye, and close once the client has
       // acknowledged it: it stops on the Goodbye, without waiting for
       // acknowledgements of its own last messages.
+      if (srv.live != nullptr && srv.complete && rep.bytes != stream.size()) {
+        rep.bytes = stream.size();
+        rep.stream_crc = crc32c(stream.data(), stream.size());
+      }
       if (receipt_at) {
         const bool all_records = srv.frames.size() >= srv.report.frames_shown;
         if (all_records || now - *receipt_at > kRecordWaitMs) srv.say_goodbye(host, rep.stream_crc);
@@ -267,6 +288,10 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
     rep.final_frame_payload = host.frame_payload();
     rep.bytes_acked = srv.written - host.unacked(channel::kStream);
   }
+  if (srv.live != nullptr) {
+    rep.bytes = stream.size();
+    rep.stream_crc = crc32c(stream.data(), stream.size());
+  }
   rep.goodbye_sent = srv.goodbye_sent;
   rep.report_seen = srv.receipt;
   rep.report_status = srv.report.status;
@@ -282,6 +307,22 @@ ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions&
   const double delivered = rep.receipt_prefix ? static_cast<double>(rep.receipt_bytes) : static_cast<double>(stream.size());
   if (rep.seconds > 0) rep.goodput = delivered / rep.seconds / (o.baud / 10.0);
   return rep;
+}
+
+}  // namespace
+
+ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions& o,
+                         const std::function<void(const std::string&)>& log) {
+  Server srv(stream);
+  return serve(srv, o, log);
+}
+
+ServeReport serve_live(LiveStream& live, const ServeOptions& o, std::vector<uint8_t>* made,
+                       const std::function<void(const std::string&)>& log) {
+  Server srv(live);
+  ServeReport r = serve(srv, o, log);
+  if (made != nullptr) *made = srv.made;
+  return r;
 }
 
 }  // namespace vds::link

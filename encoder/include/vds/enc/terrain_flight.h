@@ -6,6 +6,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,23 @@ CameraPath read_flight(const std::string& text, const std::string& name, const T
 // The terrain as a scene: the grid's cells as two triangles each, textured
 // with `texture` (RGB, the colour map's size padded to whole cells).
 Scene terrain_scene(const TerrainCoding& t);
+
+// The pose `steps` pose intervals after b, moving as it moved from a to b
+// (yaw the short way round, pitch kept within the camera's range): where
+// the server predicts the viewer will be.
+CameraPose extrapolate(const CameraPose& a, const CameraPose& b, double steps);
+
+// The ground truth of a flight: the terrain drawn by the reference
+// renderer with the whole colour map (mip-mapped, supersampled).
+class TerrainTruth {
+ public:
+  TerrainTruth(const TerrainCoding& t, int width, int height, int supersample = 2, double near_m = 0.1);
+  ~TerrainTruth();
+  io::Image render(const CameraPose& pose, double hfov_deg) const;
+
+ private:
+  std::unique_ptr<SceneRenderer> renderer_;
+};
 
 struct FlightLink {
   double rate_bytes_per_s = 2000;  // downlink payload bytes a second; 0: unlimited (every pose answered whole)

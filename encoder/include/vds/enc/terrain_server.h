@@ -46,8 +46,10 @@ struct TerrainCoding {
 // on a side.
 TerrainCoding code_terrain(const TerrainMap& map, int quantiser);
 
-// One pass of the elevation, coded losslessly (vds/terrain.h: decode_elevation).
-std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h, terrain::ElevationPass pass);
+// One pass of the elevation, coded losslessly (vds/terrain.h:
+// decode_elevation); of the fine pass, rows [y0, y1) (y1 < 0: to the end).
+std::vector<uint8_t> encode_elevation(const uint16_t* heights, int w, int h, terrain::ElevationPass pass, int y0 = 0,
+                                      int y1 = -1);
 
 // A block's texture as the client reconstructs it from the coefficients its
 // mask holds: 64 samples, row-major.
@@ -118,7 +120,8 @@ struct UpdateStats {
 // pose last needed it. What a pose lacks is sent in stages of each block's
 // need (its DC, the lowest 2x2, 4x4, 8x8 frequencies), the stages that
 // remove the most squared screen error per bit first. The store holds at
-// most `capacity` coefficients; to make room the server drops, in order,
+// most `capacity` units (2 bytes; terrain::store_cost: a held block's
+// coefficients and its 12-byte entry in the client's BlockStore); to make room the server drops, in order,
 // level-0 blocks no pose has needed for a second (the longest unneeded
 // first), what needed level-0 blocks hold beyond the need (the least
 // visible first), level-0 blocks needed within the second, and level-1

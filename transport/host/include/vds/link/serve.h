@@ -72,4 +72,23 @@ struct ServeReport {
 ServeReport serve_stream(const std::vector<uint8_t>& stream, const ServeOptions& options,
                          const std::function<void(const std::string&)>& log = {});
 
+// A stream made while it is served (the terrain server, `vds
+// serve-terrain`): produce() is called as the link runs, with the
+// milliseconds since the session began, and appends what is due; pose()
+// gets each message from the client's pose channel (latest wins: a pose
+// not yet read is replaced by a newer one).
+class LiveStream {
+ public:
+  virtual ~LiveStream() = default;
+  virtual void pose(const uint8_t* data, size_t n) = 0;
+  // true once the stream is whole (its END appended).
+  virtual bool produce(uint64_t ms, std::vector<uint8_t>& out) = 0;
+};
+
+// Serves a live stream to a client board (not loopback: its client does not
+// play streams); *made receives the whole stream as sent. A new session
+// sends the client what was made from its first byte again.
+ServeReport serve_live(LiveStream& live, const ServeOptions& options, std::vector<uint8_t>* made,
+                       const std::function<void(const std::string&)>& log = {});
+
 }  // namespace vds::link
