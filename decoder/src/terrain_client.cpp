@@ -20,10 +20,13 @@ Status params_from_bytes(const uint8_t* p, uint32_t size, Params* out) {
   t.cell_q16 = load_le32s(p + 12);
   t.height_step_q16 = load_le32s(p + 16);
   t.pose_period = load_le16(p + 20);
+  t.half_log2 = p[22];
+  t.frame_budget = p[23];
   if (t.cells_x == 0 || t.cells_y == 0 || t.cells_x > kMaxCells || t.cells_y > kMaxCells ||
       t.quantiser < kMinQuantiser || t.quantiser > kMaxQuantiser || t.cache_log2 < kMinCacheLog2 ||
       t.cache_log2 > kMaxCacheLog2 || t.max_cells == 0 || t.max_cells > kMaxDrawnCells || t.store_units == 0 ||
-      t.store_units > (1u << 28) || t.cell_q16 <= 0 || t.height_step_q16 < 0 || load_le16(p + 22) != 0)
+      t.store_units > (1u << 28) || t.cell_q16 <= 0 || t.height_step_q16 < 0 || t.half_log2 > kMaxHalfLog2 ||
+      t.frame_budget < kMinFrameBudget || t.frame_budget > kMaxFrameBudget)
     return Status::malformed;
   *out = t;
   return Status::ok;
@@ -39,7 +42,8 @@ void params_to_bytes(const Params& t, uint8_t out[kParamsBytes]) {
   store_le32(out + 12, static_cast<uint32_t>(t.cell_q16));
   store_le32(out + 16, static_cast<uint32_t>(t.height_step_q16));
   store_le16(out + 20, t.pose_period);
-  store_le16(out + 22, 0);
+  out[22] = t.half_log2;
+  out[23] = t.frame_budget;
 }
 
 void pose_to_bytes(const WalkPose& p, uint8_t out[kPoseBytes]) {
@@ -85,16 +89,21 @@ WalkPose flight_pose(const WalkPose* keys, uint32_t count, uint32_t spacing, uin
 // One buffer: the entries (sorted by id) from its start, the coefficients
 // from its end downward, block k's coefficients ending off_k units below
 // the end (off_k: the coefficients of the blocks before it), each block's
-// in raster order of its mask. A change to block k moves the coefficients
-// of the blocks after it (below it) by the change in its count.
+// in raster order of its mask. Changes are staged (up to kStaged, in
+// ascending id order) and merged in one pass: the runs of entries between
+// the changed blocks move by the change in the number of entries before
+// them, the runs of coefficients by the change in the number of
+// coefficients before them, then the changed blocks are written into the
+// room left for them.
 
 Status BlockStore::init(Arena& arena, const BlockGrid& grid, uint32_t units) {
   if (grid.cells_x == 0 || grid.cells_y == 0 || units == 0) return Status::invalid_argument;
   uint8_t* buf = static_cast<uint8_t*>(arena.alloc(size_t{units} * 2u, alignof(Entry)));
-  if (buf == nullptr) return Status::workspace_too_small;
+  stage_ = arena.alloc_array<Staged>(kStaged);
+  if (buf == nullptr || stage_ == nullptr) return Status::workspace_too_small;
   entries_ = reinterpret_cast<Entry*>(buf);
   pool_end_ = reinterpret_cast<int16_t*>(buf + size_t{units} * 2u);
-  n_ = coefficients_ = used_ = 0;
+  n_ = coefficients_ = used_ = staged_ = 0;
   units_ = units;
   blocks_ = grid.blocks();
   return Status::ok;
@@ -125,50 +134,110 @@ void BlockStore::levels(uint32_t id, int16_t out[64]) const {
     for (int u = 0; u < mask_extent(e.mask, v); ++u) out[8 * v + u] = *src++;
 }
 
-Status BlockStore::apply(const BlockUpdate& b) {
+Status BlockStore::stage(const BlockUpdate& b, MergedFn merged, void* ctx) {
   if (b.id >= blocks_ || !mask_valid(b.mask)) return Status::malformed;
-  uint32_t k = lower_bound(b.id);
-  const bool present = k < n_ && entries_[k].id == b.id;
-  const Mask old = present ? entries_[k].mask : 0;
+  if (staged_ == kStaged || (staged_ != 0 && b.id <= stage_[staged_ - 1].id)) {
+    const Status s = merge(merged, ctx);
+    if (s != Status::ok) return s;
+  }
+  const Mask old = held(b.id);
   if (old != b.held) return Status::malformed;
   if (b.mask == old) return Status::ok;
   const uint32_t used = used_ - store_cost(old) + store_cost(b.mask);
   if (used > units_) return Status::malformed;
   // The block's levels after the change: what it keeps, and what the
   // update adds.
-  int16_t lv[64];
-  levels(b.id, lv);
+  Staged& st = stage_[staged_++];
+  st.id = b.id;
+  st.old_mask = old;
+  st.mask = b.mask;
+  levels(b.id, st.levels);
   for (int v = 0; v < 8; ++v)
     for (int u = 0; u < 8; ++u) {
       const int i = 8 * v + u;
-      if (!mask_holds(b.mask, u, v)) lv[i] = 0;
-      else if (!mask_holds(old, u, v)) lv[i] = b.levels[i];
+      if (!mask_holds(b.mask, u, v)) st.levels[i] = 0;
+      else if (!mask_holds(old, u, v)) st.levels[i] = b.levels[i];
     }
-  if (!present) {
-    // A new entry at k, its coefficients where block k's began.
-    const uint32_t off = k < n_ ? entries_[k].off : coefficients_;
-    memmove(&entries_[k + 1], &entries_[k], (n_ - k) * sizeof(Entry));
-    entries_[k] = Entry{b.id, 0, off};
-    ++n_;
-  }
-  Entry& e = entries_[k];
-  const int before = mask_count(old), after = mask_count(b.mask);
-  const int32_t delta = after - before;
-  // The blocks after k lie below it: move them by delta.
-  const uint32_t below = coefficients_ - e.off - static_cast<uint32_t>(before);
-  int16_t* low = pool_end_ - coefficients_;
-  memmove(low - delta, low, below * sizeof(int16_t));
-  for (uint32_t j = k + 1; j < n_; ++j) entries_[j].off = static_cast<uint32_t>(static_cast<int32_t>(entries_[j].off) + delta);
-  coefficients_ = static_cast<uint32_t>(static_cast<int32_t>(coefficients_) + delta);
-  e.mask = b.mask;
-  int16_t* dst = pool_end_ - e.off - after;
-  for (int v = 0; v < 8; ++v)
-    for (int u = 0; u < mask_extent(b.mask, v); ++u) *dst++ = lv[8 * v + u];
-  if (b.mask == 0) {
-    memmove(&entries_[k], &entries_[k + 1], (n_ - k - 1) * sizeof(Entry));
-    --n_;
-  }
   used_ = used;
+  return Status::ok;
+}
+
+namespace {
+
+// Moves runs of elements within one array: run r ([start_r, start_r + len_r)
+// in the array's index space) moves by shift_r; runs keep their order and
+// end up apart, so moving those that go down in ascending order and those
+// that go up in descending order never overwrites one not yet moved.
+// `at(i)` is the address of index i, `bytes` an element's size; for an
+// array that grows downward in memory (the coefficients), at(i) is the
+// address of its last byte's element.
+template <class At>
+void move_runs(const uint32_t* start, const uint32_t* len, const int32_t* shift, uint32_t runs, size_t bytes, At at) {
+  for (uint32_t r = 0; r < runs; ++r)
+    if (shift[r] < 0 && len[r] != 0) memmove(at(start[r] + shift[r], len[r]), at(start[r], len[r]), len[r] * bytes);
+  for (uint32_t r = runs; r-- > 0;)
+    if (shift[r] > 0 && len[r] != 0) memmove(at(start[r] + shift[r], len[r]), at(start[r], len[r]), len[r] * bytes);
+}
+
+}  // namespace
+
+Status BlockStore::merge(MergedFn merged, void* ctx) {
+  if (staged_ == 0) return Status::ok;
+  // Where each staged block stands among the entries, and the runs between.
+  // Run r (r = 0..staged) is the entries after staged block r - 1 and
+  // before staged block r.
+  uint32_t pos[kStaged], e_start[kStaged + 1], e_len[kStaged + 1], c_start[kStaged + 1], c_len[kStaged + 1];
+  int32_t e_shift[kStaged + 1], c_shift[kStaged + 1];
+  uint32_t at = 0, coef_at = 0;
+  int32_t de = 0, dc = 0;
+  for (uint32_t i = 0; i <= staged_; ++i) {
+    const uint32_t k = i < staged_ ? lower_bound(stage_[i].id) : n_;
+    const uint32_t c = k < n_ ? entries_[k].off : coefficients_;
+    e_start[i] = at, e_len[i] = k - at, e_shift[i] = de;
+    c_start[i] = coef_at, c_len[i] = c - coef_at, c_shift[i] = dc;
+    if (i == staged_) break;
+    pos[i] = k;
+    const bool present = stage_[i].old_mask != 0;
+    at = k + (present ? 1u : 0u);
+    coef_at = c + static_cast<uint32_t>(mask_count(stage_[i].old_mask));
+    de += (stage_[i].mask != 0 ? 1 : 0) - (present ? 1 : 0);
+    dc += mask_count(stage_[i].mask) - mask_count(stage_[i].old_mask);
+  }
+  const uint32_t n_after = static_cast<uint32_t>(static_cast<int32_t>(n_) + de);
+  auto move_entries = [&] {
+    move_runs(e_start, e_len, e_shift, staged_ + 1, sizeof(Entry), [&](uint32_t i, uint32_t) { return &entries_[i]; });
+  };
+  // Coefficient index o (offset from the end) of a run of `len` starts at pool_end_ - o - len.
+  auto move_coefficients = [&] {
+    move_runs(c_start, c_len, c_shift, staged_ + 1, sizeof(int16_t),
+              [&](uint32_t o, uint32_t len) { return pool_end_ - o - len; });
+  };
+  // The entries first when there will be fewer (they leave room the
+  // coefficients may need), else the coefficients first.
+  if (n_after < n_) move_entries(), move_coefficients();
+  else move_coefficients(), move_entries();
+  // The moved entries' offsets, then the staged blocks themselves.
+  for (uint32_t r = 1; r <= staged_; ++r)
+    for (uint32_t j = 0; j < e_len[r]; ++j) {
+      Entry& e = entries_[static_cast<uint32_t>(static_cast<int32_t>(e_start[r]) + e_shift[r]) + j];
+      e.off = static_cast<uint32_t>(static_cast<int32_t>(e.off) + c_shift[r]);
+    }
+  for (uint32_t i = 0; i < staged_; ++i) {
+    const Staged& st = stage_[i];
+    if (st.mask == 0) continue;
+    const uint32_t k = static_cast<uint32_t>(static_cast<int32_t>(pos[i]) + e_shift[i]);
+    const uint32_t off = static_cast<uint32_t>(static_cast<int32_t>(c_start[i] + c_len[i]) + c_shift[i]);
+    entries_[k] = Entry{st.id, st.mask, off};
+    int16_t* dst = pool_end_ - off - mask_count(st.mask);
+    for (int v = 0; v < 8; ++v)
+      for (int u = 0; u < mask_extent(st.mask, v); ++u) *dst++ = st.levels[8 * v + u];
+  }
+  n_ = n_after;
+  coefficients_ = static_cast<uint32_t>(static_cast<int32_t>(coefficients_) + dc);
+  const uint32_t count = staged_;
+  staged_ = 0;
+  if (merged != nullptr)
+    for (uint32_t i = 0; i < count; ++i) merged(ctx, stage_[i].id);
   return Status::ok;
 }
 

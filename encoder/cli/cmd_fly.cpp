@@ -38,7 +38,7 @@ struct FlyOptions {
   bool frames_png = false;
   // encode-terrain
   std::string output;
-  int cache_log2 = 4, cells = 64;
+  int cache_log2 = 4, cells = 64, half_log2 = 6, frame_budget = 2;
   bool psnr = false;
   // serve-terrain
   BoardArgs board;
@@ -167,6 +167,8 @@ enc::TerrainStreamOptions stream_options(const FlyOptions& o, size_t frames) {
   so.store_units = o.store;
   so.cache_log2 = o.cache_log2;
   so.max_cells = o.cells;
+  so.half_log2 = o.half_log2;
+  so.frame_budget = o.frame_budget;
   so.pose.detail = o.detail;
   so.progress = [frames](size_t done) {
     if (done % 25 == 0 || done == frames) std::fprintf(stderr, "\r  frame %zu of %zu", done, frames);
@@ -312,6 +314,10 @@ void add_encode_terrain(CLI::App& app) {
   sub->add_option("--cache-log2", o->cache_log2, "The client's transformed-block window, 2^n cells a side (default 4)")
       ->check(CLI::Range(1, 6));
   sub->add_option("--cells", o->cells, "Cells the client draws with their own texels a frame (default 64)")->check(CLI::Range(1, 4096));
+  sub->add_option("--half-log2", o->half_log2, "The client's half-resolution window, 2^n cells a side, 3..7 (default 6; 0: none)")
+      ->check(CLI::Range(0, 7));
+  sub->add_option("--frame-budget", o->frame_budget, "The client's geometry a frame: 512 n vertices, 2..64 (default 2)")
+      ->check(CLI::Range(2, 64));
   sub->add_flag("--psnr", o->psnr, "Also each frame the client shows against the ground truth");
   sub->callback([o] { run_encode(*o); });
 }
@@ -326,6 +332,10 @@ void add_serve_terrain(CLI::App& app) {
   sub->add_option("--cache-log2", o->cache_log2, "The client's transformed-block window, 2^n cells a side (default 4)")
       ->check(CLI::Range(1, 6));
   sub->add_option("--cells", o->cells, "Cells the client draws with their own texels a frame (default 64)")->check(CLI::Range(1, 4096));
+  sub->add_option("--half-log2", o->half_log2, "The client's half-resolution window, 2^n cells a side, 3..7 (default 6; 0: none)")
+      ->check(CLI::Range(0, 7));
+  sub->add_option("--frame-budget", o->frame_budget, "The client's geometry a frame: 512 n vertices, 2..64 (default 2)")
+      ->check(CLI::Range(2, 64));
   sub->add_option("--board", o->board.board, "host: the host-native board on a pseudo-terminal; qemu: the Cortex-M4 board in QEMU")
       ->check(CLI::IsMember({"host", "qemu"}));
   sub->add_option("--link", o->link, "Without --board: the client's link (pty:PATH, tcp:HOST:PORT, tcp-listen:PORT, usb:VID:PID)");

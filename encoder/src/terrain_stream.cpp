@@ -36,7 +36,9 @@ TerrainSender::TerrainSender(const TerrainCoding& t, const CameraPath& path, con
     : t_(t), o_(o), hfov_(path.hfov_deg), server_(t, o.store_units) {
   if (path.frames.empty()) throw std::invalid_argument("terrain stream: the flight has no frames");
   if (o.max_cells < 1 || o.max_cells > terrain::kMaxDrawnCells || o.cache_log2 < terrain::kMinCacheLog2 ||
-      o.cache_log2 > terrain::kMaxCacheLog2 || o.key_spacing < 1 || o.key_spacing > 1024)
+      o.cache_log2 > terrain::kMaxCacheLog2 || o.key_spacing < 1 || o.key_spacing > 1024 ||
+      (o.half_log2 != 0 && (o.half_log2 < 3 || o.half_log2 > terrain::kMaxHalfLog2)) ||
+      o.frame_budget < terrain::kMinFrameBudget || o.frame_budget > terrain::kMaxFrameBudget)
     throw std::invalid_argument("terrain stream: cache, drawn cells or key spacing out of range");
   // World units: a power of two a metre, as many as keep the map, its
   // heights and the flight within kWorldExtent.
@@ -55,6 +57,14 @@ TerrainSender::TerrainSender(const TerrainCoding& t, const CameraPath& path, con
   params_.height_step_q16 = static_cast<int32_t>(std::lround(t.metres_per_unit * units_ * 65536));
   const int pose_every = std::max(1, static_cast<int>(std::lround(path.fps / std::max(1, o.link.poses_per_s))));
   params_.pose_period = static_cast<uint16_t>(o.link.poses_per_s > 0 ? pose_every : 0);
+  params_.frame_budget = static_cast<uint8_t>(o.frame_budget);
+  // The half-resolution window: as asked, but no larger than the map needs
+  // and at least 8 cells a side.
+  if (o.half_log2 != 0) {
+    int fit = 3;
+    while (fit < o.half_log2 && (1 << fit) < std::max(t.grid.cells_x, t.grid.cells_y)) ++fit;
+    params_.half_log2 = static_cast<uint8_t>(fit);
+  }
   // The flight as keys every key_spacing frames (the last frame a key too).
   const size_t frames = path.frames.size();
   spacing_ = static_cast<uint32_t>(o.key_spacing);

@@ -98,6 +98,51 @@ TEST(TerrainStore, HoldsWhatEveryUpdateLeavesAndRefusesOverflow) {
   EXPECT_EQ(store.apply(bad), Status::malformed);
 }
 
+TEST(TerrainStore, StagedChangesMergeToWhatOneByOneWouldHold) {
+  terrain::BlockGrid g;
+  g.cells_x = 30;
+  g.cells_y = 20;
+  constexpr uint32_t kUnits = 5000;
+  std::vector<uint8_t> ws_a(terrain::BlockStore::workspace_bytes(kUnits) + 64), ws_b(ws_a.size());
+  vds::Arena arena_a(ws_a.data(), ws_a.size()), arena_b(ws_b.data(), ws_b.size());
+  terrain::BlockStore one, batched;
+  ASSERT_EQ(one.init(arena_a, g, kUnits), Status::ok);
+  ASSERT_EQ(batched.init(arena_b, g, kUnits), Status::ok);
+  vds::test::Xorshift32 r{11};
+  std::vector<uint32_t> merged;
+  const auto on_merged = [](void* ctx, uint32_t id) { static_cast<std::vector<uint32_t>*>(ctx)->push_back(id); };
+  uint32_t changes = 0;
+  for (int pass = 0; pass < 300; ++pass) {
+    // A pass: blocks in ascending order, each shrunk, dropped or grown.
+    uint32_t id = r.next() % 40;
+    while (id < g.blocks()) {
+      terrain::BlockUpdate u;
+      u.id = id;
+      u.held = one.held(id);
+      const int kind = static_cast<int>(r.next() % 3);
+      u.mask = kind == 0 ? 0 : (kind == 1 ? terrain::mask_intersection(u.held, random_mask(r)) : terrain::mask_union(u.held, random_mask(r)));
+      for (int i = 0; i < 64; ++i) u.levels[i] = static_cast<int16_t>(static_cast<int>(r.next() % 2001) - 1000);
+      if (one.apply(u) == Status::ok) {
+        ASSERT_EQ(batched.stage(u, on_merged, &merged), Status::ok) << pass << " " << id;
+        changes += u.mask != u.held;
+      }
+      id += 1 + r.next() % 60;
+    }
+    if (pass % 3 == 0) ASSERT_EQ(batched.merge(on_merged, &merged), Status::ok);
+  }
+  ASSERT_EQ(batched.merge(on_merged, &merged), Status::ok);
+  EXPECT_EQ(merged.size(), changes);
+  EXPECT_EQ(batched.used_units(), one.used_units());
+  EXPECT_EQ(batched.held_blocks(), one.held_blocks());
+  for (uint32_t id = 0; id < g.blocks(); ++id) {
+    ASSERT_EQ(batched.held(id), one.held(id)) << id;
+    int16_t a[64], b[64];
+    one.levels(id, a);
+    batched.levels(id, b);
+    for (int i = 0; i < 64; ++i) ASSERT_EQ(a[i], b[i]) << id << " " << i;
+  }
+}
+
 TEST(TerrainFlightPose, InterpolatesBetweenKeysTheShortWayRound) {
   vds::WalkPose keys[3];
   keys[0].position = {vds::Q16_16::from_raw(0), vds::Q16_16::from_raw(10 << 16), vds::Q16_16::from_raw(-4 << 16)};
@@ -322,7 +367,8 @@ TEST(TerrainStream, MalformedRecordsAreRefused) {
       {"TERH with no cells", [&](Parts& p) { p.chunks[find(p, vds::chunk::kTerrainParams)].payload[0] = 0, p.chunks[find(p, vds::chunk::kTerrainParams)].payload[1] = 0; }},
       {"TERH with quantiser 0", [&](Parts& p) { p.chunks[find(p, vds::chunk::kTerrainParams)].payload[4] = 0; }},
       {"TERH with a cache of 2^7", [&](Parts& p) { p.chunks[find(p, vds::chunk::kTerrainParams)].payload[5] = 7; }},
-      {"TERH's reserved bytes set", [&](Parts& p) { p.chunks[find(p, vds::chunk::kTerrainParams)].payload[23] = 1; }},
+      {"TERH with a frame budget of 1", [&](Parts& p) { p.chunks[find(p, vds::chunk::kTerrainParams)].payload[23] = 1; }},
+      {"TERH with a half window of 2^8", [&](Parts& p) { p.chunks[find(p, vds::chunk::kTerrainParams)].payload[22] = 8; }},
       {"TERH of another length", [&](Parts& p) { p.chunks[find(p, vds::chunk::kTerrainParams)].payload.push_back(0); }},
       {"a second TERH", [&](Parts& p) { p.chunks.insert(p.chunks.begin() + 1, p.chunks[0]); }},
       {"TFLY short of the frames", [&](Parts& p) {

@@ -44,7 +44,10 @@ namespace terrain {
 // block's texels a frame, u32 store units (2 bytes each; store_cost),
 // i32 cell size (world units, Q16.16), i32 height step (world units per
 // elevation level, Q16.16), u16 pose period (frames between the poses the
-// client sends up; 0: none), u16 0.
+// client sends up; 0: none), u8 the half-resolution window's log2 (2 x 2
+// texels a cell for 2^n x 2^n cells; 0: none), u8 the frame's geometry
+// budget n (2..64: 512 n ground vertices, 512 n ground triangles, 256 n
+// skirt triangles).
 // World: point (i, j) of the grid lies at x = i cell, y = (cells_y - j)
 // cell, z = height(i, j) step; texel row 0 is the grid's row j = 0 (north).
 struct Params {
@@ -56,8 +59,12 @@ struct Params {
   int32_t cell_q16 = 0;
   int32_t height_step_q16 = 0;
   uint16_t pose_period = 0;
+  uint8_t half_log2 = 0;
+  uint8_t frame_budget = 2;
 };
 inline constexpr uint32_t kParamsBytes = 24;
+inline constexpr uint8_t kMaxHalfLog2 = 7;
+inline constexpr uint8_t kMinFrameBudget = 2, kMaxFrameBudget = 64;
 inline constexpr uint8_t kMinCacheLog2 = 1, kMaxCacheLog2 = 6;
 inline constexpr uint16_t kMaxDrawnCells = 4096;
 Status params_from_bytes(const uint8_t* p, uint32_t size, Params* out);
@@ -106,17 +113,33 @@ inline uint32_t store_cost(Mask m) { return m == 0 ? 0u : static_cast<uint32_t>(
 
 class BlockStore {
  public:
-  static size_t workspace_bytes(uint32_t units) { return size_t{units} * 2u + 4u; }
+  // Changes held back before they are merged into the store together.
+  static constexpr uint32_t kStaged = 16;
+  static size_t workspace_bytes(uint32_t units) { return size_t{units} * 2u + 4u + sizeof(Staged) * kStaged + 8u; }
   // invalid_argument for an empty grid; workspace_too_small.
   Status init(Arena& arena, const BlockGrid& grid, uint32_t units);
+  // What the store holds (changes staged and not yet merged excluded).
   Mask held(uint32_t id) const;
   // A block's levels (natural order), 0 where the mask holds nothing.
   void levels(uint32_t id, int16_t out[64]) const;
   // Applies one block of an update (vds/terrain.h, TextureUpdateReader):
   // malformed when u.held is not what the store holds or the store would
   // overflow.
-  Status apply(const BlockUpdate& u);
-  uint32_t used_units() const { return used_; }
+  Status apply(const BlockUpdate& u) {
+    const Status s = stage(u, nullptr, nullptr);
+    return s == Status::ok ? merge(nullptr, nullptr) : s;
+  }
+  // The same, held back: changes to blocks in ascending id order are
+  // merged into the store in one pass over it (an update's shrinks, then
+  // its grows). A change to a block at or below the last one staged, or
+  // one past kStaged, merges what is staged first; `merged(ctx, id)` is
+  // called for every block once its change is in the store.
+  using MergedFn = void (*)(void* ctx, uint32_t id);
+  Status stage(const BlockUpdate& u, MergedFn merged, void* ctx);
+  Status merge(MergedFn merged, void* ctx);
+  bool staged() const { return staged_ != 0; }
+  uint32_t last_staged() const { return staged_ != 0 ? stage_[staged_ - 1].id : 0; }
+  uint32_t used_units() const { return used_; }  // staged changes included
   uint32_t held_blocks() const { return n_; }
   uint32_t capacity_units() const { return units_; }
 
@@ -126,10 +149,17 @@ class BlockStore {
     Mask mask;
     uint32_t off;  // coefficients of the blocks before it
   };
+  struct Staged {
+    uint32_t id;
+    Mask old_mask, mask;
+    int16_t levels[64];  // natural order, what the block holds after
+  };
   uint32_t lower_bound(uint32_t id) const;
   const int16_t* data(const Entry& e, int count) const { return pool_end_ - e.off - count; }
   Entry* entries_ = nullptr;
   int16_t* pool_end_ = nullptr;  // block k's coefficients end off_k units below this
+  Staged* stage_ = nullptr;
+  uint32_t staged_ = 0;
   uint32_t n_ = 0, coefficients_ = 0, units_ = 0, used_ = 0, blocks_ = 0;
 };
 

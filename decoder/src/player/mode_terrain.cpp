@@ -32,12 +32,15 @@ namespace {
 using terrain::BlockGrid;
 using terrain::Mask;
 
-constexpr uint32_t kGroundTriangles = 1536;  // ground triangles a frame (beyond it patches coarsen)
-constexpr uint32_t kSkirtTriangles = 512;
-constexpr uint32_t kGroundVertices = 1024;
-constexpr int kMaxPatchesSide = 16;
-constexpr int32_t kLodPx = 12;  // a step's largest projected size, pixels
+// A frame's budgets (beyond them patches coarsen), from TERH's frame
+// budget n: 512 n ground vertices, 512 n ground triangles, 256 n skirt
+// triangles. Every visible patch fits at its coarsest step (n >= 2): at
+// most 64 patches of 12 vertices, 2 ground and 8 skirt triangles each.
+constexpr int kMaxPatchesSide = 8;
+constexpr int kMaxStepLog2 = 7;  // patches of up to 128 cells (grids up to 1,024 cells a side)
+constexpr int32_t kLodPx = 1;  // the largest height error a step may show, pixels
 constexpr uint32_t kNoTag = 0xFFFFFFFFu;
+constexpr uint16_t kNoHalf = 0xFFFF;
 constexpr uint32_t kSky = 0;  // where no ground is drawn (black, as the reference renderer)
 
 }  // namespace
@@ -54,6 +57,9 @@ struct TerrainPlay {
   // Patches: P x P cells each, at most 16 a side.
   int patch = 8, patches_x = 0, patches_y = 0;
   uint16_t *patch_lo = nullptr, *patch_hi = nullptr;
+  // Per patch and step 2^l (l = 1 .. kMaxStepLog2): the largest height
+  // error (elevation levels) drawing it at that step makes.
+  uint16_t* patch_err = nullptr;
   uint8_t* patch_step = nullptr;  // this frame's step (0: not drawn)
   int32_t* patch_z = nullptr;     // nearest camera depth, raw Q16.16
   uint16_t* order = nullptr;      // visible patches, nearest first
@@ -73,12 +79,21 @@ struct TerrainPlay {
   uint32_t* cclaim = nullptr;
   uint32_t* cowner = nullptr;  // the Cb block that claimed a chroma slot this frame
   uint32_t stamp = 0;
+  // The half-resolution window: 2 x 2 luma texels and one chroma texel a
+  // cell for hwin x hwin cells (slot = cell mod hwin), a texture the
+  // renderer samples with repeat addressing. A slot's tag is the cell's
+  // (i / hwin, j / hwin) in a byte each (kNoHalf: empty).
+  uint32_t hwin = 0;
+  uint8_t *hy = nullptr, *hcb = nullptr, *hcr = nullptr;
+  uint16_t* htag = nullptr;
+  uint16_t* hclaim = nullptr;  // the low 16 bits of the frame stamp a slot was claimed at
+  Texture half_tex;
   // Draw buffers.
   uint32_t max_vertices = 0;
   Vec3<Q16_16>* pos = nullptr;
   TexCoord* uv = nullptr;
-  uint16_t* ground_idx = nullptr;  // kGroundTriangles * 3
-  uint16_t* skirt_idx = nullptr;   // kSkirtTriangles * 3
+  uint16_t* ground_idx = nullptr;  // ground_triangles() * 3
+  uint16_t* skirt_idx = nullptr;   // skirt_triangles() * 3
   uint16_t* cell_idx = nullptr;    // max_cells * 6
   Mesh* meshes = nullptr;          // ground, skirts, then one per textured cell
   Texture* cell_tex = nullptr;
@@ -93,9 +108,19 @@ int patch_size(const terrain::Params& t) {
   return p;
 }
 
+uint32_t ground_vertices(const terrain::Params& t) { return 512u * t.frame_budget; }
+uint32_t ground_triangles(const terrain::Params& t) { return 512u * t.frame_budget; }
+uint32_t skirt_triangles(const terrain::Params& t) { return 256u * t.frame_budget; }
+
 RenderConfig render_config(const StreamHeader& h, const terrain::Params& t, const PlayerConfig& c) {
-  return detail::band_render_config(h, c, kGroundVertices + 4u * t.max_cells,
-                                    kGroundTriangles + kSkirtTriangles + 2u * t.max_cells);
+  return detail::band_render_config(h, c, ground_vertices(t) + 4u * t.max_cells,
+                                    ground_triangles(t) + skirt_triangles(t) + 2u * t.max_cells);
+}
+
+uint32_t half_window(const terrain::Params& t) { return t.half_log2 == 0 ? 0u : 1u << t.half_log2; }
+size_t half_bytes(const terrain::Params& t) {
+  const size_t h = half_window(t);
+  return h * h * (4 + 2 + 2 + 2) + 16;
 }
 
 // Every allocation of setup() with its alignment slack.
@@ -106,13 +131,13 @@ size_t workspace(const StreamHeader& h, const terrain::Params& t, const PlayerCo
   const size_t patches = static_cast<size_t>((t.cells_x + p - 1) / p) * ((t.cells_y + p - 1) / p);
   const size_t luma = size_t{t.cells_x} * t.cells_y, chroma = size_t{g.plane_blocks(0, 1)};
   const size_t win = size_t{1} << t.cache_log2, cwin = win / 2;
-  const size_t vertices = kGroundVertices + 4u * t.max_cells;
+  const size_t vertices = ground_vertices(t) + 4u * t.max_cells;
   return sizeof(TerrainPlay) + 8 + terrain::BlockStore::workspace_bytes(t.store_units) + 4 +
-         render_workspace_size(render_config(h, t, c)) + 2 * points + 2 + patches * (2 + 2 + 1 + 4 + 2) + 16 +
+         render_workspace_size(render_config(h, t, c)) + 2 * points + 2 + patches * (2 + 2 + 1 + 4 + 2 + 2 * (kMaxStepLog2 + 1)) + 18 +
          luma + 2 * chroma + 4 + terrain::kMaxFlightKeys * sizeof(WalkPose) + 4 + win * win * (4 + 64 + 4) + 12 +
          2 * cwin * cwin * (4 + 64) + cwin * cwin * 8 + 16 + vertices * (sizeof(Vec3<Q16_16>) + sizeof(TexCoord)) + 8 +
-         (kGroundTriangles + kSkirtTriangles + 2u * t.max_cells) * 6 + 6 +
-         (2u + t.max_cells) * sizeof(Mesh) + 8 + t.max_cells * sizeof(Texture) + 8;
+         (ground_triangles(t) + skirt_triangles(t) + 2u * t.max_cells) * 6 + 6 +
+         (4u + t.max_cells) * sizeof(Mesh) + 8 + t.max_cells * sizeof(Texture) + 8 + half_bytes(t);
 }
 
 bool start(Player& p, const StreamHeader& h) {
@@ -160,6 +185,7 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   w.heights = take<uint16_t>(a, static_cast<size_t>(w.pw) * w.ph);
   w.patch_lo = take<uint16_t>(a, patches);
   w.patch_hi = take<uint16_t>(a, patches);
+  w.patch_err = take<uint16_t>(a, patches * (kMaxStepLog2 + 1));
   w.patch_step = take<uint8_t>(a, patches);
   w.patch_z = take<int32_t>(a, patches);
   w.order = take<uint16_t>(a, patches);
@@ -175,14 +201,21 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   w.cclaim = take<uint32_t>(a, w.cwin * w.cwin);
   w.cowner = take<uint32_t>(a, w.cwin * w.cwin);
   w.ctex = take<uint8_t>(a, 2 * w.cwin * w.cwin * 64);
-  w.max_vertices = kGroundVertices + 4u * t.max_cells;
+  w.max_vertices = ground_vertices(t) + 4u * t.max_cells;
   w.pos = take<Vec3<Q16_16>>(a, w.max_vertices);
   w.uv = take<TexCoord>(a, w.max_vertices);
-  w.ground_idx = take<uint16_t>(a, 3 * (kGroundTriangles + kSkirtTriangles + 2u * t.max_cells));
-  w.meshes = take<Mesh>(a, 2u + t.max_cells);
+  w.ground_idx = take<uint16_t>(a, 3 * (ground_triangles(t) + skirt_triangles(t) + 2u * t.max_cells));
+  w.meshes = take<Mesh>(a, 4u + t.max_cells);
+  w.hwin = half_window(t);
+  if (w.hwin != 0) {
+    w.hy = take<uint8_t>(a, 6u * w.hwin * w.hwin);
+    w.htag = take<uint16_t>(a, w.hwin * w.hwin);
+    w.hclaim = take<uint16_t>(a, w.hwin * w.hwin);
+    if (!w.hy || !w.htag || !w.hclaim) s = Status::workspace_too_small;
+  }
   w.cell_tex = take<Texture>(a, t.max_cells);
   if (s == Status::ok &&
-      (!w.heights || !w.patch_lo || !w.patch_hi || !w.patch_step || !w.patch_z || !w.order || !w.dc_y || !w.keys ||
+      (!w.heights || !w.patch_lo || !w.patch_hi || !w.patch_err || !w.patch_step || !w.patch_z || !w.order || !w.dc_y || !w.keys ||
        !w.ytag || !w.yclaim || !w.ytex || !w.ctag || !w.cclaim || !w.cowner || !w.ctex || !w.pos || !w.uv || !w.ground_idx ||
        !w.meshes || !w.cell_tex))
     s = Status::workspace_too_small;
@@ -190,8 +223,8 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
     p.fail(s, "the terrain could not be set up");
     return false;
   }
-  w.skirt_idx = w.ground_idx + 3 * kGroundTriangles;
-  w.cell_idx = w.skirt_idx + 3 * kSkirtTriangles;
+  w.skirt_idx = w.ground_idx + 3 * ground_triangles(t);
+  w.cell_idx = w.skirt_idx + 3 * skirt_triangles(t);
   w.dc_cb = w.dc_y + luma;
   w.dc_cr = w.dc_cb + chroma;
   for (size_t i = 0; i < luma + 2 * chroma; ++i) w.dc_y[i] = 128;
@@ -199,6 +232,20 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   for (uint32_t i = 0; i < w.win * w.win; ++i) w.ytag[i] = kNoTag, w.yclaim[i] = 0;
   for (uint32_t i = 0; i < 2 * w.cwin * w.cwin; ++i) w.ctag[i] = kNoTag;
   for (uint32_t i = 0; i < w.cwin * w.cwin; ++i) w.cclaim[i] = 0, w.cowner[i] = kNoTag;
+  if (w.hwin != 0) {
+    w.hcb = w.hy + 4u * w.hwin * w.hwin;
+    w.hcr = w.hcb + w.hwin * w.hwin;
+    for (uint32_t i = 0; i < w.hwin * w.hwin; ++i) w.htag[i] = kNoHalf, w.hclaim[i] = 0;
+    Texture& ht = w.half_tex;
+    ht.format = TexFormat::ycbcr420;
+    ht.address = TexAddress::repeat;
+    ht.width = ht.height = static_cast<uint16_t>(2 * w.hwin);
+    ht.stride = 2 * w.hwin;
+    ht.texels = w.hy;
+    ht.cb = w.hcb;
+    ht.cr = w.hcr;
+    ht.chroma_stride = w.hwin;
+  }
   Texture& d = w.dc_tex;
   d.format = TexFormat::ycbcr420;
   d.address = TexAddress::clamp;
@@ -229,11 +276,32 @@ void coarse_of(const TerrainPlay& w, uint32_t id1, int16_t plane[64]) {
   terrain::coarse_plane(lv, w.store.held(id1), w.params.quantiser, plane);
 }
 
+uint16_t half_tag(const TerrainPlay& w, int i, int j) {
+  return static_cast<uint16_t>((static_cast<uint32_t>(i) >> (w.params.half_log2)) |
+                               ((static_cast<uint32_t>(j) >> w.params.half_log2) << 8));
+}
+uint32_t half_slot(const TerrainPlay& w, int i, int j) {
+  return (static_cast<uint32_t>(j) & (w.hwin - 1)) * w.hwin + (static_cast<uint32_t>(i) & (w.hwin - 1));
+}
+
+// The half-resolution texels of cells [i0, i0 + n) x [j0, j0 + n) are no
+// longer what the store holds.
+void half_forget(TerrainPlay& w, int i0, int j0, int n) {
+  if (w.hwin == 0) return;
+  for (int j = j0; j < j0 + n && j < w.params.cells_y; ++j)
+    for (int i = i0; i < i0 + n && i < w.params.cells_x; ++i) {
+      const uint32_t slot = half_slot(w, i, j);
+      if (w.htag[slot] == half_tag(w, i, j)) w.htag[slot] = kNoHalf;
+    }
+}
+
 // After a change to block `id`: its DC texel, or (level 1) the texels of
 // the level-0 blocks under it that hold nothing; and the cache slot that
 // held its texels.
 void refresh(TerrainPlay& w, uint32_t id) {
   const terrain::BlockPlace pl = w.grid.place(id);
+  const int span = (pl.level == 1 ? 8 : 1) * (pl.comp == 0 ? 1 : 2);  // cells a side the block covers
+  half_forget(w, pl.bx * span, pl.by * span, span);
   if (pl.level == 1) {
     int16_t plane[64];
     coarse_of(w, id, plane);
@@ -286,11 +354,72 @@ void fill_block(TerrainPlay& w, uint32_t id, uint32_t* tag, uint8_t* px) {
   *tag = id;
 }
 
+// The mean of a 4 x 4 quadrant (qx, qy) of 8 x 8 texels, rounded.
+uint8_t quadrant_mean(const uint8_t* px, int qx, int qy) {
+  uint32_t sum = 8;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) sum += px[(4 * qy + y) * 8 + 4 * qx + x];
+  return static_cast<uint8_t>(sum >> 4);
+}
+
+// Cell (i, j)'s half-resolution texels into its slot: its luma block's
+// quadrant means, and its quarter of each chroma block's mean.
+void fill_half(TerrainPlay& w, int i, int j) {
+  const uint32_t slot = half_slot(w, i, j);
+  const uint16_t tag = half_tag(w, i, j);
+  if (w.htag[slot] == tag) return;
+  uint8_t px[64];
+  uint32_t scratch = kNoTag;
+  fill_block(w, w.grid.cell(i, j), &scratch, px);
+  const uint32_t x = 2 * (static_cast<uint32_t>(i) & (w.hwin - 1)), y = 2 * (static_cast<uint32_t>(j) & (w.hwin - 1));
+  for (int qy = 0; qy < 2; ++qy)
+    for (int qx = 0; qx < 2; ++qx) w.hy[(y + qy) * 2 * w.hwin + x + qx] = quadrant_mean(px, qx, qy);
+  const int ci = i / 2, cj = j / 2;
+  scratch = kNoTag;
+  fill_block(w, w.grid.id(0, 1, ci, cj), &scratch, px);
+  w.hcb[slot] = quadrant_mean(px, i & 1, j & 1);
+  scratch = kNoTag;
+  fill_block(w, w.grid.id(0, 2, ci, cj), &scratch, px);
+  w.hcr[slot] = quadrant_mean(px, i & 1, j & 1);
+  w.htag[slot] = tag;
+}
+
+// Claims the half-resolution slots of cells [i0, i0 + ni) x [j0, j0 + nj)
+// for this frame and fills them: false (nothing claimed) when another
+// cell of the frame has one of them.
+bool claim_half(TerrainPlay& w, int i0, int j0, int ni, int nj) {
+  if (w.hwin == 0) return false;
+  const uint16_t stamp = static_cast<uint16_t>(w.stamp);
+  for (int j = j0; j < j0 + nj; ++j)
+    for (int i = i0; i < i0 + ni; ++i) {
+      const uint32_t slot = half_slot(w, i, j);
+      if (w.hclaim[slot] == stamp && w.htag[slot] != half_tag(w, i, j)) return false;
+    }
+  for (int j = j0; j < j0 + nj; ++j)
+    for (int i = i0; i < i0 + ni; ++i) {
+      w.hclaim[half_slot(w, i, j)] = stamp;
+      fill_half(w, i, j);
+    }
+  return true;
+}
+
 // --- Updates and elevation ---------------------------------------------------------
 
-Mask held_cb(void* ctx, uint32_t id) { return static_cast<TerrainPlay*>(ctx)->store.held(id); }
+// Changes are staged in the store and merged a batch at a time; the
+// reader's questions are answered from the store with every change before
+// them merged: a block's mask (a grow after the shrinks restarts at low
+// ids), and what a level-0 block shows (its level-1 block may have just
+// changed).
+void merged_cb(void* ctx, uint32_t id) { refresh(*static_cast<TerrainPlay*>(ctx), id); }
+void merge_staged(TerrainPlay& w) { w.store.merge(merged_cb, &w); }
+Mask held_cb(void* ctx, uint32_t id) {
+  TerrainPlay& w = *static_cast<TerrainPlay*>(ctx);
+  if (w.store.staged() && id <= w.store.last_staged()) merge_staged(w);
+  return w.store.held(id);
+}
 int shown_dc_cb(void* ctx, uint32_t id) {
   TerrainPlay& w = *static_cast<TerrainPlay*>(ctx);
+  merge_staged(w);
   return *dc_texel(w, w.grid.place(id)) - 128;
 }
 
@@ -300,11 +429,37 @@ Status apply_update(TerrainPlay& w, const uint8_t* payload, uint32_t size) {
   terrain::BlockUpdate u;
   while (s == Status::ok) {
     s = r.next(&u);
-    if (s != Status::ok) break;
-    s = w.store.apply(u);
-    if (s == Status::ok) refresh(w, u.id);
+    if (s == Status::ok) s = w.store.stage(u, merged_cb, &w);
   }
+  // What was staged before a refusal is merged too: the store stays whole.
+  merge_staged(w);
   return s == Status::more_input && r.done() ? Status::ok : (s == Status::more_input ? Status::malformed : s);
+}
+
+// The largest height error of drawing the patch whose first cell is
+// (i0, j0), ni x nj cells, at step s: every grid point against the coarse
+// triangles over it (a coarse quad a b / c d split along b-c, as drawn).
+uint16_t step_error(const TerrainPlay& w, int i0, int j0, int ni, int nj, int s) {
+  auto h = [&](int i, int j) { return int64_t{w.heights[static_cast<size_t>(j) * w.pw + i]}; };
+  auto gi = [&](int c) { return i0 + (c * s < ni ? c * s : ni); };
+  auto gj = [&](int r) { return j0 + (r * s < nj ? r * s : nj); };
+  int64_t worst = 0;
+  for (int j = j0; j <= j0 + nj; ++j)
+    for (int i = i0; i <= i0 + ni; ++i) {
+      const int c = (i - i0) / s, r = (j - j0) / s;
+      const int ia = gi(c), ib = gi(c + 1), ja = gj(r), jc = gj(r + 1);
+      const int64_t W = ib - ia, H = jc - ja, U = i - ia, V = j - ja;
+      if (W == 0 || H == 0) continue;  // on the patch's last row or column of vertices
+      const int64_t a = h(ia, ja), b = h(ib, ja), cc = h(ia, jc), d = h(ib, jc);
+      // The coarse surface at (i, j), times W H.
+      const int64_t at = U * H + V * W <= W * H ? a * W * H + U * H * (b - a) + V * W * (cc - a)
+                                                : d * W * H + (W - U) * H * (cc - d) + (H - V) * W * (b - d);
+      int64_t e = h(i, j) * W * H - at;
+      if (e < 0) e = -e;
+      e = (e + W * H - 1) / (W * H);
+      if (e > worst) worst = e;
+    }
+  return static_cast<uint16_t>(worst > 65535 ? 65535 : worst);
 }
 
 void patch_bounds(TerrainPlay& w, int row0, int row1) {
@@ -320,8 +475,13 @@ void patch_bounds(TerrainPlay& w, int row0, int row1) {
           if (v < lo) lo = v;
           if (v > hi) hi = v;
         }
-      w.patch_lo[py * w.patches_x + px] = lo;
-      w.patch_hi[py * w.patches_x + px] = hi;
+      const int k = py * w.patches_x + px;
+      w.patch_lo[k] = lo;
+      w.patch_hi[k] = hi;
+      uint16_t* err = w.patch_err + k * (kMaxStepLog2 + 1);
+      err[0] = 0;
+      for (int l = 1; l <= kMaxStepLog2; ++l)
+        err[l] = (1 << l) <= w.patch ? step_error(w, i0, j0, i1 - i0, j1 - j0, 1 << l) : 65535;
     }
   }
 }
@@ -374,6 +534,7 @@ uint32_t outcode(const Camera& c, const StreamHeader& h, const Vec3<Q16_16>& q) 
 struct Builder {
   TerrainPlay& w;
   uint32_t vertices = 0, ground = 0, skirts = 0, cells = 0;
+  uint32_t half_ground = 0, half_skirts = 0;  // written from the ends of the index arrays
   uint16_t vertex(const Vec3<Q16_16>& p, int32_t u_q16, int32_t v_q16) {
     w.pos[vertices] = p;
     w.uv[vertices] = {Q16_16::from_raw(u_q16), Q16_16::from_raw(v_q16)};
@@ -385,14 +546,23 @@ struct Builder {
   }
 };
 
-// Vertices and triangles a patch takes at step s (skirts on every edge, an upper bound).
-uint32_t patch_vertices(int cells, int s) {
-  const uint32_t n = static_cast<uint32_t>(cells / s) + 1;
-  return n * n + 4 * n;
-}
-uint32_t patch_triangles(int cells, int s) {
+// What a patch of `cells` a side takes at step s: vertices (its grid and
+// skirts on every edge), ground triangles and skirt triangles (upper bounds).
+struct PatchCost {
+  uint32_t vertices = 0, ground = 0, skirts = 0;
+  PatchCost& operator+=(const PatchCost& c) {
+    vertices += c.vertices, ground += c.ground, skirts += c.skirts;
+    return *this;
+  }
+  bool within(const PatchCost& more, const PatchCost& reserve, const terrain::Params& t) const {
+    return vertices + more.vertices + reserve.vertices <= ground_vertices(t) &&
+           ground + more.ground + reserve.ground <= ground_triangles(t) &&
+           skirts + more.skirts + reserve.skirts <= skirt_triangles(t);
+  }
+};
+PatchCost patch_cost(int cells, int s) {
   const uint32_t n = static_cast<uint32_t>(cells / s);
-  return 2 * n * n;
+  return {(n + 1) * (n + 1) + 4 * (n + 1), 2 * n * n, 8 * n};
 }
 
 // Cell (i, j) with its own block's texels, if its slots are free this frame.
@@ -434,7 +604,7 @@ bool textured_cell(TerrainPlay& w, Builder& b, int i, int j) {
   const uint16_t c = b.vertex(point(w, i, j + 1), 0, k8), d = b.vertex(point(w, i + 1, j + 1), k8, k8);
   uint16_t* idx = w.cell_idx + 6 * b.cells;
   idx[0] = a, idx[1] = c, idx[2] = bb, idx[3] = bb, idx[4] = c, idx[5] = d;
-  Mesh& m = w.meshes[2 + b.cells];
+  Mesh& m = w.meshes[4 + b.cells];
   m = Mesh{};
   m.indices = idx;
   m.num_triangles = 2;
@@ -456,16 +626,29 @@ void draw_patch(TerrainPlay& w, Builder& b, int px, int py, int s) {
   const int cols = (ni + s - 1) / s + 1, rows = (nj + s - 1) / s + 1;
   auto gi = [&](int c) { return i0 + (c * s < ni ? c * s : ni); };
   auto gj = [&](int r) { return j0 + (r * s < nj ? r * s : nj); };
+  // Near patches take the half-resolution window when their cells' slots are free.
+  const bool half = s <= 8 && claim_half(w, i0, j0, ni, nj);
+  const int32_t texels = half ? 2 : 1;  // a cell's texels in the patch's texture
   const uint32_t first = b.vertices;
   for (int r = 0; r < rows; ++r)
-    for (int c = 0; c < cols; ++c) b.vertex(point(w, gi(c), gj(r)), gi(c) << 16, gj(r) << 16);
+    for (int c = 0; c < cols; ++c) b.vertex(point(w, gi(c), gj(r)), gi(c) * texels << 16, gj(r) * texels << 16);
+  // Ground triangles: DC plane from the front of the array, half window from the back.
+  auto ground_tri = [&](uint16_t a, uint16_t bb, uint16_t c) {
+    if (!half) {
+      b.tri(w.ground_idx, b.ground, a, bb, c);
+    } else {
+      uint32_t at = ground_triangles(w.params) - 1 - b.half_ground;
+      b.tri(w.ground_idx, at, a, bb, c);
+      ++b.half_ground;
+    }
+  };
   for (int r = 0; r + 1 < rows; ++r)
     for (int c = 0; c + 1 < cols; ++c) {
       if (s == 1 && textured_cell(w, b, i0 + c, j0 + r)) continue;
       const uint16_t a = static_cast<uint16_t>(first + r * cols + c), bb = static_cast<uint16_t>(a + 1);
       const uint16_t cc = static_cast<uint16_t>(a + cols), d = static_cast<uint16_t>(cc + 1);
-      b.tri(w.ground_idx, b.ground, a, cc, bb);
-      b.tri(w.ground_idx, b.ground, bb, cc, d);
+      ground_tri(a, cc, bb);
+      ground_tri(bb, cc, d);
     }
   // Skirts where a neighbour is drawn at another step.
   const int k = py * w.patches_x + px;
@@ -477,13 +660,20 @@ void draw_patch(TerrainPlay& w, Builder& b, int px, int py, int s) {
   };
   auto skirt = [&](int count, auto at) {  // at(n) -> vertex index on the edge
     uint16_t prev_top = 0, prev_low = 0;
-    for (int n = 0; n < count && b.skirts + 2 <= kSkirtTriangles; ++n) {
+    for (int n = 0; n < count && b.skirts + b.half_skirts + 2 <= skirt_triangles(w.params); ++n) {
       const uint16_t top = at(n);
       const Vec3<Q16_16> p = w.pos[top];
       const uint16_t low = b.vertex({p.x, p.y, Q16_16::from_raw(sat_s32(int64_t{p.z.raw()} - drop))}, w.uv[top].u.raw(), w.uv[top].v.raw());
       if (n > 0) {
-        b.tri(w.skirt_idx, b.skirts, prev_top, prev_low, top);
-        b.tri(w.skirt_idx, b.skirts, top, prev_low, low);
+        if (!half) {
+          b.tri(w.skirt_idx, b.skirts, prev_top, prev_low, top);
+          b.tri(w.skirt_idx, b.skirts, top, prev_low, low);
+        } else {
+          uint32_t at1 = skirt_triangles(w.params) - 1 - b.half_skirts, at2 = at1 - 1;
+          b.tri(w.skirt_idx, at1, prev_top, prev_low, top);
+          b.tri(w.skirt_idx, at2, top, prev_low, low);
+          b.half_skirts += 2;
+        }
       }
       prev_top = top, prev_low = low;
     }
@@ -498,10 +688,11 @@ Status draw(Player& p, TerrainPlay& w, const WalkPose& pose) {
   Camera cam;
   if (walk_camera(p.header(), pose, &cam) != Status::ok) return Status::malformed;
   ++w.stamp;
-  if (w.stamp == 0) {  // wrapped: no slot may look claimed
+  if ((w.stamp & 0xFFFF) == 0) {  // wrapped (the half window keeps 16 bits): no slot may look claimed
     for (uint32_t i = 0; i < w.win * w.win; ++i) w.yclaim[i] = 0;
     for (uint32_t i = 0; i < w.cwin * w.cwin; ++i) w.cclaim[i] = 0;
-    w.stamp = 1;
+    for (uint32_t i = 0; i < w.hwin * w.hwin; ++i) w.hclaim[i] = 0;
+    ++w.stamp;
   }
   Builder b{w};
   uint32_t visible = 0;
@@ -533,21 +724,29 @@ Status draw(Player& p, TerrainPlay& w, const WalkPose& pose) {
         }
         w.order[at] = static_cast<uint16_t>(k);
       }
-    // Steps, nearest first, within the buffers.
-    const int64_t cell_px = int64_t{cam.fx.raw() >> 8} * (w.params.cell_q16 >> 8);  // Q16: pixels x units
-    uint32_t vertices = 0, triangles = 0;
+    // Steps, nearest first: each patch at the step its depth asks for, or
+    // coarser where that would leave the patches after it less than their
+    // coarsest steps.
+    const int64_t fx = cam.fx.raw() >> 8;
+    const PatchCost coarsest = patch_cost(w.patch, w.patch);
+    PatchCost used, reserve;
+    for (uint32_t n = 0; n < visible; ++n) reserve += coarsest;
     for (uint32_t n = 0; n < visible; ++n) {
       const int k = w.order[n];
-      const int64_t limit = int64_t{kLodPx} * w.patch_z[k];
+      reserve.vertices -= coarsest.vertices, reserve.ground -= coarsest.ground, reserve.skirts -= coarsest.skirts;
+      // The coarsest step whose height error projects to at most kLodPx
+      // pixels at the patch's nearest depth.
+      const int64_t limit = int64_t{kLodPx} * w.patch_z[k];  // Q16
+      const uint16_t* err = w.patch_err + k * (kMaxStepLog2 + 1);
       int s = 1;
-      while (s < w.patch && cell_px * (2 * s) <= limit) s *= 2;
-      while (s < w.patch && (vertices + patch_vertices(w.patch, s) > kGroundVertices ||
-                             triangles + patch_triangles(w.patch, s) > kGroundTriangles))
-        s *= 2;
-      if (vertices + patch_vertices(w.patch, s) > kGroundVertices || triangles + patch_triangles(w.patch, s) > kGroundTriangles)
-        continue;
-      vertices += patch_vertices(w.patch, s);
-      triangles += patch_triangles(w.patch, s);
+      for (int l = 1; (1 << l) <= w.patch; ++l) {
+        const int64_t e = (int64_t{err[l]} * w.params.height_step_q16) >> 8;  // world units, Q8
+        if (e * fx > limit) break;
+        s = 1 << l;
+      }
+      while (s < w.patch && !used.within(patch_cost(w.patch, s), reserve, w.params)) s *= 2;
+      if (!used.within(patch_cost(w.patch, s), reserve, w.params)) continue;  // (never: the budgets hold every patch's coarsest)
+      used += patch_cost(w.patch, s);
       w.patch_step[k] = static_cast<uint8_t>(s);
     }
     for (uint32_t n = 0; n < visible; ++n) {
@@ -569,11 +768,22 @@ Status draw(Player& p, TerrainPlay& w, const WalkPose& pose) {
   skirts.indices = w.skirt_idx;
   skirts.num_triangles = b.skirts;
   skirts.cull = Cull::none;
+  Mesh& half = w.meshes[2];
+  half = ground;
+  half.indices = w.ground_idx + 3 * (ground_triangles(w.params) - b.half_ground);
+  half.num_triangles = b.half_ground;
+  half.texture = &w.half_tex;
+  Mesh& half_skirts = w.meshes[3];
+  half_skirts = skirts;
+  half_skirts.indices = w.skirt_idx + 3 * (skirt_triangles(w.params) - b.half_skirts);
+  half_skirts.num_triangles = b.half_skirts;
+  half_skirts.texture = &w.half_tex;
+  if (w.hwin == 0) half.texture = half_skirts.texture = &w.dc_tex;  // (never drawn)
   DrawList list;
   list.positions = w.pos;
   list.num_positions = b.vertices;
   list.meshes = w.meshes;
-  list.num_meshes = 2 + b.cells;
+  list.num_meshes = 4 + b.cells;
   return w.renderer.render(cam, list, kSky, detail::render_band_to_player, &p);
 }
 

@@ -23,6 +23,8 @@ struct TerrainStreamOptions {
   int cache_log2 = 4;            // transformed blocks for a 16 x 16-cell window
   int max_cells = 64;            // cells drawn with their own texels a frame
   int key_spacing = 10;          // frames between the flight's keys
+  int frame_budget = 2;          // the client's geometry a frame: 512 n vertices (2..64)
+  int half_log2 = 6;             // the half-resolution window: 2^n cells a side (no larger than the map; 0: none)
   PoseOptions pose;
   uint32_t max_chunk = 4096;     // the client's chunk buffer
   std::function<void(size_t done)> progress;
