@@ -8,7 +8,8 @@
 # the encoder's reconstruction. Then the Stanford bunny (glmark2-data) as a
 # progressive model at 2 KB/s to the host-native board, drawn after every
 # level; a walkthrough of the OpenArena map oa_dm4 at 2 KB/s to both
-# boards; then the client self-test on both boards and the size of the
+# boards; a terrain flight over a Trigger Rally map, served live to both
+# boards as they send their poses up; then the client self-test on both boards and the size of the
 # client's parts. Everything goes to out/demo/; the summary
 # is out/demo/report.md.
 set -euo pipefail
@@ -22,10 +23,10 @@ rm -rf "$OUT"
 mkdir -p "$OUT/src"
 [ -f "$PK3" ] || { echo "demo: $PK3 not found; run scripts/fetch-data.sh" >&2; exit 1; }
 
-echo "demo: 1/7 taking twelve textures from $(basename "$PK3")"
+echo "demo: 1/8 taking twelve textures from $(basename "$PK3")"
 python3 "$ROOT/scripts/demo_reel.py" "$OUT/src" "$PK3"
 
-echo "demo: 2/7 encoding, then streaming to both boards at 115,200 baud (about a minute)"
+echo "demo: 2/8 encoding, then streaming to both boards at 115,200 baud (about a minute)"
 python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
   --qemu qemu-system-arm --elf "$CM4/vds_fw_client.elf" --work "$OUT" --quality 75 \
   --inputs "$OUT"/src/*.tga --report "$OUT/run.json" > "$OUT/end_to_end.log" 2>&1 || {
@@ -35,7 +36,7 @@ python3 "$ROOT/tests/tools/e2e_boards.py" --vds "$VDS" --host-board "$ROOT/$BUIL
 }
 grep -E '^(encoder|host|cortex-m4) *:|^end-to-end' "$OUT/end_to_end.log"
 
-echo "demo: 3/7 the Stanford bunny as a progressive model at 2 KB/s to the host-native board, then to the Cortex-M4 board (about a minute)"
+echo "demo: 3/8 the Stanford bunny as a progressive model at 2 KB/s to the host-native board, then to the Cortex-M4 board (about a minute)"
 MODEL=/usr/share/glmark2/models/bunny.obj
 [ -f "$MODEL" ] || { echo "demo: $MODEL not found; run scripts/fetch-data.sh" >&2; exit 1; }
 python3 "$ROOT/scripts/demo_model.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
@@ -48,7 +49,7 @@ python3 "$ROOT/scripts/demo_model.py" --vds "$VDS" --host-board "$ROOT/$BUILD/fi
 }
 grep -E '^(`|The same stream)' "$OUT/model.md"
 
-echo "demo: 4/7 a walkthrough of oa_dm4 at 2 KB/s (vds path, vds encode-walk) to both boards, each frame at its time (about two minutes)"
+echo "demo: 4/8 a walkthrough of oa_dm4 at 2 KB/s (vds path, vds encode-walk) to both boards, each frame at its time (about two minutes)"
 python3 "$ROOT/scripts/demo_walk.py" --vds "$VDS" --host-board "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
   --qemu qemu-system-arm --elf "$CM4/vds_fw_client.elf" --out "$OUT/walk" > "$OUT/walk.md" || {
   cat "$OUT/walk.md"
@@ -57,18 +58,30 @@ python3 "$ROOT/scripts/demo_walk.py" --vds "$VDS" --host-board "$ROOT/$BUILD/fir
 }
 grep -E '^(`|On the Cortex)' "$OUT/walk.md"
 
-echo "demo: 5/7 client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
+echo "demo: 5/8 a terrain flight over the Trigger Rally map grass, served live (vds serve-terrain) to both boards as they send their poses up"
+mkdir -p "$OUT/terrain"
+TERRAIN_OK=1
+for board in host qemu; do
+  FW="$ROOT/$BUILD/firmware_sim/vds_fw_client_host"
+  [ "$board" = qemu ] && FW="$CM4/vds_fw_client.elf"
+  "$VDS" serve-terrain grass --frames 100 --rate 4000 --board "$board" --firmware "$FW" --board-out "$OUT/terrain/$board" \
+    --stream-out "$OUT/terrain/$board.vds" > "$OUT/terrain/$board.log" 2>&1 || TERRAIN_OK=0
+  grep -E '^grass \(live\): [0-9]+ frames made|^  replay ' "$OUT/terrain/$board.log" | sed "s/^/  $board: /"
+done
+[ "$TERRAIN_OK" = 1 ] || { echo "demo: the terrain run failed (logs: out/demo/terrain/)" >&2; exit 1; }
+
+echo "demo: 6/8 client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
 BOARDS=$(python3 "$ROOT/tests/tools/compare_boards.py" --host "$ROOT/$BUILD/firmware_sim/vds_fw_selftest_host" \
   --qemu qemu-system-arm --elf "$CM4/vds_fw_selftest.elf")
 echo "$BOARDS" | grep -E '^boards'
 
-echo "demo: 6/7 Cortex-M4 size of the client library and the link"
+echo "demo: 7/8 Cortex-M4 size of the client library and the link"
 SIZE_TABLE=$(python3 "$ROOT/tests/tools/check_freestanding.py" \
   --cxx arm-none-eabi-g++ --nm arm-none-eabi-nm --size arm-none-eabi-size --out "$OUT/linkcheck" \
   --lib "decoder=$ROOT/$BUILD/cm4/decoder/libvds_decoder.a" \
   --lib "transport_core=$ROOT/$BUILD/cm4/transport/libvds_transport_core.a")
 
-echo "demo: 7/7 writing the report"
+echo "demo: 8/8 writing the report"
 {
   python3 "$ROOT/scripts/client_report.py" --run "$OUT/run.json" --elf "$CM4/vds_fw_client.elf" \
     --map "$CM4/vds_fw_client.map" --title "vds demo: twelve textures to a simulated client" --images-dir host |
@@ -80,6 +93,17 @@ echo "demo: 7/7 writing the report"
   cat "$OUT/model.md"
   echo
   cat "$OUT/walk.md"
+  echo
+  echo "## Terrain, live"
+  echo
+  echo "\`vds serve-terrain grass --frames 100 --rate 4000 --board host|qemu\`: the client plays the flight the stream"
+  echo "gives it and sends its pose up the link's pose channel; the server answers the newest pose it has."
+  echo "Every frame each board showed equals the replay of the stream it was sent. Frames from the host board:"
+  echo "\`out/demo/terrain/host/frames/\`, contact sheet \`out/demo/terrain/host/contact_sheet.png\`."
+  echo
+  echo '```'
+  for board in host qemu; do grep -E '^grass \(live\): [0-9]+ frames made|^  replay |^  client stats' "$OUT/terrain/$board.log"; done
+  echo '```'
   echo
   echo "## Client self-test, host board against the Cortex-M4 board"
   echo

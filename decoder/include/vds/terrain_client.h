@@ -138,6 +138,7 @@ class BlockStore {
   Status stage(const BlockUpdate& u, MergedFn merged, void* ctx);
   Status merge(MergedFn merged, void* ctx);
   bool staged() const { return staged_ != 0; }
+  uint32_t first_staged() const { return staged_ != 0 ? stage_[0].id : 0; }
   uint32_t last_staged() const { return staged_ != 0 ? stage_[staged_ - 1].id : 0; }
   uint32_t used_units() const { return used_; }  // staged changes included
   uint32_t held_blocks() const { return n_; }

@@ -95,7 +95,7 @@ struct TerrainPlay {
   uint16_t* ground_idx = nullptr;  // ground_triangles() * 3
   uint16_t* skirt_idx = nullptr;   // skirt_triangles() * 3
   uint16_t* cell_idx = nullptr;    // max_cells * 6
-  Mesh* meshes = nullptr;          // ground, skirts, then one per textured cell
+  Mesh* meshes = nullptr;          // one per textured cell, then half, ground, half skirts, skirts
   Texture* cell_tex = nullptr;
 };
 
@@ -419,7 +419,9 @@ Mask held_cb(void* ctx, uint32_t id) {
 }
 int shown_dc_cb(void* ctx, uint32_t id) {
   TerrainPlay& w = *static_cast<TerrainPlay*>(ctx);
-  merge_staged(w);
+  // It depends on the block's level-1 block: merge if one is staged (they
+  // come first, with the lowest ids).
+  if (w.store.staged() && w.store.first_staged() < w.grid.first(0, 0)) merge_staged(w);
   return *dc_texel(w, w.grid.place(id)) - 128;
 }
 
@@ -604,7 +606,7 @@ bool textured_cell(TerrainPlay& w, Builder& b, int i, int j) {
   const uint16_t c = b.vertex(point(w, i, j + 1), 0, k8), d = b.vertex(point(w, i + 1, j + 1), k8, k8);
   uint16_t* idx = w.cell_idx + 6 * b.cells;
   idx[0] = a, idx[1] = c, idx[2] = bb, idx[3] = bb, idx[4] = c, idx[5] = d;
-  Mesh& m = w.meshes[4 + b.cells];
+  Mesh& m = w.meshes[b.cells];
   m = Mesh{};
   m.indices = idx;
   m.num_triangles = 2;
@@ -754,7 +756,14 @@ Status draw(Player& p, TerrainPlay& w, const WalkPose& pose) {
       if (w.patch_step[k] != 0) draw_patch(w, b, k % w.patches_x, k / w.patches_x, w.patch_step[k]);
     }
   }
-  Mesh& ground = w.meshes[0];
+  // Nearest first, so that the depth test spares the farther ones' texels:
+  // the cells drawn from their own blocks, the half-resolution window's
+  // patches, the DC plane's, then the skirts.
+  Mesh* fixed = w.meshes + b.cells;
+  Mesh& half = fixed[0];
+  Mesh& ground = fixed[1];
+  Mesh& half_skirts = fixed[2];
+  Mesh& skirts = fixed[3];
   ground = Mesh{};
   ground.indices = w.ground_idx;
   ground.num_triangles = b.ground;
@@ -763,17 +772,14 @@ Status draw(Player& p, TerrainPlay& w, const WalkPose& pose) {
   ground.cull = Cull::back;
   ground.uvs = w.uv;
   ground.texture = &w.dc_tex;
-  Mesh& skirts = w.meshes[1];
   skirts = ground;
   skirts.indices = w.skirt_idx;
   skirts.num_triangles = b.skirts;
   skirts.cull = Cull::none;
-  Mesh& half = w.meshes[2];
   half = ground;
   half.indices = w.ground_idx + 3 * (ground_triangles(w.params) - b.half_ground);
   half.num_triangles = b.half_ground;
   half.texture = &w.half_tex;
-  Mesh& half_skirts = w.meshes[3];
   half_skirts = skirts;
   half_skirts.indices = w.skirt_idx + 3 * (skirt_triangles(w.params) - b.half_skirts);
   half_skirts.num_triangles = b.half_skirts;
