@@ -4,7 +4,8 @@
 # bench/results/terrain.md, terrain_bits.png (bits a frame, the paper's
 # figure 14) and terrain_psnr.png (rendered PSNR a frame):
 #   the paper's form: every pose answered whole (--rate 0), with an
-#   unbounded client store and with a STORE-coefficient one;
+#   unbounded client store and with a STORE-byte one (STORE / 2 units: a held
+#   block costs its coefficients and a 12-byte entry);
 #   over a link: 2,000 bytes/s (a 19,200-baud line, 2 KB/s) and 11,520
 #   bytes/s (115,200 baud), the coarse elevation first, poses up 5 times a
 #   second, two frames from a pose to its update; vds against the tile
@@ -27,10 +28,11 @@ Q=${QUANTISER:-4}
 D=${DETAIL:-1.25}
 MAPS=${MAPS:-arizonachase crooked tropic}
 STORE=${STORE:-98304}
+UNITS=$((STORE / 2))
 runs="paper:--rate 0 --store 67108864
-paperstore:--rate 0 --store $STORE
-r2000:--rate 2000 --store $STORE
-r11520:--rate 11520 --store $STORE"
+paperstore:--rate 0 --store $UNITS
+r2000:--rate 2000 --store $UNITS
+r11520:--rate 11520 --store $UNITS"
 # The tile pyramids at both rates, each codec at two qualities (the better is reported).
 for rate in 2000 11520; do
   for v in jpeg64 jpeg256 webp64 webp256; do
@@ -73,8 +75,8 @@ L = ["# Terrain mode: the server's replay\n",
      "a climb to a third of the map's width, a wide turn, a dive, out low). The client's store after each update is the "
      "server's mirror of it (the tests check that the client's reader leaves exactly that); its frame here is the "
      "**reference renderer** drawing the texture that store holds, against the reference renderer drawing the original "
-     "colour map (mip-mapped, anisotropic, 2x2 supersampled): coding and masking loss only. The client's own renderer, "
-     "its level of detail and the boards are not in these figures yet (docs/terrain.md).\n",
+     "colour map (mip-mapped, anisotropic, 2x2 supersampled): coding and masking loss only. What the client "
+     "library itself draws (its level of detail and texture windows, on the Cortex-M4 board) is in terrain_m4.md.\n",
      "## The paper's form: every pose answered whole\n",
      "Ratios against the raw 24-bit texture (3 MiB); intra = the first pose's data, inter = the mean a frame after it, "
      "overall = the mean a frame over the flight. Paper (a 1024x1024 texture on a 128x128 grid): 1:11, 1:460, 1:300. "
@@ -84,7 +86,7 @@ L = ["# Terrain mode: the server's replay\n",
      "| map | store | elevation | intra | inter | overall | mean PSNR | client's renderer, whole texture |",
      "|---|---|---:|---:|---:|---:|---:|---:|"]
 for m in maps:
-    for r, store in (("paper", "unbounded"), ("paperstore", "98,304 coefficients")):
+    for r, store in (("paper", "unbounded"), ("paperstore", "96 KiB")):
         t, rows = read(m, r)
         ev = num(r"elevation: (\d+) bytes", t, int)
         bits = num(r"\(([\d.]+) bits a point\)", t)
@@ -98,7 +100,7 @@ for m in maps:
                  + (f"1:{inter[2]}" if inter else "-") + f" | 1:{overall[2]} | {psnr:.2f} dB | "
                  + (f"{full:.2f} dB |" if full else "- |"))
 L += ["",
-      "A 98,304-coefficient store (what a client could hold as 8-bit levels in 96 KiB) evicts and resends during the "
+      "A 96 KiB store (49,152 2-byte units: a held block costs its coefficients and a 12-byte entry) evicts and resends during the "
       "flight: the server drops the blocks the pose has longest not needed, then detail beyond the pose's need.\n",
       "## Over a link, against the tile pyramid\n",
       "The coarse elevation goes first (every 8th point), then the rest shares the link half and half with the texture "
@@ -106,7 +108,7 @@ L += ["",
       "pyramids get the same elevation on the same link. The server answers the newest pose it has (sent up 5 times "
       "a second, 2 frames old) and the pose extrapolated to the frame being drawn, once the link has carried 200 "
       "bytes since its last answer; the tile client requests for the same two poses. vds: coarse before fine, "
-      "the stages that remove the most screen error per bit first, with a 98,304-coefficient store. Tiles: JPEG "
+      "the stages that remove the most screen error per bit first, with a 96 KiB store (49,152 units). Tiles: JPEG "
       "(tables counted once) or WebP, 64 or 256 texels, quality 60 or 85 (the better mean is shown), 2-pixel screen "
       "error, nearest first, cancelled when the pose no longer wants them, a 98,304-byte cache of 4:2:0 texels.\n",
       "Goal: at each link rate, mean PSNR at least the best tile variant's + 3 dB, and the first 30 dB frame in half "

@@ -34,7 +34,7 @@ struct FlyOptions {
   std::vector<double> scale;
   int frames = 300, quantiser = 4, latency = 2, poses = 5;
   double fps = 20, rate = 2000, detail = 1.25;
-  uint32_t store = 98304;
+  uint32_t store = 49152;
   bool frames_png = false;
   // encode-terrain
   std::string output;
@@ -352,7 +352,7 @@ void add_fly(CLI::App& app) {
   auto o = std::make_shared<FlyOptions>();
   CLI::App* sub = app.add_subcommand("fly", "Replay a flight over a terrain on the server: updates, ratios, pictures (docs/terrain.md)");
   map_options(sub, o.get());
-  sub->add_option("--store", o->store, "Client store, 2-byte units: a held block costs its coefficients + 6 (default 98304)")->check(CLI::Range(64u, 1u << 26));
+  sub->add_option("--store", o->store, "Client store, 2-byte units: a held block costs its coefficients + 6 (default 49152: 96 KiB, the tiles' cache)")->check(CLI::Range(64u, 1u << 26));
   sub->add_option("--tiles", o->tiles, "The baseline instead of vds: a tile pyramid, jpeg64, jpeg256, webp64 or webp256")
       ->check(CLI::IsMember({"jpeg64", "jpeg256", "webp64", "webp256"}));
   sub->add_option("--tile-quality", o->tile_quality, "With --tiles: the codec's quality, 1..100 (default 75)")
