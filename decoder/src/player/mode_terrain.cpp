@@ -4,20 +4,23 @@
 // State: the elevation, the block store (masks and quantised coefficients
 // as the updates leave them), the DC plane (one texel per block: the
 // block's own DC where it holds one, else its sample of its level-1
-// block's plane) and a cache of transformed blocks for a window of
-// 2^n x 2^n cells around any point (slot = cell mod window).
+// block's plane), a half-resolution window (2 x 2 texels a cell for
+// 2^n x 2^n cells, slot = cell mod window) and a cache of transformed
+// blocks for a window of 2^m x 2^m cells.
 //
 // A frame: the grid in patches of P x P cells, each patch outside the view
 // dropped, the rest taken nearest first and drawn at a step of 1, 2, 4 ...
-// P cells (geomipmapping: the step whose cells project to at most
-// kLodPx pixels at the patch's nearest depth), textured with the DC plane;
-// patches at step 1 draw each cell whose luma block the store holds with
-// the block's own texels (the integer IDCT of its held coefficients, done
-// again only when the block changes or leaves the cache) as long as its
-// cache slots are free this frame and max_cells allows. Where two patches
-// of different steps meet, the coarser edge could leave a crack: every
-// edge whose neighbour is drawn at another step hangs a skirt (the edge
-// copied down by the patch's height range) that covers it.
+// P cells (geomipmapping: the coarsest step whose height error projects to
+// at most kLodPx pixels at the patch's nearest depth, within the frame's
+// geometry budget), textured with the half-resolution window where its
+// slots are free, else the DC plane; patches at step 1 draw each cell
+// whose luma block the store holds with the block's own texels (the
+// integer IDCT of its held coefficients, done again only when the block
+// changes or leaves the cache) as long as its cache slots are free this
+// frame and max_cells allows. Where two patches of different steps meet,
+// the coarser edge could leave a crack: every edge whose neighbour is
+// drawn at another step hangs a skirt (the edge copied down by the
+// patch's height range) that covers it.
 #include "vds/bytes.h"
 #include "vds/fixed.h"
 #include "vds/idct.h"
@@ -32,10 +35,11 @@ namespace {
 using terrain::BlockGrid;
 using terrain::Mask;
 
-// A frame's budgets (beyond them patches coarsen), from TERH's frame
+// A frame's budgets (beyond them patches coarsen) come from TERH's frame
 // budget n: 512 n ground vertices, 512 n ground triangles, 256 n skirt
-// triangles. Every visible patch fits at its coarsest step (n >= 2): at
-// most 64 patches of 12 vertices, 2 ground and 8 skirt triangles each.
+// triangles (ground_vertices() ...). Every visible patch fits at its
+// coarsest step (n >= 2): at most 64 patches of 12 vertices, 2 ground and
+// 8 skirt triangles each.
 constexpr int kMaxPatchesSide = 8;
 constexpr int kMaxStepLog2 = 7;  // patches of up to 128 cells (grids up to 1,024 cells a side)
 constexpr int32_t kLodPx = 1;  // the largest height error a step may show, pixels
