@@ -6,7 +6,6 @@
 // (latest wins: the server answers the newest that arrives).
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <vector>
 
 #include "../unit/terrain_maps.h"
@@ -21,8 +20,6 @@ using vds::Status;
 namespace enc = vds::enc;
 namespace link = vds::link;
 
-constexpr double kPi = 3.14159265358979323846;
-
 struct Device {
   link::Link* link = nullptr;
   uint32_t frames = 0, poses_sent = 0, poses_refused_by_link = 0;
@@ -31,27 +28,8 @@ struct Device {
 
 TEST(TerrainOverTheLink, LostPosesAndDamagedFramesStillPlayEveryFrameBitExactly) {
   const enc::TerrainCoding t = enc::code_terrain(vds::test::terrain_test_map(), 6);
-  enc::CameraPath path;
-  path.hfov_deg = 70;
-  path.fps = 20;
-  const double w = t.grid.cells_x * t.cell_m, d = t.grid.cells_y * t.cell_m;
-  for (int f = 0; f < 60; ++f) {
-    const double a = 2 * kPi * f / 60;
-    enc::CameraPose p;
-    p.x = w * (0.5 + 0.3 * std::cos(a));
-    p.y = d * (0.5 + 0.3 * std::sin(a));
-    p.z = 80;
-    p.yaw_deg = std::fmod(a * 180 / kPi + 90 + 360, 360);
-    p.pitch_deg = -30;
-    path.frames.push_back(p);
-  }
-  enc::TerrainStreamOptions o;
-  o.width = 96;
-  o.height = 64;
-  o.store_units = 6000;
-  o.cache_log2 = 3;
-  o.max_cells = 24;
-  o.link.rate_bytes_per_s = 6000;
+  const enc::CameraPath path = vds::test::terrain_test_flight(t, 60, 80);
+  const enc::TerrainStreamOptions o = vds::test::terrain_test_client(6000);
   enc::TerrainLive live(t, path, o);
 
   link::FaultConfig down, up;

@@ -28,8 +28,6 @@ using vds::terrain::Mask;
 namespace enc = vds::enc;
 namespace terrain = vds::terrain;
 
-constexpr double kPi = 3.14159265358979323846;
-
 // --- The block store --------------------------------------------------------------
 
 Mask random_mask(vds::test::Xorshift32& r) {
@@ -164,34 +162,8 @@ TEST(TerrainFlightPose, InterpolatesBetweenKeysTheShortWayRound) {
 
 // --- The stream -------------------------------------------------------------------
 
-enc::CameraPath circle_flight(const enc::TerrainCoding& t, int frames) {
-  enc::CameraPath path;
-  path.hfov_deg = 70;
-  path.fps = 20;
-  const double w = t.grid.cells_x * t.cell_m, d = t.grid.cells_y * t.cell_m;
-  for (int f = 0; f < frames; ++f) {
-    const double a = 2 * kPi * f / frames;
-    enc::CameraPose p;
-    p.x = w * (0.5 + 0.3 * std::cos(a));
-    p.y = d * (0.5 + 0.3 * std::sin(a));
-    p.z = 70 + 40 * std::sin(a) * std::sin(a);
-    p.yaw_deg = std::fmod(a * 180 / kPi + 90 + 360, 360);
-    p.pitch_deg = -30;
-    path.frames.push_back(p);
-  }
-  return path;
-}
-
-enc::TerrainStreamOptions small_client() {
-  enc::TerrainStreamOptions o;
-  o.width = 96;
-  o.height = 64;
-  o.store_units = 6000;
-  o.cache_log2 = 3;
-  o.max_cells = 24;
-  o.link.rate_bytes_per_s = 3000;
-  return o;
-}
+enc::CameraPath circle_flight(const enc::TerrainCoding& t, int frames) { return vds::test::terrain_test_flight(t, frames); }
+enc::TerrainStreamOptions small_client() { return vds::test::terrain_test_client(3000); }
 
 // A player fed a stream as it is made.
 struct Feeder {

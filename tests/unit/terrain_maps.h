@@ -1,9 +1,11 @@
 // A small synthetic terrain for the terrain tests: a 97 x 81 heightmap of
-// rolling hills and a 192 x 160 colour map of stripes, ramps and checks.
+// rolling hills and a 192 x 160 colour map of stripes, ramps and checks;
+// a circular flight over any map and a small client for streams over it.
 #pragma once
 #include <cmath>
 
 #include "vds/enc/terrain_map.h"
+#include "vds/enc/terrain_stream.h"
 #include "vds/io/image.h"
 
 namespace vds::test {
@@ -28,6 +30,39 @@ inline enc::TerrainMap terrain_test_map() {
       m.colour.at(x, y, 2) = static_cast<uint8_t>(((x / 6 + y / 6) & 1) ? 200 : 40);
     }
   return m;
+}
+
+// A lap round the map's centre at `altitude` metres (or, with altitude 0,
+// rising and falling between 70 and 110 m), looking 30 degrees down.
+inline enc::CameraPath terrain_test_flight(const enc::TerrainCoding& t, int frames, double altitude = 0) {
+  constexpr double kPi = 3.14159265358979323846;
+  enc::CameraPath path;
+  path.hfov_deg = 70;
+  path.fps = 20;
+  const double w = t.grid.cells_x * t.cell_m, d = t.grid.cells_y * t.cell_m;
+  for (int f = 0; f < frames; ++f) {
+    const double a = 2 * kPi * f / frames;
+    enc::CameraPose p;
+    p.x = w * (0.5 + 0.3 * std::cos(a));
+    p.y = d * (0.5 + 0.3 * std::sin(a));
+    p.z = altitude != 0 ? altitude : 70 + 40 * std::sin(a) * std::sin(a);
+    p.yaw_deg = std::fmod(a * 180 / kPi + 90 + 360, 360);
+    p.pitch_deg = -30;
+    path.frames.push_back(p);
+  }
+  return path;
+}
+
+// A small client: 96 x 64 frames, a 12,000-byte store, small caches.
+inline enc::TerrainStreamOptions terrain_test_client(double rate_bytes_per_s) {
+  enc::TerrainStreamOptions o;
+  o.width = 96;
+  o.height = 64;
+  o.store_units = 6000;
+  o.cache_log2 = 3;
+  o.max_cells = 24;
+  o.link.rate_bytes_per_s = rate_bytes_per_s;
+  return o;
 }
 
 }  // namespace vds::test
