@@ -9,10 +9,10 @@
 // blocks for a window of 2^m x 2^m cells.
 //
 // A frame: the grid in patches of P x P cells, each patch outside the view
-// dropped, the rest taken nearest first and drawn at a step of 1, 2, 4 ...
-// P cells (geomipmapping: the coarsest step whose height error projects to
-// at most kLodPx pixels at the patch's nearest depth, within the frame's
-// geometry budget), textured with the half-resolution window where its
+// dropped, the rest drawn at a step of 1, 2, 4 ... P cells (geomipmapping:
+// from the coarsest step, the patch whose height error shows most on
+// screen refined first, while the frame's geometry budget lasts and the
+// error is over kLodPx pixels), nearest first, textured with the half-resolution window where its
 // slots are free, else the DC plane; patches at step 1 draw each cell
 // whose luma block the store holds with the block's own texels (the
 // integer IDCT of its held coefficients, done again only when the block
@@ -66,6 +66,7 @@ struct TerrainPlay {
   uint16_t* patch_err = nullptr;
   uint8_t* patch_step = nullptr;  // this frame's step (0: not drawn)
   int32_t* patch_z = nullptr;     // nearest camera depth, raw Q16.16
+  int64_t* patch_px = nullptr;    // this frame: its height error on screen at its step
   uint16_t* order = nullptr;      // visible patches, nearest first
   // The DC plane: one texel a level-0 block.
   uint8_t *dc_y = nullptr, *dc_cb = nullptr, *dc_cr = nullptr;
@@ -137,7 +138,7 @@ size_t workspace(const StreamHeader& h, const terrain::Params& t, const PlayerCo
   const size_t win = size_t{1} << t.cache_log2, cwin = win / 2;
   const size_t vertices = ground_vertices(t) + 4u * t.max_cells;
   return sizeof(TerrainPlay) + 8 + terrain::BlockStore::workspace_bytes(t.store_units) + 4 +
-         render_workspace_size(render_config(h, t, c)) + 2 * points + 2 + patches * (2 + 2 + 1 + 4 + 2 + 2 * (kMaxStepLog2 + 1)) + 18 +
+         render_workspace_size(render_config(h, t, c)) + 2 * points + 2 + patches * (2 + 2 + 1 + 4 + 8 + 2 + 2 * (kMaxStepLog2 + 1)) + 26 +
          luma + 2 * chroma + 4 + terrain::kMaxFlightKeys * sizeof(WalkPose) + 4 + win * win * (4 + 64 + 4) + 12 +
          2 * cwin * cwin * (4 + 64) + cwin * cwin * 8 + 16 + vertices * (sizeof(Vec3<Q16_16>) + sizeof(TexCoord)) + 8 +
          (ground_triangles(t) + skirt_triangles(t) + 2u * t.max_cells) * 6 + 6 +
@@ -192,6 +193,7 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   w.patch_err = take<uint16_t>(a, patches * (kMaxStepLog2 + 1));
   w.patch_step = take<uint8_t>(a, patches);
   w.patch_z = take<int32_t>(a, patches);
+  w.patch_px = take<int64_t>(a, patches);
   w.order = take<uint16_t>(a, patches);
   const size_t luma = size_t{t.cells_x} * t.cells_y, chroma = w.grid.plane_blocks(0, 1);
   w.dc_y = take<uint8_t>(a, luma + 2 * chroma);
@@ -219,7 +221,7 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   }
   w.cell_tex = take<Texture>(a, t.max_cells);
   if (s == Status::ok &&
-      (!w.heights || !w.patch_lo || !w.patch_hi || !w.patch_err || !w.patch_step || !w.patch_z || !w.order || !w.dc_y || !w.keys ||
+      (!w.heights || !w.patch_lo || !w.patch_hi || !w.patch_err || !w.patch_step || !w.patch_z || !w.patch_px || !w.order || !w.dc_y || !w.keys ||
        !w.ytag || !w.yclaim || !w.ytex || !w.ctag || !w.cclaim || !w.cowner || !w.ctex || !w.pos || !w.uv || !w.ground_idx ||
        !w.meshes || !w.cell_tex))
     s = Status::workspace_too_small;
@@ -730,30 +732,51 @@ Status draw(Player& p, TerrainPlay& w, const WalkPose& pose) {
         }
         w.order[at] = static_cast<uint16_t>(k);
       }
-    // Steps, nearest first: each patch at the step its depth asks for, or
-    // coarser where that would leave the patches after it less than their
-    // coarsest steps.
+    // Steps: every visible patch starts at its coarsest step, then the
+    // patch whose step shows the largest height error on screen (its error
+    // at the patch's nearest depth) is halved, again and again, while the
+    // frame's budget holds the finer step and the error is over kLodPx
+    // pixels: the budget goes where the picture is most wrong.
     const int64_t fx = cam.fx.raw() >> 8;
-    const PatchCost coarsest = patch_cost(w.patch, w.patch);
-    PatchCost used, reserve;
-    for (uint32_t n = 0; n < visible; ++n) reserve += coarsest;
+    PatchCost used;
     for (uint32_t n = 0; n < visible; ++n) {
-      const int k = w.order[n];
-      reserve.vertices -= coarsest.vertices, reserve.ground -= coarsest.ground, reserve.skirts -= coarsest.skirts;
-      // The coarsest step whose height error projects to at most kLodPx
-      // pixels at the patch's nearest depth.
-      const int64_t limit = int64_t{kLodPx} * w.patch_z[k];  // Q16
+      w.patch_step[w.order[n]] = static_cast<uint8_t>(w.patch);
+      used += patch_cost(w.patch, w.patch);
+    }
+    auto screen_error = [&](int k, int step) {  // Q16 pixels x units, against kLodPx x depth
       const uint16_t* err = w.patch_err + k * (kMaxStepLog2 + 1);
-      int s = 1;
-      for (int l = 1; (1 << l) <= w.patch; ++l) {
-        const int64_t e = (int64_t{err[l]} * w.params.height_step_q16) >> 8;  // world units, Q8
-        if (e * fx > limit) break;
-        s = 1 << l;
+      return ((int64_t{err[ilog2(static_cast<uint32_t>(step))]} * w.params.height_step_q16) >> 8) * fx;
+    };
+    // Each patch's error on screen at its current step, about 2^8 pixels
+    // (0: nothing to refine); only the refined patch's changes.
+    auto on_screen = [&](int k) -> int64_t {
+      const int st = w.patch_step[k];
+      if (st <= 1) return 0;
+      const int64_t e = screen_error(k, st), z = w.patch_z[k] > 0 ? w.patch_z[k] : 1;
+      return e <= int64_t{kLodPx} * z ? 0 : e / ((z >> 8) + 1);  // (no overflow for any stream's values)
+    };
+    for (uint32_t n = 0; n < visible; ++n) w.patch_px[w.order[n]] = on_screen(w.order[n]);
+    const PatchCost none;
+    for (;;) {
+      int best = -1;
+      for (uint32_t n = 0; n < visible; ++n) {
+        const int k = w.order[n];
+        if (w.patch_px[k] == 0 || (best >= 0 && w.patch_px[k] <= w.patch_px[best])) continue;
+        // Would the finer step fit? (Its cost less the current one's.)
+        const int st = w.patch_step[k];
+        PatchCost more = patch_cost(w.patch, st / 2);
+        const PatchCost now = patch_cost(w.patch, st);
+        more.vertices -= now.vertices, more.ground -= now.ground, more.skirts -= now.skirts;
+        if (used.within(more, none, w.params)) best = k;
       }
-      while (s < w.patch && !used.within(patch_cost(w.patch, s), reserve, w.params)) s *= 2;
-      if (!used.within(patch_cost(w.patch, s), reserve, w.params)) continue;  // (never: the budgets hold every patch's coarsest)
-      used += patch_cost(w.patch, s);
-      w.patch_step[k] = static_cast<uint8_t>(s);
+      if (best < 0) break;
+      const int st = w.patch_step[best];
+      const PatchCost now = patch_cost(w.patch, st), finer = patch_cost(w.patch, st / 2);
+      used.vertices += finer.vertices - now.vertices;
+      used.ground += finer.ground - now.ground;
+      used.skirts += finer.skirts - now.skirts;
+      w.patch_step[best] = static_cast<uint8_t>(st / 2);
+      w.patch_px[best] = on_screen(best);
     }
     for (uint32_t n = 0; n < visible; ++n) {
       const int k = w.order[n];
