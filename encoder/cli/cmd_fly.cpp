@@ -198,14 +198,13 @@ void run_encode(const FlyOptions& o) {
   for (uint32_t c : crcs) all = all * 31 + c;
   std::printf("  the client library plays it: %zu frames (CRCs hashed: %08x)\n", crcs.size(), all);
   if (o.psnr || !o.out.empty()) {
-    enc::TerrainSender sender(t, path, so);
     const enc::TerrainTruth truth(t, so.width, so.height);
     double sum = 0;
     std::vector<io::Image> sheet;
     const size_t tiles = std::min<size_t>(8, shown.size());
     if (!o.out.empty()) std::filesystem::create_directories(o.out);
     for (size_t f = 0; f < shown.size(); ++f) {
-      const io::Image g = truth.render(sender.metres(sender.pose(static_cast<uint32_t>(f))), sender.hfov_deg());
+      const io::Image g = truth.render(r.flight[f], path.hfov_deg);
       sum += io::psnr(g, shown[f]);
       for (size_t k = 0; k < tiles; ++k)
         if (sheet_frame(k, tiles, shown.size()) == f) sheet.push_back(io::side_by_side({&g, &shown[f]}));
@@ -301,14 +300,10 @@ void map_options(CLI::App* sub, FlyOptions* o) {
   sub->add_flag("--frames-png", o->frames_png, "With --out: every frame the client shows, as PNG");
 }
 
-}  // namespace
-
-void add_encode_terrain(CLI::App& app) {
-  auto o = std::make_shared<FlyOptions>();
+// The terrain client's sizes (encode-terrain, serve-terrain); the store's
+// default is the Cortex-M4 board's.
+void client_options(CLI::App* sub, FlyOptions* o) {
   o->store = 16384;
-  CLI::App* sub = app.add_subcommand("encode-terrain", "Write the terrain stream of a scripted flight and replay it through the client library (docs/terrain.md)");
-  map_options(sub, o.get());
-  sub->add_option("-o,--output", o->output, "The stream to write")->required();
   sub->add_option("--store", o->store, "Client block store, 2-byte units: a held block costs its coefficients + 6 (default 16384)")
       ->check(CLI::Range(64u, 1u << 26));
   sub->add_option("--cache-log2", o->cache_log2, "The client's transformed-block window, 2^n cells a side (default 4)")
@@ -318,24 +313,25 @@ void add_encode_terrain(CLI::App& app) {
       ->check(CLI::Range(0, 7));
   sub->add_option("--frame-budget", o->frame_budget, "The client's geometry a frame: 512 n vertices, 2..64 (default 2)")
       ->check(CLI::Range(2, 64));
+}
+
+}  // namespace
+
+void add_encode_terrain(CLI::App& app) {
+  auto o = std::make_shared<FlyOptions>();
+  CLI::App* sub = app.add_subcommand("encode-terrain", "Write the terrain stream of a scripted flight and replay it through the client library (docs/terrain.md)");
+  map_options(sub, o.get());
+  client_options(sub, o.get());
+  sub->add_option("-o,--output", o->output, "The stream to write")->required();
   sub->add_flag("--psnr", o->psnr, "Also each frame the client shows against the ground truth");
   sub->callback([o] { run_encode(*o); });
 }
 
 void add_serve_terrain(CLI::App& app) {
   auto o = std::make_shared<FlyOptions>();
-  o->store = 16384;
   CLI::App* sub = app.add_subcommand("serve-terrain", "Serve a terrain live to a client board, answering the poses it sends up (docs/terrain.md)");
   map_options(sub, o.get());
-  sub->add_option("--store", o->store, "Client block store, 2-byte units: a held block costs its coefficients + 6 (default 16384)")
-      ->check(CLI::Range(64u, 1u << 26));
-  sub->add_option("--cache-log2", o->cache_log2, "The client's transformed-block window, 2^n cells a side (default 4)")
-      ->check(CLI::Range(1, 6));
-  sub->add_option("--cells", o->cells, "Cells the client draws with their own texels a frame (default 64)")->check(CLI::Range(1, 4096));
-  sub->add_option("--half-log2", o->half_log2, "The client's half-resolution window, 2^n cells a side, 3..7 (default 6; 0: none)")
-      ->check(CLI::Range(0, 7));
-  sub->add_option("--frame-budget", o->frame_budget, "The client's geometry a frame: 512 n vertices, 2..64 (default 2)")
-      ->check(CLI::Range(2, 64));
+  client_options(sub, o.get());
   sub->add_option("--board", o->board.board, "host: the host-native board on a pseudo-terminal; qemu: the Cortex-M4 board in QEMU")
       ->check(CLI::IsMember({"host", "qemu"}));
   sub->add_option("--link", o->link, "Without --board: the client's link (pty:PATH, tcp:HOST:PORT, tcp-listen:PORT, usb:VID:PID)");

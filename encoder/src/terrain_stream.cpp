@@ -245,6 +245,7 @@ TerrainStreamResult write_terrain_stream(const TerrainCoding& t, const CameraPat
   r.frames = live.frames();
   r.opening_bytes = live.opening_bytes();
   r.elevation_frame = live.elevation_frame();
+  for (uint32_t f = 0; f < live.sender().frames(); ++f) r.flight.push_back(live.sender().metres(live.sender().pose(f)));
   return r;
 }
 

@@ -150,11 +150,6 @@ bool start(Player& p, const StreamHeader& h) {
   return detail::header_has_camera_and_frames(p, h, "a terrain stream needs a camera and a frame count in its header");  // set up at TERH
 }
 
-template <class T>
-T* take(Arena& a, size_t n) {
-  return a.alloc_array<T>(n);
-}
-
 bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   terrain::Params t;
   if (terrain::params_from_bytes(payload, size, &t) != Status::ok) {
@@ -187,39 +182,39 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   const size_t patches = static_cast<size_t>(w.patches_x) * w.patches_y;
   Status s = w.store.init(a, w.grid, t.store_units);
   if (s == Status::ok) s = w.renderer.init(render_config(h, t, p.config()), a);
-  w.heights = take<uint16_t>(a, static_cast<size_t>(w.pw) * w.ph);
-  w.patch_lo = take<uint16_t>(a, patches);
-  w.patch_hi = take<uint16_t>(a, patches);
-  w.patch_err = take<uint16_t>(a, patches * (kMaxStepLog2 + 1));
-  w.patch_step = take<uint8_t>(a, patches);
-  w.patch_z = take<int32_t>(a, patches);
-  w.patch_px = take<int64_t>(a, patches);
-  w.order = take<uint16_t>(a, patches);
+  w.heights = a.alloc_array<uint16_t>(static_cast<size_t>(w.pw) * w.ph);
+  w.patch_lo = a.alloc_array<uint16_t>(patches);
+  w.patch_hi = a.alloc_array<uint16_t>(patches);
+  w.patch_err = a.alloc_array<uint16_t>(patches * (kMaxStepLog2 + 1));
+  w.patch_step = a.alloc_array<uint8_t>(patches);
+  w.patch_z = a.alloc_array<int32_t>(patches);
+  w.patch_px = a.alloc_array<int64_t>(patches);
+  w.order = a.alloc_array<uint16_t>(patches);
   const size_t luma = size_t{t.cells_x} * t.cells_y, chroma = w.grid.plane_blocks(0, 1);
-  w.dc_y = take<uint8_t>(a, luma + 2 * chroma);
-  w.keys = take<WalkPose>(a, terrain::kMaxFlightKeys);
+  w.dc_y = a.alloc_array<uint8_t>(luma + 2 * chroma);
+  w.keys = a.alloc_array<WalkPose>(terrain::kMaxFlightKeys);
   w.win = 1u << t.cache_log2;
   w.cwin = w.win / 2;
-  w.ytag = take<uint32_t>(a, w.win * w.win);
-  w.yclaim = take<uint32_t>(a, w.win * w.win);
-  w.ytex = take<uint8_t>(a, w.win * w.win * 64);
-  w.ctag = take<uint32_t>(a, 2 * w.cwin * w.cwin);
-  w.cclaim = take<uint32_t>(a, w.cwin * w.cwin);
-  w.cowner = take<uint32_t>(a, w.cwin * w.cwin);
-  w.ctex = take<uint8_t>(a, 2 * w.cwin * w.cwin * 64);
+  w.ytag = a.alloc_array<uint32_t>(w.win * w.win);
+  w.yclaim = a.alloc_array<uint32_t>(w.win * w.win);
+  w.ytex = a.alloc_array<uint8_t>(w.win * w.win * 64);
+  w.ctag = a.alloc_array<uint32_t>(2 * w.cwin * w.cwin);
+  w.cclaim = a.alloc_array<uint32_t>(w.cwin * w.cwin);
+  w.cowner = a.alloc_array<uint32_t>(w.cwin * w.cwin);
+  w.ctex = a.alloc_array<uint8_t>(2 * w.cwin * w.cwin * 64);
   w.max_vertices = ground_vertices(t) + 4u * t.max_cells;
-  w.pos = take<Vec3<Q16_16>>(a, w.max_vertices);
-  w.uv = take<TexCoord>(a, w.max_vertices);
-  w.ground_idx = take<uint16_t>(a, 3 * (ground_triangles(t) + skirt_triangles(t) + 2u * t.max_cells));
-  w.meshes = take<Mesh>(a, 4u + t.max_cells);
+  w.pos = a.alloc_array<Vec3<Q16_16>>(w.max_vertices);
+  w.uv = a.alloc_array<TexCoord>(w.max_vertices);
+  w.ground_idx = a.alloc_array<uint16_t>(3 * (ground_triangles(t) + skirt_triangles(t) + 2u * t.max_cells));
+  w.meshes = a.alloc_array<Mesh>(4u + t.max_cells);
   w.hwin = half_window(t);
   if (w.hwin != 0) {
-    w.hy = take<uint8_t>(a, 6u * w.hwin * w.hwin);
-    w.htag = take<uint16_t>(a, w.hwin * w.hwin);
-    w.hclaim = take<uint16_t>(a, w.hwin * w.hwin);
+    w.hy = a.alloc_array<uint8_t>(6u * w.hwin * w.hwin);
+    w.htag = a.alloc_array<uint16_t>(w.hwin * w.hwin);
+    w.hclaim = a.alloc_array<uint16_t>(w.hwin * w.hwin);
     if (!w.hy || !w.htag || !w.hclaim) s = Status::workspace_too_small;
   }
-  w.cell_tex = take<Texture>(a, t.max_cells);
+  w.cell_tex = a.alloc_array<Texture>(t.max_cells);
   if (s == Status::ok &&
       (!w.heights || !w.patch_lo || !w.patch_hi || !w.patch_err || !w.patch_step || !w.patch_z || !w.patch_px || !w.order || !w.dc_y || !w.keys ||
        !w.ytag || !w.yclaim || !w.ytex || !w.ctag || !w.cclaim || !w.cowner || !w.ctex || !w.pos || !w.uv || !w.ground_idx ||
@@ -562,10 +557,13 @@ struct PatchCost {
     vertices += c.vertices, ground += c.ground, skirts += c.skirts;
     return *this;
   }
-  bool within(const PatchCost& more, const PatchCost& reserve, const terrain::Params& t) const {
-    return vertices + more.vertices + reserve.vertices <= ground_vertices(t) &&
-           ground + more.ground + reserve.ground <= ground_triangles(t) &&
-           skirts + more.skirts + reserve.skirts <= skirt_triangles(t);
+  // What going from `from` to `to` adds (to is the larger).
+  static PatchCost growth(const PatchCost& from, const PatchCost& to) {
+    return {to.vertices - from.vertices, to.ground - from.ground, to.skirts - from.skirts};
+  }
+  bool within(const PatchCost& more, const terrain::Params& t) const {
+    return vertices + more.vertices <= ground_vertices(t) && ground + more.ground <= ground_triangles(t) &&
+           skirts + more.skirts <= skirt_triangles(t);
   }
 };
 PatchCost patch_cost(int cells, int s) {
@@ -756,26 +754,18 @@ Status draw(Player& p, TerrainPlay& w, const WalkPose& pose) {
       return e <= int64_t{kLodPx} * z ? 0 : e / ((z >> 8) + 1);  // (no overflow for any stream's values)
     };
     for (uint32_t n = 0; n < visible; ++n) w.patch_px[w.order[n]] = on_screen(w.order[n]);
-    const PatchCost none;
+    // What halving a patch's step adds.
+    auto finer = [&](int k) { return PatchCost::growth(patch_cost(w.patch, w.patch_step[k]), patch_cost(w.patch, w.patch_step[k] / 2)); };
     for (;;) {
       int best = -1;
       for (uint32_t n = 0; n < visible; ++n) {
         const int k = w.order[n];
         if (w.patch_px[k] == 0 || (best >= 0 && w.patch_px[k] <= w.patch_px[best])) continue;
-        // Would the finer step fit? (Its cost less the current one's.)
-        const int st = w.patch_step[k];
-        PatchCost more = patch_cost(w.patch, st / 2);
-        const PatchCost now = patch_cost(w.patch, st);
-        more.vertices -= now.vertices, more.ground -= now.ground, more.skirts -= now.skirts;
-        if (used.within(more, none, w.params)) best = k;
+        if (used.within(finer(k), w.params)) best = k;
       }
       if (best < 0) break;
-      const int st = w.patch_step[best];
-      const PatchCost now = patch_cost(w.patch, st), finer = patch_cost(w.patch, st / 2);
-      used.vertices += finer.vertices - now.vertices;
-      used.ground += finer.ground - now.ground;
-      used.skirts += finer.skirts - now.skirts;
-      w.patch_step[best] = static_cast<uint8_t>(st / 2);
+      used += finer(best);
+      w.patch_step[best] = static_cast<uint8_t>(w.patch_step[best] / 2);
       w.patch_px[best] = on_screen(best);
     }
     for (uint32_t n = 0; n < visible; ++n) {

@@ -45,7 +45,6 @@ class TerrainSender {
   TerrainSender(const TerrainCoding& t, const CameraPath& path, const TerrainStreamOptions& o);
   const StreamHeader& header() const { return header_; }
   const terrain::Params& params() const { return params_; }
-  double units_per_metre() const { return units_; }
   uint32_t frames() const { return header_.frame_count; }
   // TERH, TFLY and the coarse elevation: what a client needs before its first frame.
   std::vector<TerrainChunk> opening() const;
@@ -141,6 +140,7 @@ struct TerrainStreamResult {
   std::vector<TerrainStreamFrame> frames;
   size_t opening_bytes = 0;  // HEAD, TERH, TFLY and the coarse elevation
   uint32_t elevation_frame = 0;  // the frame the fine elevation was whole by (frames: never)
+  std::vector<CameraPose> flight;  // the camera the client flies each frame (metres: its keys interpolated)
 };
 // The stream for a scripted flight over the link FlightLink models (as
 // vds fly does): TerrainLive, given the client's pose of every
