@@ -8,10 +8,12 @@
 #                           fixes (pak6-patch085), player models
 #   trigger-rally-data      96 terrain maps (heightmap, colour map, scales)
 #                           in data.zip, read in place
+#   assimp-testmodels       textured models in many formats (the duck, the
+#                           milk truck, mrfixit, ...) for the model mode
 # and prints where each lives. Idempotent.
 set -euo pipefail
 
-PACKAGES=(glmark2-data openarena-081-maps openarena-081-textures openarena-081-misc openarena-data trigger-rally-data)
+PACKAGES=(glmark2-data openarena-081-maps openarena-081-textures openarena-081-misc openarena-data trigger-rally-data assimp-testmodels)
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
@@ -27,7 +29,8 @@ fi
 GLMARK2=/usr/share/glmark2
 OPENARENA=/usr/share/games/openarena/baseoa
 TRIGGER=/usr/share/games/trigger-rally/data.zip
-for f in "$TRIGGER" "$GLMARK2/models/bunny.obj" "$GLMARK2/models/horse.3ds" "$OPENARENA/pak1-maps.pk3" "$OPENARENA/pak4-textures.pk3" "$OPENARENA/pak0.pk3"; do
+ASSIMP_MODELS=/usr/share/assimp/models
+for f in "$TRIGGER" "$GLMARK2/models/bunny.obj" "$GLMARK2/models/horse.3ds" "$OPENARENA/pak1-maps.pk3" "$OPENARENA/pak4-textures.pk3" "$OPENARENA/pak0.pk3" "$ASSIMP_MODELS/Collada/duck_triangulate.dae"; do
   [ -e "$f" ] || echo "fetch-data: note: $f not found" >&2
 done
 echo "fetch-data: glmark2 models:   $GLMARK2/models ($(ls "$GLMARK2/models" 2>/dev/null | wc -l) files)"

@@ -16,6 +16,8 @@ PACKAGES=(
   libsdl2-dev
   # anchors the benchmarks and conformance tests compare against
   libjpeg-turbo-progs libturbojpeg0-dev libwebp-dev
+  # the model mode's texture anchors: cwebp, dwebp, avifenc, avifdec
+  webp libavif-bin
   # the video codecs the walkthrough is measured against (x264, x265, SVT-AV1, libaom)
   ffmpeg
   # measurement and plots

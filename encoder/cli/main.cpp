@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   vds::cli::add_fly(app);
   vds::cli::add_encode_terrain(app);
   vds::cli::add_serve_terrain(app);
+  vds::cli::add_mesh_colors(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

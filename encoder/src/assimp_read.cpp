@@ -11,6 +11,8 @@
 #include <assimp/MemoryIOWrapper.h>
 
 #include "mesh_glb_check.h"
+#include "mesh_collada_check.h"
+#include "mesh_iqm_check.h"
 #include "mesh_ply_check.h"
 #include "text.h"
 
@@ -117,7 +119,7 @@ class ConfinedIO : public Assimp::DefaultIOSystem {
 // (tests/fuzz/fuzz_mesh_import.cpp). Assimp reads dozens more, some of
 // which trust the counts a file declares.
 bool imported_format(const std::string& ext) {
-  static const char* const kFormats[] = {"obj", "ply", "gltf", "glb", "3ds"};
+  static const char* const kFormats[] = {"obj", "ply", "gltf", "glb", "3ds", "dae", "iqm"};
   for (const char* f : kFormats)
     if (ext == f) return true;
   return false;
@@ -137,6 +139,11 @@ const aiScene* read_with_assimp(Assimp::Importer& importer, const uint8_t* data,
   // GLB's lengths are checked by the project's own reader first: assimp
   // allocates what they say.
   if (format == "glb") check_glb(data, size, name);
+  // IQM's counts and offsets are checked by the project's own reader first:
+  // assimp's loader takes them as given.
+  if (format == "iqm") check_iqm(data, size, name);
+  // Collada's counts, strides and indices too.
+  if (format == "dae") check_collada(data, size, name);
   // The model under its own name with its format's extension (see ConfinedIO).
   std::string stem = std::filesystem::path(name).stem().string();
   if (stem.empty() || stem.find('$') != std::string::npos) stem = "model";
@@ -148,7 +155,7 @@ const aiScene* read_with_assimp(Assimp::Importer& importer, const uint8_t* data,
   // looks like a PLY to it) and hand the bytes to a loader nothing checked.
   if (!imported_format(format) || importer.GetImporter(format.c_str()) == nullptr)
     throw std::runtime_error(name + ": not a mesh format this tool reads ('" + format +
-                             "'; it reads .obj, .ply, .gltf, .glb, .3ds and .drc)");
+                             "'; it reads .obj, .ply, .gltf, .glb, .3ds, .dae, .iqm and .drc)");
   for (size_t i = importer.GetImporterCount(); i-- > 0;) {
     Assimp::BaseImporter* loader = importer.GetImporter(i);
     std::set<std::string> extensions;

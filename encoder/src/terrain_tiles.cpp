@@ -16,19 +16,6 @@ namespace vds::enc {
 
 namespace {
 
-// One level of the pyramid: the colour map box-filtered down by 2^level.
-io::Image halve(const io::Image& a) {
-  io::Image b(std::max(1, (a.width + 1) / 2), std::max(1, (a.height + 1) / 2), 3);
-  for (int y = 0; y < b.height; ++y)
-    for (int x = 0; x < b.width; ++x)
-      for (int c = 0; c < 3; ++c) {
-        int s = 0;
-        for (int dy = 0; dy < 2; ++dy)
-          for (int dx = 0; dx < 2; ++dx) s += a.at(std::min(2 * x + dx, a.width - 1), std::min(2 * y + dy, a.height - 1), c);
-        b.at(x, y, c) = static_cast<uint8_t>((s + 2) / 4);
-      }
-  return b;
-}
 
 // Bytes of a JPEG's DQT and DHT segments: a client with shared tables
 // holds them once.
@@ -61,7 +48,7 @@ class TileSource : public FlightSource {
       for (int ty = 0; ty < ny; ++ty)
         for (int tx = 0; tx < nx; ++tx) tiles_.push_back(code(level, static_cast<int>(levels_.size()) - 1, tx, ty));
       if (nx == 1 && ny == 1) break;
-      level = halve(level);
+      level = io::halve(level);
     }
     held_.assign(tiles_.size(), 0);
     last_wanted_.assign(tiles_.size(), 0);

@@ -1,6 +1,7 @@
 // libFuzzer: the host's mesh import (vds/enc/mesh_import.h), what `vds
 // encode-mesh` does with a user's file: the project's PLY check, assimp
-// (with its data-structure validation) for OBJ, PLY, glTF and GLB, libdraco
+// (with its data-structure validation) for OBJ, PLY, glTF, GLB, Collada
+// and IQM (IQM checked by the project's own reader first), libdraco
 // for Draco, then the repair rule. The first byte picks the format the
 // file's name says; the rest is the file. Invariants: no crash, sanitizer
 // report, hang or allocation beyond libFuzzer's limit; a refusal is a
@@ -9,7 +10,7 @@
 //
 // Seed corpus: when the corpus directory is empty, small valid files are
 // written to it first (an OBJ, an ASCII and a binary PLY, a glTF with its
-// buffer inline, a GLB, a Draco mesh).
+// buffer inline, a GLB, a Draco mesh, a Collada file, an IQM file).
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -25,8 +26,9 @@
 
 namespace {
 
-const char* const kNames[] = {"input.obj", "input.ply", "input.gltf", "input.glb", "input.drc", "input.3ds", "input.off"};
-constexpr int kFormats = 7;  // .off: a format the tool refuses
+const char* const kNames[] = {"input.obj", "input.ply", "input.gltf", "input.glb", "input.drc",
+                              "input.3ds", "input.off", "input.dae", "input.iqm"};
+constexpr int kFormats = 9;  // .off: a format the tool refuses
 
 void write(const std::filesystem::path& p, uint8_t pick, const std::string& body) {
   std::ofstream f(p, std::ios::binary);
@@ -108,6 +110,31 @@ void seed(const std::filesystem::path& dir) {
   for (const auto& t : f) faces += le16(uint16_t(t[0])) + le16(uint16_t(t[1])) + le16(uint16_t(t[2])) + le16(0);
   const std::string mesh3ds = chunk(0x4100, chunk(0x4110, verts) + chunk(0x4120, faces));
   write(dir / "seed_3ds", 5, chunk(0x4D4D, chunk(0x0002, le32(3)) + chunk(0x3D3D, chunk(0x4000, std::string("t\0", 2) + mesh3ds))));
+  write(dir / "seed_dae", 7,
+        "<?xml version=\"1.0\"?><COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
+        "<library_geometries><geometry id=\"g\"><mesh><source id=\"p\"><float_array id=\"pa\" count=\"9\">0 0 0 1 0 0 0 1 0"
+        "</float_array><technique_common><accessor source=\"#pa\" count=\"3\" stride=\"3\"><param name=\"X\" type=\"float\"/>"
+        "<param name=\"Y\" type=\"float\"/><param name=\"Z\" type=\"float\"/></accessor></technique_common></source>"
+        "<vertices id=\"v\"><input semantic=\"POSITION\" source=\"#p\"/></vertices><triangles count=\"1\">"
+        "<input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>0 1 2</p></triangles></mesh></geometry>"
+        "</library_geometries><library_visual_scenes><visual_scene id=\"s\"><node><instance_geometry url=\"#g\"/></node>"
+        "</visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#s\"/></scene></COLLADA>");
+  // IQM: the header, the text, one mesh, a position array, one triangle.
+  {
+    std::string text("\0m\0", 3);
+    const uint32_t ofs_text = 124, ofs_meshes = ofs_text + 4, ofs_va = ofs_meshes + 24, ofs_pos = ofs_va + 20,
+                   ofs_tri = ofs_pos + 36, size = ofs_tri + 12;
+    const uint32_t h[27] = {2, size, 0, 4, ofs_text, 1, ofs_meshes, 1, 3, ofs_va, 1, ofs_tri, 0, 0, 0, 0, 0, 0, 0,
+                            0, 0, 0, 0, 0, 0, 0, 0};
+    std::string iqm("INTERQUAKEMODEL\0", 16);
+    for (uint32_t x : h) iqm += le32(x);
+    iqm += text + std::string(1, '\0');
+    for (uint32_t x : {1u, 1u, 0u, 3u, 0u, 1u}) iqm += le32(x);
+    for (uint32_t x : {0u, 0u, 7u, 3u, ofs_pos}) iqm += le32(x);
+    for (const auto& p : tri) iqm += lef(p[0]) + lef(p[1]) + lef(p[2]);
+    iqm += le32(0) + le32(1) + le32(2);
+    write(dir / "seed_iqm", 8, iqm);
+  }
   write(dir / "seed_off", 6, "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n");
 }
 

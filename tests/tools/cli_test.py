@@ -107,6 +107,21 @@ check(code == 2 and "--tail needs the arithmetic coder" in err and not os.path.e
 code, out, err = run("encode-mesh", obj, "-o", model + ".splits", "--tail", "0")
 check(code == 0 and "single-rate tail" not in out, "--tail 0 splits all the way")
 
+# vds mesh-colors: the octahedron has no texture (vertex samples only, no
+# level to code); a missing model names the file; a resolution beyond the
+# format's is a usage error.
+code, out, err = run("mesh-colors", obj, "--quality", "1")
+check(code == 0 and "R=1: 8 faces" in out, "mesh-colors on an untextured model: resolution 1 everywhere")
+code, out, err = run("mesh-colors", os.path.join(TMP, "no_such.obj"))
+check(code == 1 and "no_such.obj" in err, "mesh-colors on a missing file names it (exit 1)")
+code, out, err = run("mesh-colors", obj, "--max-res", "11")
+check(code == 2, "mesh-colors --max-res beyond 10 is a usage error")
+anchors = os.path.join(TMP, "anchors.csv")
+with open(anchors, "w") as f:
+    f.write("jpeg,50,1000\n")
+code, out, err = run("mesh-colors", obj, "--views", "1", "--size", "16", "--anchors", anchors)
+check(code == 1 and "anchors.csv: line 1" in err, "a malformed anchors line is refused naming the file and line")
+
 # vds play and encode-walk: options checked before anything runs.
 code, out, err = run("play", stream, "--board", "fpga")
 check(code == 2 and "--board" in err, "vds play refuses a board it does not have")

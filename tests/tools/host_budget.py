@@ -191,6 +191,34 @@ def png(w, h, rows_data):
             png_chunk(b"IDAT", zlib.compress(rows_data)) + png_chunk(b"IEND", b""))
 
 
+# --- Textured models (vds mesh-colors) -------------------------------------------------------
+# An IQM whose header claims a billion vertices: refused by the project's check before assimp.
+iqm_text = b"\0m\0\0"
+iqm_size = 124 + 4 + 24 + 20 + 36 + 12
+iqm_header = [2, iqm_size, 0, 4, 124, 1, 128, 1, 3, 152, 1, 188 - 12 + 12, 0] + [0] * 14
+iqm_header[11] = 124 + 4 + 24 + 20 + 36
+iqm = (b"INTERQUAKEMODEL\0" + struct.pack("<27I", *iqm_header) + iqm_text + struct.pack("<6I", 1, 0, 0, 3, 0, 1) +
+       struct.pack("<5I", 0, 0, 7, 3, 172) + struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0) + struct.pack("<3I", 0, 1, 2))
+run("iqm_valid", ["mesh-colors", write("ok.iqm", iqm), "--quality", "1"], os.path.join(TMP, "ok.iqm"), 0)
+huge_iqm = bytearray(iqm)
+struct.pack_into("<I", huge_iqm, 16 + 4 * 8, 1000000000)
+run("iqm_claims_1e9_vertices", ["mesh-colors", write("huge.iqm", bytes(huge_iqm))], os.path.join(TMP, "huge.iqm"), 1,
+    "do not fit the file")
+os.makedirs(os.path.join(TMP, "textured"), exist_ok=True)
+tex_obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3\n"
+write(os.path.join("textured", "t.png"), png(4, 2, b"".join(b"\0" + bytes(range(12)) for _ in range(2))))
+write(os.path.join("textured", "m.mtl"), "newmtl t\nmap_Kd t.png\n")
+ok_obj = write(os.path.join("textured", "ok.obj"), tex_obj)
+run("textured_obj_valid", ["mesh-colors", ok_obj, "--quality", "1", "--views", "2", "--size", "32"], ok_obj, 0)
+write(os.path.join("textured", "out.mtl"), "newmtl t\nmap_Kd ../ok.png\n")
+out_obj = write(os.path.join("textured", "out.obj"), tex_obj.replace("m.mtl", "out.mtl"))
+run("textured_obj_texture_outside_folder", ["mesh-colors", out_obj], out_obj, 1, "not in the model's folder")
+write(os.path.join("textured", "huge.png"), png(65535, 65535, b"\0" * 1000))
+write(os.path.join("textured", "huge.mtl"), "newmtl t\nmap_Kd huge.png\n")
+huge_obj = write(os.path.join("textured", "huge.obj"), tex_obj.replace("m.mtl", "huge.mtl"))
+run("textured_obj_texture_claims_65535", ["mesh-colors", huge_obj], huge_obj, 1, "declares a 65535x65535 image")
+
+
 img_out = os.path.join(TMP, "out_img.vds")
 small = png(4, 2, b"".join(b"\0" + bytes(range(12)) for _ in range(2)))
 run("png_valid", ["encode-image", write("ok.png", small), "-o", img_out], os.path.join(TMP, "ok.png"), 0, output=img_out)

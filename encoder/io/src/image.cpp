@@ -137,6 +137,38 @@ void save_png(const std::string& path, const Image& img) {
   w.finish();
 }
 
+Image halve(const Image& a) {
+  Image b(std::max(1, (a.width + 1) / 2), std::max(1, (a.height + 1) / 2), 3);
+  for (int y = 0; y < b.height; ++y)
+    for (int x = 0; x < b.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        int s = 0;
+        for (int dy = 0; dy < 2; ++dy)
+          for (int dx = 0; dx < 2; ++dx) s += a.at(std::min(2 * x + dx, a.width - 1), std::min(2 * y + dy, a.height - 1), c);
+        b.at(x, y, c) = static_cast<uint8_t>((s + 2) / 4);
+      }
+  return b;
+}
+
+std::array<double, 3> bilinear_repeat(const Image& img, double x, double y) {
+  x -= 0.5;
+  y -= 0.5;
+  const double fx = std::floor(x), fy = std::floor(y);
+  const double ax = x - fx, ay = y - fy;
+  // Coordinates far outside the image repeat: reduce before converting to int.
+  auto wrap = [](double i, int n) {
+    const int r = static_cast<int>(std::fmod(i, static_cast<double>(n)));
+    return ((r % n) + n) % n;
+  };
+  const int x0 = wrap(fx, img.width), y0 = wrap(fy, img.height);
+  const int x1 = (x0 + 1) % img.width, y1 = (y0 + 1) % img.height;
+  std::array<double, 3> out{};
+  for (int c = 0; c < 3; ++c)
+    out[c] = (img.at(x0, y0, c) * (1 - ax) + img.at(x1, y0, c) * ax) * (1 - ay) +
+             (img.at(x0, y1, c) * (1 - ax) + img.at(x1, y1, c) * ax) * ay;
+  return out;
+}
+
 double mse(const Image& a, const Image& b) {
   if (a.width != b.width || a.height != b.height || a.channels != b.channels)
     throw std::invalid_argument("images differ in size or channels");

@@ -3,6 +3,7 @@
 // libjpeg-turbo only, nothing of vds) that the encoder and the host-native board both
 // use.
 #pragma once
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -77,6 +78,15 @@ class PngRowWriter {
 
 // Same size and channels, else throws std::invalid_argument.
 double mse(const Image& a, const Image& b);
+
+// An RGB image box-filtered to half its size (rounded up; the last row and
+// column repeat where the size is odd), each channel rounded: one level of
+// a pyramid.
+Image halve(const Image& rgb);
+
+// An RGB image sampled bilinearly at (x, y) in texels (texel (i, j) covers
+// [i, i+1) x [j, j+1)), coordinates repeating; channels 0..255, unrounded.
+std::array<double, 3> bilinear_repeat(const Image& rgb, double x, double y);
 // 10·log10(255² / MSE); identical images give +infinity.
 double psnr(const Image& a, const Image& b);
 

@@ -1,0 +1,52 @@
+// vds encoder: the rendered views a textured model is measured by
+// (docs/model-mode.md, "Figures"): a double-precision rasteriser that draws
+// the model unlit — either its texture through its UV map (bilinear, the
+// reference) or its mesh colors (the mesh colors paper's linear filter) —
+// from cameras on an orbit around it, with n x n supersampling, and the
+// PSNR of a render against the reference over the pixels the model covers.
+#pragma once
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "vds/enc/image_io.h"
+#include "vds/enc/mesh_colors.h"
+#include "vds/ref/scene.h"
+
+namespace vds::enc {
+
+struct ModelViews {
+  int width = 256;
+  int height = 256;
+  int supersample = 3;
+  std::vector<ref::CameraD> cameras;
+};
+
+// `count` cameras evenly round the up axis (`up`: 1 for +y, 2 for +z)
+// through the centre of the model's bounds, alternately 20 degrees above
+// and below the horizon, each framing the bounding sphere with a 40-degree
+// field of view.
+ModelViews orbit_views(const std::vector<std::array<double, 3>>& positions, int count, int width, int height,
+                       int supersample, int up = 1);
+
+// One view of the model: RGB and a coverage mask (255 where the model is).
+struct ModelFrame {
+  Image rgb;
+  Image mask;
+};
+
+// The model through its UV map with `textures` in place of its own (same
+// count and sizes; pass model.textures for the reference).
+ModelFrame render_textured(const TexturedModel& model, const std::vector<Image>& textures, const ref::CameraD& cam,
+                           const ModelViews& v);
+
+// The model's mesh colors at level m, from the planes of that level.
+ModelFrame render_mesh_colors(const MeshColorsModel& mc, const std::array<std::vector<uint8_t>, 3>& planes, int m,
+                              const ref::CameraD& cam, const ModelViews& v);
+
+// Mean squared error of `test` against `ref` over the pixels ref covers.
+double masked_mse(const ModelFrame& ref, const ModelFrame& test);
+// 10 log10(255^2 / mse) (99 for 0).
+double psnr_of_mse(double mse);
+
+}  // namespace vds::enc

@@ -1,0 +1,400 @@
+// vds encoder: the mesh colors codec's encoder (paper mode). The bitstream
+// is defined by the client's decoder (vds/mesh_colors.h); this file writes
+// what it reads.
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "vds/enc/arith_encoder.h"
+#include "vds/enc/mesh_colors.h"
+#include "vds/image_model.h"
+#include "vds/mesh_colors.h"
+
+namespace vds::enc {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// The modified DCT-II of length n: out[0] the mean, out[k] = sum x_i cos(pi/n (i + 1/2) k).
+void forward_dct(const double* x, int n, double* out, int in_stride = 1, int out_stride = 1) {
+  double mean = 0;
+  for (int i = 0; i < n; ++i) mean += x[i * in_stride];
+  out[0] = mean / n;
+  for (int k = 1; k < n; ++k) {
+    double s = 0;
+    for (int i = 0; i < n; ++i) s += x[i * in_stride] * std::cos(kPi / n * (i + 0.5) * k);
+    out[k * out_stride] = s;
+  }
+}
+
+int64_t div_round(int64_t a, int64_t b) { return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b); }
+
+int32_t quantise(double coef, uint32_t step_q4) { return static_cast<int32_t>(std::lround(coef * 16 / step_q4)); }
+
+uint8_t to_sample(int32_t q4) { return static_cast<uint8_t>(std::clamp((q4 + 8) >> 4, 0, 255)); }
+
+struct Block {
+  int comp = 0;
+  int kind = 0;  // 0 face, 1 edge
+  int positions = 0;
+  int32_t dc_diff = 0;
+  std::vector<int32_t> ac;  // in the order the decoder reads them
+};
+
+struct Pair {
+  uint32_t run;
+  int32_t amp;
+};
+
+// The pairs of one context set's AC sequence (vds/mesh_colors.h).
+std::vector<Pair> make_pairs(const std::vector<int32_t>& seq) {
+  std::vector<Pair> out;
+  uint32_t zeros = 0;
+  for (int32_t v : seq) {
+    if (v == 0) {
+      ++zeros;
+      continue;
+    }
+    while (zeros > mc::kMaxRun) {
+      out.push_back({mc::kMaxRun, 0});
+      zeros -= mc::kMaxRun;
+    }
+    out.push_back({zeros, v});
+    zeros = 0;
+  }
+  while (zeros > 0) {
+    const uint32_t r = std::min(zeros, mc::kMaxRun);
+    out.push_back({r, 0});
+    zeros -= r;
+  }
+  return out;
+}
+
+// The orthonormal DCT-II of length n (the vds mode).
+void forward_orthonormal(const double* x, int n, double* out, int in_stride = 1, int out_stride = 1) {
+  for (int k = 0; k < n; ++k) {
+    double s = 0;
+    for (int i = 0; i < n; ++i) s += x[i * in_stride] * std::cos(kPi / n * (i + 0.5) * k);
+    out[k * out_stride] = s * (k == 0 ? std::sqrt(1.0 / n) : std::sqrt(2.0 / n));
+  }
+}
+
+// The vds mode's levels of a block (lv[0 .. positions - 1], scan order):
+// the mirror of the client's read_levels (decoder/src/mesh_colors.cpp).
+void write_levels(ArithEncoder& enc, mc::BlockContexts& cx, int cls, int kind, int positions, uint8_t& prev_nz,
+                  const std::vector<int32_t>& lv) {
+  uint32_t nz = 0;
+  for (int z = 0; z < positions; ++z) nz += lv[z] != 0;
+  enc.encode_ueg(cx.nz[cls][kind][image_model::kNzBucketOf[prev_nz]], mc::BlockContexts::kNzCtx, nz, mc::kNzCutoff,
+                 mc::kNzOrder);
+  prev_nz = static_cast<uint8_t>(nz);
+  uint32_t left = nz;
+  int order = 0;
+  for (int z = 0; z < positions && left > 0; ++z) {
+    const int32_t v = lv[z];
+    if (static_cast<uint32_t>(positions - z) != left)
+      enc.encode_bit(cx.sig[cls][kind][image_model::kSigPosOf[z]][image_model::kSigLeftOf[left]], v != 0);
+    if (v == 0) continue;
+    const int lp = image_model::kLevelPosOf[z], ll = image_model::kLevelLeftOf[left];
+    const uint32_t mag = static_cast<uint32_t>(v < 0 ? -v : v);
+    enc.encode_bit(cx.gt1[cls][kind][lp][ll], mag > 1);
+    if (mag > 1) {
+      enc.encode_bit(cx.gt2[cls][kind][lp][ll], mag > 2);
+      if (mag > 2) {
+        const uint32_t rest = mag - 3;
+        enc.encode_exp_golomb(nullptr, 0, rest, order);
+        if (rest > (mc::kRestRaise << order) && order < mc::kRestMaxOrder) ++order;
+      }
+    }
+    enc.encode_bypass(v < 0);
+    --left;
+  }
+}
+
+std::vector<uint8_t> encode_level(const MeshColorsModel& model, mc::MeshColors& layout, const mc::Steps& steps, int m,
+                                  uint8_t mode, double deadzone) {
+  layout.layout_level(m);
+  const mc::Layout& l = layout.layout();
+  const mc::Topology& topo = layout.topology();
+  const bool paper = mode == mc::kModePaper;
+  const auto& planes = model.levels[static_cast<size_t>(m)];
+  std::array<std::vector<uint8_t>, 3> recon = planes;  // every block replaced by its reconstruction in turn
+  std::vector<Block> blocks;
+  auto quantise_ac = [&](double coef, uint32_t step_q4) {
+    if (paper) return quantise(coef, step_q4);
+    const double a = std::fabs(coef) * 16 / step_q4;
+    const int32_t q = static_cast<int32_t>(std::floor(a + 0.5 - deadzone));
+    return coef < 0 ? -std::max(q, 0) : std::max(q, 0);
+  };
+
+  for (uint32_t e = 0; e < topo.edges; ++e) {
+    const uint32_t n = mc::edge_samples(mc::level_res(layout.edge_res()[e], m));
+    const uint32_t base = l.edge_base + l.edge_offset[e];
+    int64_t prev_q[3] = {0, 0, 0};
+    for (uint32_t b = 0; 8 * b < n; ++b) {
+      const int len = static_cast<int>(std::min<uint32_t>(8, n - 8 * b));
+      for (int c = 0; c < 3; ++c) {
+        const uint32_t* step = steps.edge[c == 0 ? 0 : 1];
+        double x[8], X[8];
+        for (int i = 0; i < len; ++i) x[i] = planes[c][base + 8 * b + i];
+        const int64_t vertex_q4 = int64_t{16} * model.vertex_ycc[3 * topo.edge_vertex[2 * e] + c];
+        uint8_t* dst = recon[c].data() + base + 8 * b;
+        const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
+        const int64_t pred = paper && b > 0 ? prev_q[c] : div_round(b == 0 ? vertex_q4 : mc::mean_q4(dst - 8, 8), dc_step);
+        Block blk;
+        blk.comp = c;
+        blk.kind = 1;
+        blk.positions = len;
+        int32_t q[8];
+        int64_t mean_q4 = 0;
+        if (paper) {
+          forward_dct(x, len, X);
+          q[0] = quantise(X[0], step[0]);
+          blk.dc_diff = static_cast<int32_t>(q[0] - pred);
+          for (int k = 1; k < len; ++k) blk.ac.push_back(q[k] = quantise(X[k], step[k]));
+        } else {
+          double mean = 0;
+          for (int i = 0; i < len; ++i) mean += x[i] / len;
+          const int32_t qm = quantise(mean, dc_step);  // the mean's index
+          blk.dc_diff = static_cast<int32_t>(qm - pred);
+          mean_q4 = int64_t{qm} * dc_step;
+          for (int i = 0; i < len; ++i) x[i] -= mean_q4 / 16.0;
+          forward_orthonormal(x, len, X);
+          for (int k = 0; k < len; ++k) blk.ac.push_back(q[k] = quantise_ac(X[k], step[k]));
+        }
+        const int32_t dc_index = paper ? q[0] : static_cast<int32_t>(blk.dc_diff + pred);
+        mc::reconstruct_edge_block(q, len, step, mode, mean_q4, dst);
+        q[0] = dc_index;
+        prev_q[c] = q[0];
+        blocks.push_back(std::move(blk));
+      }
+    }
+  }
+
+  for (uint32_t f = 0; f < topo.faces; ++f) {
+    const int rf = mc::level_res(model.face_res[f], m);
+    if (mc::face_samples(rf) == 0) continue;
+    const int32_t n = static_cast<int32_t>(mc::resolution(rf)) - 2;
+    const uint32_t base = l.face_base + l.face_offset[f];
+    int64_t corner_q4[3];
+    for (int c = 0; c < 3; ++c) {
+      int64_t sum = 0;
+      for (int k = 0; k < 3; k += 2) {
+        const uint32_t fe = topo.face_edge[3 * f + k], e = fe >> 1;
+        const uint32_t ne = mc::edge_samples(mc::level_res(layout.edge_res()[e], m));
+        const uint8_t* src = recon[c].data() + l.edge_base + l.edge_offset[e];
+        const bool at_start = (k == 0) == ((fe & 1u) == 0);
+        const uint32_t from = at_start ? 0 : 8 * ((ne - 1) / 8);
+        const uint32_t to = at_start ? std::min<uint32_t>(ne, 8) : ne;
+        sum += mc::mean_q4(src + from, to - from);
+      }
+      corner_q4[c] = sum;
+    }
+    int64_t left_q[3] = {0, 0, 0}, row_q[3] = {0, 0, 0}, left_mean[3] = {0, 0, 0}, row_mean[3] = {0, 0, 0};
+    for (int32_t br = 0; 8 * br < n; ++br)
+      for (int32_t bc = 0; n - 8 * (br + bc) >= 1; ++bc) {
+        const int32_t D = n - 8 * (br + bc);
+        const int rows = std::min(D, 8);
+        const int positions = mc::face_block_positions(D);
+        for (int c = 0; c < 3; ++c) {
+          const uint32_t* step = steps.face[c == 0 ? 0 : 1];
+          double x[64] = {}, rowX[64] = {}, Z[64] = {};
+          const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
+          const int64_t pred =
+              paper ? (bc > 0 ? left_q[c] : (br > 0 ? row_q[c] : div_round(corner_q4[c], 2 * dc_step)))
+                    : div_round(bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : div_round(corner_q4[c], 2)), dc_step);
+          double sum = 0;
+          for (int r = 0; r < rows; ++r) {
+            const int32_t gr = 8 * br + r;
+            const int len = std::min(8, D - r);
+            const uint8_t* src = planes[c].data() + base + static_cast<uint32_t>(gr * n - gr * (gr - 1) / 2 + 8 * bc);
+            for (int i = 0; i < len; ++i) sum += x[8 * r + i] = src[i];
+          }
+          Block blk;
+          blk.comp = c;
+          blk.kind = 0;
+          blk.positions = positions;
+          int32_t q[64] = {};
+          int64_t mean_q4 = 0;
+          if (paper) {
+            for (int r = 0; r < rows; ++r) forward_dct(x + 8 * r, std::min(8, D - r), rowX + 8 * r);
+            for (int k = 0; k < rows; ++k) forward_dct(rowX + k, std::min(8, D - k), Z + k, 8, 8);
+            q[0] = quantise(Z[0], step[0]);
+            blk.dc_diff = static_cast<int32_t>(q[0] - pred);
+            for (int z = 1; z < positions; ++z) {
+              const int pos = image_model::kZigzag[z];
+              blk.ac.push_back(q[pos] = quantise(Z[pos], step[pos]));
+            }
+          } else {
+            const int32_t qm = quantise(sum / positions, dc_step);
+            blk.dc_diff = static_cast<int32_t>(qm - pred);
+            mean_q4 = int64_t{qm} * dc_step;
+            for (int r = 0; r < rows; ++r) {
+              const int len = std::min(8, D - r);
+              for (int i = 0; i < len; ++i) x[8 * r + i] -= mean_q4 / 16.0;
+              forward_orthonormal(x + 8 * r, len, rowX + 8 * r);
+            }
+            for (int k = 0; k < rows; ++k) forward_orthonormal(rowX + k, std::min(8, D - k), Z + k, 8, 8);
+            for (int z = 0; z < positions; ++z) {
+              const int pos = image_model::kZigzag[z];
+              blk.ac.push_back(q[pos] = quantise_ac(Z[pos], step[pos]));
+            }
+          }
+          const int64_t mean = mc::reconstruct_face_block(q, D, step, mode, mean_q4, recon[c].data() + base, n, br, bc);
+          if (!paper) q[0] = static_cast<int32_t>(blk.dc_diff + pred);
+          left_q[c] = q[0];
+          left_mean[c] = mean;
+          if (bc == 0) {
+            row_q[c] = q[0];
+            row_mean[c] = mean;
+          }
+          blocks.push_back(std::move(blk));
+        }
+      }
+  }
+
+  ArithEncoder enc;
+  if (paper) {
+    // The pairs of each context set, then everything in the decoder's order.
+    std::vector<int32_t> seq[3][2];
+    for (const Block& b : blocks) seq[b.comp][b.kind].insert(seq[b.comp][b.kind].end(), b.ac.begin(), b.ac.end());
+    std::vector<Pair> pairs[3][2];
+    size_t cursor[3][2] = {};
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 2; ++k) pairs[c][k] = make_pairs(seq[c][k]);
+    struct State {
+      uint32_t zeros = 0;
+      bool has_amp = false;
+    } st[3][2];
+    mc::CodecContexts cx;
+    cx.reset();
+    for (const Block& b : blocks) {
+      const int c = b.comp, k = b.kind;
+      enc.encode_signed(cx.dc_zero[c][k], cx.dc_mag[c][k], mc::CodecContexts::kDcCtx, b.dc_diff, mc::kDcCutoff,
+                        mc::kDcOrder);
+      for (size_t i = 0; i < b.ac.size(); ++i) {
+        State& s = st[c][k];
+        if (s.zeros > 0) {
+          --s.zeros;
+          continue;
+        }
+        if (s.has_amp) {
+          s.has_amp = false;
+          continue;
+        }
+        const Pair p = pairs[c][k].at(cursor[c][k]++);
+        enc.encode_ueg(cx.run[c][k], mc::CodecContexts::kRunCtx, p.run, mc::kRunCutoff, mc::kRunOrder);
+        enc.encode_signed(cx.amp_zero[c][k], cx.amp_mag[c][k], mc::CodecContexts::kAmpCtx, p.amp, mc::kAmpCutoff,
+                          mc::kAmpOrder);
+        if (p.amp == 0) {
+          s.zeros = p.run - 1;
+        } else if (p.run > 0) {
+          s.zeros = p.run - 1;
+          s.has_amp = true;
+        }
+      }
+    }
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 2; ++k)
+        if (cursor[c][k] != pairs[c][k].size()) throw std::logic_error("mesh colors: pairs left unwritten");
+  } else {
+    mc::BlockContexts cx;
+    cx.reset();
+    uint8_t prev_nz[2][2] = {};
+    for (const Block& b : blocks) {
+      const int cls = b.comp == 0 ? 0 : 1;
+      enc.encode_signed(cx.dc_zero[cls][b.kind], cx.dc_mag[cls][b.kind], mc::BlockContexts::kDcCtx, b.dc_diff,
+                        mc::kDcCutoff, mc::kDcOrder);
+      write_levels(enc, cx, cls, b.kind, b.positions, prev_nz[cls][b.kind], b.ac);
+    }
+  }
+  std::vector<uint8_t> out{static_cast<uint8_t>(m)};
+  const std::vector<uint8_t> body = enc.finish();
+  out.insert(out.end(), body.begin(), body.end());
+  return out;
+}
+
+struct Layout {
+  std::vector<uint8_t> work;
+  Arena arena;
+  mc::MeshColors mc;
+};
+
+void set_up(const MeshColorsModel& model, uint16_t q8, uint8_t mode, Layout& l) {
+  const uint32_t F = static_cast<uint32_t>(model.face_res.size());
+  const uint32_t V = static_cast<uint32_t>(model.positions.size());
+  l.work.assign(mc::MeshColors::init_bytes(F, V), 0);
+  l.arena = Arena(l.work.data(), l.work.size());
+  if (l.mc.init(l.arena, model.triangles.data(), F, V) != Status::ok ||
+      l.mc.set(model.face_res.data(), model.vertex_ycc.data(), q8, mode) != Status::ok)
+    throw std::invalid_argument("mesh colors: the model's mesh is not one a client can hold");
+}
+
+}  // namespace
+
+MccEncoded encode_mesh_colors(const MeshColorsModel& model, double quality, const MccOptions& o) {
+  const uint16_t q8 = static_cast<uint16_t>(std::clamp<long>(std::lround(quality * 256), 1, 65535));
+  const uint8_t mode = o.paper ? mc::kModePaper : mc::kModeVds;
+  Layout l;
+  set_up(model, q8, mode, l);
+  const uint32_t F = static_cast<uint32_t>(model.face_res.size());
+  const uint32_t V = static_cast<uint32_t>(model.positions.size());
+  MccEncoded out;
+  std::vector<uint8_t>& h = out.header;
+  h = {mc::kVersion, mode, static_cast<uint8_t>(model.max_res), 0, static_cast<uint8_t>(q8 & 0xFF),
+       static_cast<uint8_t>(q8 >> 8), static_cast<uint8_t>(V & 0xFF), static_cast<uint8_t>(V >> 8),
+       static_cast<uint8_t>(F & 0xFF), static_cast<uint8_t>((F >> 8) & 0xFF), static_cast<uint8_t>((F >> 16) & 0xFF),
+       static_cast<uint8_t>(F >> 24)};
+  if (o.paper) h.insert(h.end(), model.vertex_ycc.begin(), model.vertex_ycc.end());
+  ArithEncoder enc;
+  ArithContext ctx[mc::kMaxResLog2 + 1][mc::kMaxResLog2];
+  arith_init_contexts(&ctx[0][0], (mc::kMaxResLog2 + 1) * mc::kMaxResLog2);
+  int prev = 0;
+  if (model.max_res > 0)
+    for (uint32_t f = 0; f < F; ++f) {
+      enc.encode_unary(ctx[prev], mc::kMaxResLog2, model.face_res[f], static_cast<uint32_t>(model.max_res));
+      prev = model.face_res[f];
+    }
+  if (!o.paper) {
+    const mc::Topology& topo = l.mc.topology();
+    std::vector<uint8_t> scratch(mc::adjacency_bytes(topo.vertices, topo.edges));
+    Arena arena(scratch.data(), scratch.size());
+    mc::Adjacency adj;
+    if (mc::build_adjacency(arena, topo, &adj) != Status::ok) throw std::logic_error("mesh colors: adjacency");
+    mc::VertexContexts vx;
+    vx.reset();
+    for (uint32_t v = 0; v < V; ++v)
+      for (int c = 0; c < 3; ++c) {
+        const int cls = c == 0 ? 0 : 1;
+        const int32_t r = model.vertex_ycc[3 * v + c] - mc::vertex_prediction(adj, model.vertex_ycc.data(), v, c);
+        enc.encode_signed(vx.zero[cls], vx.mag[cls], mc::VertexContexts::kMagCtx, r, mc::kDcCutoff, mc::kDcOrder);
+      }
+  }
+  const std::vector<uint8_t> body = enc.finish();
+  h.insert(h.end(), body.begin(), body.end());
+  mc::Steps steps;
+  mc::make_steps(q8, mode, &steps);
+  for (int m = 0; m < model.max_res; ++m) out.levels.push_back(encode_level(model, l.mc, steps, m, mode, o.deadzone));
+  return out;
+}
+
+std::array<std::vector<uint8_t>, 3> decode_mesh_colors_level(const MeshColorsModel& model, const MccEncoded& enc, int m) {
+  Layout l;
+  set_up(model, 256, mc::kModePaper, l);
+  Status s = l.mc.read_header(enc.header.data(), enc.header.size());
+  if (s != Status::ok) throw std::runtime_error(std::string("mesh colors header refused: ") + status_name(s));
+  const uint32_t total = l.mc.layout_level(m);
+  std::array<std::vector<uint8_t>, 3> planes{std::vector<uint8_t>(total), std::vector<uint8_t>(total),
+                                             std::vector<uint8_t>(total)};
+  if (m == model.max_res) {  // vertices only
+    for (uint32_t v = 0; v < model.positions.size(); ++v)
+      for (int c = 0; c < 3; ++c) planes[c][v] = l.mc.vertex_samples()[3 * v + c];
+    return planes;
+  }
+  s = l.mc.decode_level(enc.levels.at(static_cast<size_t>(m)).data(), enc.levels[static_cast<size_t>(m)].size(),
+                        mc::Planes{planes[0].data(), planes[1].data(), planes[2].data()});
+  if (s != Status::ok) throw std::runtime_error(std::string("mesh colors level refused: ") + status_name(s));
+  return planes;
+}
+
+}  // namespace vds::enc

@@ -1,0 +1,443 @@
+// Mesh colors and their codec: the topology's edge numbering, the lattice
+// layout (every sample of a level named exactly once, shared edges named
+// alike from both faces), the transform pair, the paper-mode codec through
+// the client library (bounds on error, bytes falling with quality, the
+// encoder's edge reconstruction equal to the client's), refused headers,
+// every prefix and flipped bytes refused cleanly, the textured import of the
+// duck and mrfixit, and the IQM check.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <random>
+#include <set>
+#include <string>
+
+#include "vds/enc/mesh_colors.h"
+#include "vds/enc/stream_writer.h"
+#include "vds/mesh_colors.h"
+#include "vds/ref/scene.h"
+
+namespace {
+
+using namespace vds;
+
+// A tetrahedron: every edge shared by two faces in opposite directions.
+const uint16_t kTetra[] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
+
+vds::enc::MccOptions paper_mode() {
+  vds::enc::MccOptions o;
+  o.paper = true;
+  return o;
+}
+
+struct Held {
+  std::vector<uint8_t> work;
+  Arena arena;
+  mc::MeshColors mc;
+  Status init(const std::vector<uint16_t>& tri, uint32_t vertices) {
+    const uint32_t faces = static_cast<uint32_t>(tri.size() / 3);
+    work.assign(mc::MeshColors::init_bytes(faces, vertices), 0);
+    arena = Arena(work.data(), work.size());
+    return mc.init(arena, tri.data(), faces, vertices);
+  }
+};
+
+TEST(MeshColorsTopology, EdgesAreNumberedByFirstAppearanceAndSharedBothWays) {
+  std::vector<uint8_t> work(mc::topology_bytes(4));
+  Arena arena(work.data(), work.size());
+  mc::Topology t;
+  ASSERT_EQ(mc::build_topology(arena, kTetra, 4, 4, &t), Status::ok);
+  EXPECT_EQ(t.edges, 6u);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(t.face_edge[k], static_cast<uint32_t>(k) << 1);  // face 0 names them first
+  std::map<uint32_t, int> uses, reversed;
+  for (uint32_t f = 0; f < 4; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t fe = t.face_edge[3 * f + k], e = fe >> 1;
+      ++uses[e];
+      reversed[e] += fe & 1;
+      const uint16_t a = kTetra[3 * f + k], b = kTetra[3 * f + (k + 1) % 3];
+      EXPECT_EQ(t.edge_vertex[2 * e], (fe & 1) ? b : a);
+      EXPECT_EQ(t.edge_vertex[2 * e + 1], (fe & 1) ? a : b);
+    }
+  for (uint32_t e = 0; e < 6; ++e) {
+    EXPECT_EQ(uses[e], 2);
+    EXPECT_EQ(reversed[e], 1);  // the second face runs it the other way
+  }
+  // Scratch given back: only the persistent arrays stay carved.
+  EXPECT_LE(arena.used(), 3 * 4 * 4 + 6 * 4 * 2 + 16u);
+}
+
+TEST(MeshColorsTopology, RefusesIndicesOutOfRangeAndRepeatedVertices) {
+  std::vector<uint8_t> work(mc::topology_bytes(1));
+  mc::Topology t;
+  const uint16_t out_of_range[] = {0, 1, 3};
+  const uint16_t repeated[] = {0, 1, 1};
+  Arena a1(work.data(), work.size());
+  EXPECT_EQ(mc::build_topology(a1, out_of_range, 1, 3, &t), Status::invalid_argument);
+  Arena a2(work.data(), work.size());
+  EXPECT_EQ(mc::build_topology(a2, repeated, 1, 3, &t), Status::invalid_argument);
+  Arena a3(work.data(), work.size());
+  EXPECT_EQ(mc::build_topology(a3, repeated, 1, mc::kMaxVertices + 1, &t), Status::invalid_argument);
+  Arena small(work.data(), 8);
+  EXPECT_EQ(mc::build_topology(small, kTetra, 1, 4, &t), Status::workspace_too_small);
+}
+
+// A grid of n x n quads over [0, 1]^2 (z = 0), two triangles each, the UV
+// map the plane itself.
+enc::TexturedModel grid_model(int n, const enc::Image& texture) {
+  enc::TexturedModel m;
+  m.name = "grid";
+  for (int y = 0; y <= n; ++y)
+    for (int x = 0; x <= n; ++x) m.positions.push_back({double(x) / n, double(y) / n, 0});
+  m.materials.push_back({0, {1, 1, 1}});
+  m.textures.push_back(texture);
+  auto uv = [&](uint32_t v) { return std::array<double, 2>{m.positions[v][0], m.positions[v][1]}; };
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      const uint32_t a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+      for (const std::array<uint32_t, 3>& t : {std::array<uint32_t, 3>{a, b, d}, std::array<uint32_t, 3>{a, d, c}}) {
+        m.triangles.push_back(t);
+        m.uv.push_back({uv(t[0]), uv(t[1]), uv(t[2])});
+        m.colour.push_back({std::array<double, 3>{1, 1, 1}, std::array<double, 3>{1, 1, 1}, std::array<double, 3>{1, 1, 1}});
+        m.material.push_back(0);
+      }
+    }
+  return m;
+}
+
+enc::MeshColorsModel test_colors(int max_res = 5) {
+  const enc::Image tex = ref::make_noise_texture(128, 11, 0x203040, 0xE0C060);
+  enc::MeshColorsOptions o;
+  o.max_res_log2 = max_res;
+  return enc::to_mesh_colors(grid_model(4, tex), o);
+}
+
+TEST(MeshColorsLayout, EveryLatticePointNamesOneSampleAndSharedEdgesAgree) {
+  enc::MeshColorsModel m = test_colors();
+  // Mixed resolutions: every third face one step coarser.
+  for (size_t f = 0; f < m.face_res.size(); f += 3) m.face_res[f] = static_cast<uint8_t>(m.face_res[f] - 1);
+  Held h;
+  ASSERT_EQ(h.init(m.triangles, static_cast<uint32_t>(m.positions.size())), Status::ok);
+  ASSERT_EQ(h.mc.set(m.face_res.data(), m.vertex_ycc.data(), 256), Status::ok);
+  for (int level = 0; level <= h.mc.max_res_log2(); ++level) {
+    const uint32_t total = h.mc.layout_level(level);
+    // The position each sample stands for, from every face that names it.
+    std::vector<std::array<double, 3>> where(total);
+    std::vector<int> named(total, 0);
+    for (uint32_t f = 0; f < h.mc.topology().faces; ++f) {
+      const uint32_t R = mc::resolution(mc::level_res(m.face_res[f], level));
+      for (uint32_t j = 0; j <= R; ++j)
+        for (uint32_t i = 0; i + j <= R; ++i) {
+          const uint32_t s = h.mc.sample_index(f, level, i, j);
+          ASSERT_LT(s, total);
+          std::array<double, 3> p{};
+          const double w[3] = {double(R - i - j) / R, double(i) / R, double(j) / R};
+          for (int k = 0; k < 3; ++k)
+            for (int c = 0; c < 3; ++c) p[c] += w[k] * m.positions[m.triangles[3 * f + k]][c];
+          if (named[s]++ == 0) {
+            where[s] = p;
+          } else {
+            for (int c = 0; c < 3; ++c) ASSERT_NEAR(where[s][c], p[c], 1e-12) << "sample " << s << " level " << level;
+          }
+        }
+    }
+    // Edge samples a coarser face skips are named by the finer face only;
+    // every sample is named at least once.
+    for (uint32_t s = 0; s < total; ++s) EXPECT_GT(named[s], 0) << "sample " << s << " of level " << level;
+  }
+}
+
+TEST(MeshColorsCodec, InverseTransformUndoesTheForward) {
+  std::mt19937 rng(5);
+  for (int n = 1; n <= 8; ++n)
+    for (int trial = 0; trial < 200; ++trial) {
+      double x[8], X[8];
+      for (int i = 0; i < n; ++i) x[i] = rng() % 256;
+      double mean = 0;
+      for (int i = 0; i < n; ++i) mean += x[i];
+      X[0] = mean / n;
+      for (int k = 1; k < n; ++k) {
+        X[k] = 0;
+        for (int i = 0; i < n; ++i) X[k] += x[i] * std::cos(3.14159265358979323846 / n * (i + 0.5) * k);
+      }
+      int32_t in[8], out[8];
+      for (int k = 0; k < n; ++k) in[k] = static_cast<int32_t>(std::lround(X[k] * 16));
+      mc::inverse_dct(in, n, out);
+      for (int i = 0; i < n; ++i) ASSERT_NEAR(out[i], x[i] * 16, 2.0) << "n " << n;
+    }
+}
+
+double plane_psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
+  double se = 0;
+  for (size_t i = 0; i < a.size(); ++i) se += (double(a[i]) - b[i]) * (double(a[i]) - b[i]);
+  return se == 0 ? 99 : 10 * std::log10(255.0 * 255.0 * a.size() / se);
+}
+
+TEST(MeshColorsCodec, RoundTripThroughTheClientWithinBoundsAndSmallerAtLowerQuality) {
+  const enc::MeshColorsModel m = test_colors();
+  ASSERT_EQ(m.max_res, 5);
+  size_t previous = SIZE_MAX;
+  const double quality[] = {0.1, 1, 4};
+  // The thesis's steps quantise the DC (the mean) with the tables' first
+  // step: coarse for chroma at high quality factors.
+  const double min_luma[] = {41, 30, 23}, min_chroma[] = {44, 30, 18};
+  for (int qi = 0; qi < 3; ++qi) {
+    const enc::MccEncoded e = enc::encode_mesh_colors(m, quality[qi], paper_mode());
+    ASSERT_EQ(e.levels.size(), 5u);
+    size_t bytes = 0;
+    for (int level = 0; level < m.max_res; ++level) {
+      bytes += e.levels[level].size();
+      const auto planes = enc::decode_mesh_colors_level(m, e, level);
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(planes[c].size(), m.levels[level][c].size());
+        // Vertex samples travel uncoded.
+        for (size_t v = 0; v < m.positions.size(); ++v) ASSERT_EQ(planes[c][v], m.levels[level][c][v]);
+        EXPECT_GE(plane_psnr(planes[c], m.levels[level][c]), c == 0 ? min_luma[qi] : min_chroma[qi])
+            << "quality " << quality[qi] << " level " << level << " component " << c;
+      }
+    }
+    EXPECT_LT(bytes, previous) << "quality " << quality[qi];
+    previous = bytes;
+  }
+}
+
+TEST(MeshColorsCodec, TheVdsModeRoundTripsWithinBoundsAndBeatsThePaperMode) {
+  const enc::MeshColorsModel m = test_colors();
+  auto level0 = [&](double quality, const enc::MccOptions& o, double* psnr) {
+    const enc::MccEncoded e = enc::encode_mesh_colors(m, quality, o);
+    const auto planes = enc::decode_mesh_colors_level(m, e, 0);
+    *psnr = plane_psnr(planes[0], m.levels[0][0]);
+    return e.levels[0].size();
+  };
+  // Bounds, and fewer bytes at lower quality.
+  const double quality[] = {0.125, 0.25, 0.5, 1, 2, 4, 8};
+  const double min_psnr[] = {48, 45, 42, 39, 35, 31, 27};
+  std::vector<std::pair<size_t, double>> vds;
+  for (int qi = 0; qi < 7; ++qi) {
+    double p;
+    const size_t bytes = level0(quality[qi], enc::MccOptions{}, &p);
+    EXPECT_GE(p, min_psnr[qi]) << "quality " << quality[qi];
+    if (!vds.empty()) EXPECT_LT(bytes, vds.back().first) << "quality " << quality[qi];
+    vds.emplace_back(bytes, p);
+    // Vertex samples are coded losslessly, every level decodes.
+    const enc::MccEncoded e = enc::encode_mesh_colors(m, quality[qi]);
+    for (int level = 0; level < m.max_res; ++level) {
+      const auto planes = enc::decode_mesh_colors_level(m, e, level);
+      for (int c = 0; c < 3; ++c)
+        for (size_t v = 0; v < m.positions.size(); ++v) ASSERT_EQ(planes[c][v], m.levels[level][c][v]);
+    }
+  }
+  // Every paper-mode point is beaten: some vds point has no more bytes and a higher PSNR.
+  for (double q : {0.25, 1.0, 4.0}) {
+    double p;
+    const size_t bytes = level0(q, paper_mode(), &p);
+    bool beaten = false;
+    for (const auto& [b, pv] : vds) beaten |= b <= bytes && pv >= p;
+    EXPECT_TRUE(beaten) << "paper quality " << q << ": " << bytes << " bytes, " << p << " dB";
+  }
+}
+
+TEST(MeshColorsCodec, AFlatColourCostsAlmostNothingInTheVdsMode) {
+  enc::MeshColorsModel m = test_colors();
+  for (auto& level : m.levels)
+    for (int c = 0; c < 3; ++c) std::fill(level[c].begin(), level[c].end(), static_cast<uint8_t>(90 + 40 * c));
+  for (size_t i = 0; i < m.vertex_ycc.size(); ++i) m.vertex_ycc[i] = static_cast<uint8_t>(90 + 40 * (i % 3));
+  const enc::MccEncoded e = enc::encode_mesh_colors(m, 2);
+  for (int level = 0; level < m.max_res; ++level) {
+    EXPECT_LT(e.levels[level].size(), 40u) << "level " << level;
+    const auto planes = enc::decode_mesh_colors_level(m, e, level);
+    // Flat everywhere, within half the mean's step (4 levels at quality 2) of the colour.
+    for (int c = 0; c < 3; ++c)
+      for (size_t i = m.positions.size(); i < planes[c].size(); ++i) {
+        ASSERT_EQ(planes[c][i], planes[c][m.positions.size()]) << "level " << level << " sample " << i;
+        ASSERT_LE(std::abs(planes[c][i] - m.levels[level][c][i]), 2) << "level " << level << " sample " << i;
+      }
+  }
+}
+
+TEST(MeshColorsCodec, HeadersAClientCannotTakeAreRefused) {
+  const enc::MeshColorsModel m = test_colors(3);
+  const enc::MccEncoded e = enc::encode_mesh_colors(m, 1, paper_mode());
+  Held h;
+  ASSERT_EQ(h.init(m.triangles, static_cast<uint32_t>(m.positions.size())), Status::ok);
+  ASSERT_EQ(h.mc.read_header(e.header.data(), e.header.size()), Status::ok);
+  EXPECT_EQ(h.mc.max_res_log2(), 3);
+  auto with = [&](size_t at, uint8_t value) {
+    std::vector<uint8_t> b = e.header;
+    b[at] = value;
+    return h.mc.read_header(b.data(), b.size());
+  };
+  EXPECT_EQ(with(0, 0), Status::malformed);
+  EXPECT_EQ(with(0, 2), Status::unsupported_version);
+  EXPECT_TRUE(is_error(with(1, 1)));  // a paper header read as a vds one: its raw vertex bytes are no code
+  EXPECT_EQ(with(1, 7), Status::malformed);
+  EXPECT_EQ(with(2, 11), Status::malformed);  // above kMaxResLog2
+  EXPECT_TRUE(is_error(with(2, 4)));         // not the largest face's (the codes end early)
+  EXPECT_EQ(with(3, 1), Status::malformed);  // flags
+  std::vector<uint8_t> zero_quality = e.header;
+  zero_quality[4] = zero_quality[5] = 0;
+  EXPECT_EQ(h.mc.read_header(zero_quality.data(), zero_quality.size()), Status::malformed);
+  EXPECT_EQ(with(6, static_cast<uint8_t>(e.header[6] + 1)), Status::malformed);  // vertex count
+  EXPECT_EQ(with(8, static_cast<uint8_t>(e.header[8] + 1)), Status::malformed);  // face count
+  std::vector<uint8_t> longer = e.header;
+  longer.push_back(0);
+  EXPECT_EQ(h.mc.read_header(longer.data(), longer.size()), Status::malformed);
+  // A level beyond the header's, and a level before any header.
+  ASSERT_EQ(h.mc.read_header(e.header.data(), e.header.size()), Status::ok);
+  std::vector<uint8_t> level = e.levels[0];
+  level[0] = 3;
+  const uint32_t total = h.mc.layout_level(0);
+  std::vector<uint8_t> y(total), cb(total), cr(total);
+  EXPECT_EQ(h.mc.decode_level(level.data(), level.size(), mc::Planes{y.data(), cb.data(), cr.data()}), Status::malformed);
+  Held fresh;
+  ASSERT_EQ(fresh.init(m.triangles, static_cast<uint32_t>(m.positions.size())), Status::ok);
+  EXPECT_EQ(fresh.mc.decode_level(e.levels[0].data(), e.levels[0].size(), mc::Planes{y.data(), cb.data(), cr.data()}),
+            Status::invalid_argument);
+}
+
+class MeshColorsModes : public ::testing::TestWithParam<bool> {};
+
+TEST_P(MeshColorsModes, EveryPrefixAndFlippedBytesAreRefusedCleanly) {
+  const enc::MeshColorsModel m = test_colors(4);
+  enc::MccOptions o;
+  o.paper = GetParam();
+  const enc::MccEncoded e = enc::encode_mesh_colors(m, 1, o);
+  Held h;
+  ASSERT_EQ(h.init(m.triangles, static_cast<uint32_t>(m.positions.size())), Status::ok);
+  for (size_t n = 0; n < e.header.size(); ++n)
+    EXPECT_TRUE(is_error(h.mc.read_header(e.header.data(), n))) << "header prefix " << n;
+  ASSERT_EQ(h.mc.read_header(e.header.data(), e.header.size()), Status::ok);
+  const uint32_t total = h.mc.layout_level(0);
+  std::vector<uint8_t> y(total), cb(total), cr(total);
+  const mc::Planes planes{y.data(), cb.data(), cr.data()};
+  for (int level = 0; level < 4; ++level) {
+    const std::vector<uint8_t>& b = e.levels[level];
+    ASSERT_EQ(h.mc.decode_level(b.data(), b.size(), planes), Status::ok);
+    for (size_t n = 0; n < b.size(); ++n) EXPECT_TRUE(is_error(h.mc.decode_level(b.data(), n, planes))) << n;
+  }
+  // Flipped bytes: any status, never a crash or a write outside the planes
+  // (the sanitizers watch), and the level's size stays its own.
+  std::mt19937 rng(3);
+  int refused = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    std::vector<uint8_t> b = e.levels[trial % 4];
+    const size_t at = 1 + rng() % (b.size() - 1);
+    b[at] ^= static_cast<uint8_t>(1 + rng() % 255);
+    refused += is_error(h.mc.decode_level(b.data(), b.size(), planes));
+  }
+  EXPECT_GT(refused, 150);  // most damage is caught by the exact-length rule or a value no encoder writes
+}
+
+INSTANTIATE_TEST_SUITE_P(PaperAndVds, MeshColorsModes, ::testing::Values(true, false),
+                         [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "paper" : "vds"; });
+
+// Real data: assimp-testmodels, which make test installs (scripts/fetch-data.sh).
+TEST(MeshColorsImport, TheDuckAndMrFixitConvertAndRoundTrip) {
+  const char* duck = "/usr/share/assimp/models/Collada/duck_triangulate.dae";
+  const char* fixit = "/usr/share/assimp/models/IQM/mrfixit.iqm";
+  for (const char* path : {duck, fixit})
+    ASSERT_TRUE(std::ifstream(path).good()) << path << " not installed: scripts/fetch-data.sh installs assimp-testmodels";
+  const enc::TexturedModel d = enc::load_textured_model(duck);
+  EXPECT_EQ(d.positions.size(), 2108u);
+  EXPECT_EQ(d.triangles.size(), 4212u);
+  ASSERT_EQ(d.textures.size(), 1u);
+  EXPECT_EQ(d.textures[0].width, 512);
+  const enc::TexturedModel f = enc::load_textured_model(fixit);
+  ASSERT_EQ(f.textures.size(), 2u);  // Body and Head, found by name with another extension
+  EXPECT_GT(f.triangles.size(), 2000u);
+  enc::MeshColorsOptions o;
+  o.max_res_log2 = 4;
+  for (const enc::TexturedModel* t : {&d, &f}) {
+    const enc::MeshColorsModel m = enc::to_mesh_colors(*t, o);
+    const enc::MccEncoded e = enc::encode_mesh_colors(m, 1);
+    const auto planes = enc::decode_mesh_colors_level(m, e, 0);
+    EXPECT_GE(plane_psnr(planes[0], m.levels[0][0]), 34) << t->name;  // mrfixit measured 35.5
+  }
+}
+
+std::vector<uint8_t> read_bytes(const char* path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::vector<uint8_t>(std::istreambuf_iterator<char>(f), {});
+}
+
+TEST(MeshColorsImport, IqmCountsThatDoNotFitAreRefusedNamingTheFile) {
+  const char* fixit = "/usr/share/assimp/models/IQM/mrfixit.iqm";
+  const std::vector<uint8_t> good = read_bytes(fixit);
+  ASSERT_GT(good.size(), 124u) << fixit << " not installed";
+  const std::string dir = std::string(::testing::TempDir()) + "/iqm_check";
+  std::filesystem::create_directories(dir);
+  auto refused = [&](std::vector<uint8_t> bytes, const std::string& want) {
+    const std::string path = dir + "/bad.iqm";
+    enc::write_file(path, bytes);
+    try {
+      enc::load_textured_model(path);
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+      return;
+    }
+    ADD_FAILURE() << "accepted: " << want;
+  };
+  auto set32 = [](std::vector<uint8_t>& b, size_t at, uint32_t v) {
+    for (int i = 0; i < 4; ++i) b[at + i] = static_cast<uint8_t>(v >> (8 * i));
+  };
+  std::vector<uint8_t> b = good;
+  set32(b, 16 + 4 * 8, 0x10000000);  // num_vertexes
+  refused(b, "do not fit");
+  b = good;
+  set32(b, 16 + 4 * 10, 0x40000000);  // num_triangles
+  refused(b, "do not fit");
+  b = good;
+  b.resize(good.size() - 1);
+  refused(b, "the header says the file is");
+  b = good;
+  set32(b, 16, 1);  // version
+  refused(b, "IQM version 1");
+}
+
+}  // namespace
+
+namespace {
+
+std::string collada(const std::string& array_count, const std::string& accessor_count, const std::string& p) {
+  return "<?xml version=\"1.0\"?><COLLADA xmlns=\"http://www.collada.org/2005/11/COLLADASchema\" version=\"1.4.1\">"
+         "<library_geometries><geometry id=\"g\"><mesh><source id=\"p\"><float_array id=\"pa\" count=\"" +
+         array_count +
+         "\">0 0 0 1 0 0 0 1 0</float_array><technique_common><accessor source=\"#pa\" count=\"" + accessor_count +
+         "\" stride=\"3\"><param name=\"X\" type=\"float\"/><param name=\"Y\" type=\"float\"/>"
+         "<param name=\"Z\" type=\"float\"/></accessor></technique_common></source><vertices id=\"v\">"
+         "<input semantic=\"POSITION\" source=\"#p\"/></vertices><triangles count=\"1\">"
+         "<input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>" +
+         p +
+         "</p></triangles></mesh></geometry></library_geometries><library_visual_scenes><visual_scene id=\"s\"><node>"
+         "<instance_geometry url=\"#g\"/></node></visual_scene></library_visual_scenes><scene>"
+         "<instance_visual_scene url=\"#s\"/></scene></COLLADA>";
+}
+
+std::string refusal(const std::string& doc) {
+  try {
+    vds::enc::read_textured_model(reinterpret_cast<const uint8_t*>(doc.data()), doc.size(), "m.dae");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MeshColorsImport, ColladaCountsAndIndicesThatLieAreRefusedNamingTheFile) {
+  EXPECT_EQ(refusal(collada("9", "3", "0 1 2")), "");  // the valid document (no texture: untextured faces)
+  EXPECT_NE(refusal(collada("0", "3", "0 1 2")).find("m.dae: <float_array count=\"0\"> holds 9 values"), std::string::npos);
+  EXPECT_NE(refusal(collada("9", "4", "0 1 2")).find("an accessor of 4 x 3 from 0 in an array of 9"), std::string::npos);
+  EXPECT_NE(refusal(collada("9", "3", "0 1 3")).find("index 3 names one of 3 elements"), std::string::npos);
+  EXPECT_NE(refusal(collada("9", "3", "0 1")).find("holds 2 corners"), std::string::npos);
+  EXPECT_NE(refusal(collada("9", "3", "0 1 -2")).find("is not a non-negative integer"), std::string::npos);
+  EXPECT_NE(refusal(collada("99999999999", "3", "0 1 2")).find("is not a count"), std::string::npos);
+  EXPECT_NE(refusal("<COLLADA><unclosed></COLLADA>").find("m.dae: not an XML document"), std::string::npos);
+}
+
+}  // namespace
