@@ -85,8 +85,10 @@ def main():
     fig.tight_layout()
     fig.savefig(os.path.join(results, "model_rd.png"), dpi=90)
     head = ["## Summary: BD-rate of the mesh colors codecs on rendered-view PSNR", "",
-            "mcc-vds is the improved codec (vds mode), mcc-paper the thesis's. Negative: fewer bytes than the anchor "
-            "for the same rendered PSNR, over the PSNR range both reach.", "",
+            "mcc-vds is the improved codec (vds mode; its sample density follows the quality, "
+            "`density_for_quality`), mcc-paper the thesis's (one sample per texel side). Bytes: the header and "
+            "level 0, what a client needs to show level 0; the anchors: the texture file(s). Negative: fewer bytes "
+            "than the anchor for the same rendered PSNR, over the PSNR range both reach.", "",
             "| model | codec | against | BD-rate |", "|---|---|---|---:|"]
     head += ["| %s | %s | %s | %s |" % (n, c, a, "no overlap" if b is None else "%+.1f %%" % b) for n, c, a, b in summary]
     head += ["", "Goal (issue): the improved codec at <= -25 % against JPEG and <= 0 % against WebP.", "",

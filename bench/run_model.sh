@@ -13,7 +13,8 @@
 #   colors codec against each anchor.
 #
 # Usage: bench/run_model.sh [BUILD_DIR]   (default build/host-release)
-#   MODELS (default: the duck, the milk truck, mrfixit); WORK (default BUILD_DIR/model);
+#   MODELS (default: the duck, the milk truck, mrfixit, an OpenArena player's torso: PLAYER=major);
+#   WORK (default BUILD_DIR/model);
 #   VIEWS=24 SIZE=256 SUPERSAMPLE=3; QUALITIES (mesh colors quality factors); MAX_RES (face resolution cap, 2^r).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
@@ -23,13 +24,24 @@ VDS="$BUILD/encoder/vds"
 WORK=${WORK:-$BUILD/model}
 RESULTS=${RESULTS:-$ROOT/bench/results}
 A=/usr/share/assimp/models
-MODELS=${MODELS:-"duck:$A/Collada/duck_triangulate.dae truck:$A/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf mrfixit:$A/IQM/mrfixit.iqm"}
-# Models whose up axis is +z (none of the defaults: assimp gives these +y).
-Z_UP=${Z_UP:-}
+mkdir -p "$WORK"
+# An OpenArena player's torso (openarena-data's pak2-players.pk3), taken out
+# of the archive with its skin and textures.
+PLAYER=${PLAYER:-major}
+/usr/bin/python3 - "$WORK/oa" "$PLAYER" <<'PY'
+import sys, zipfile
+z = zipfile.ZipFile("/usr/share/games/openarena/baseoa/pak2-players.pk3")
+for n in z.namelist():
+    if n.startswith("models/players/%s/" % sys.argv[2]):
+        z.extract(n, sys.argv[1])
+PY
+MODELS=${MODELS:-"duck:$A/Collada/duck_triangulate.dae truck:$A/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf mrfixit:$A/IQM/mrfixit.iqm $PLAYER:$WORK/oa/models/players/$PLAYER/upper.md3"}
+# Models whose up axis is +z (Quake III's); assimp gives the others +y.
+Z_UP=${Z_UP:-$PLAYER}
 VIEWS=${VIEWS:-24}
 SIZE=${SIZE:-256}
 SS=${SUPERSAMPLE:-3}
-QUALITIES=${QUALITIES:-0.25 0.5 1 2 4 8 16}
+QUALITIES=${QUALITIES:-0.125 0.25 0.5 1 2 4 8 16}
 MAX_RES=${MAX_RES:-8}   # R <= 256: the truck's few larger faces change its figures by under 0.2 dB and double the time
 for tool in cjpeg cwebp dwebp avifenc avifdec; do
   command -v $tool >/dev/null || { echo "run_model: $tool missing (scripts/setup.sh installs it)" >&2; exit 1; }

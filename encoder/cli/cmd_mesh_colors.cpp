@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,7 +38,7 @@ using enc::save_png;
 struct MeshColorsOptions {
   std::string input;
   std::vector<double> quality{0.25, 0.5, 1, 2, 4};
-  double density = 1;
+  double density = 0;  // 0: the vds codec's density follows the quality
   int max_res = 10;
   std::string csv;
   int views = 0;
@@ -49,6 +50,7 @@ struct MeshColorsOptions {
   std::string sheet;
   std::string up = "y";
   std::vector<std::string> codecs{"vds", "paper"};
+  double deadzone = enc::MccOptions{}.deadzone;
 };
 
 void write_ppm(const std::string& path, const Image& img) {
@@ -120,13 +122,8 @@ double plane_psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b, 
 
 void run(const MeshColorsOptions& o) {
   enc::TexturedModel model;
-  enc::MeshColorsModel mcm;
   try {
     model = enc::load_textured_model(o.input);
-    enc::MeshColorsOptions mo;
-    mo.density = o.density;
-    mo.max_res_log2 = o.max_res;
-    mcm = enc::to_mesh_colors(model, mo);
   } catch (const std::runtime_error& e) {
     throw Failure(kExitBadInput, e.what());
   }
@@ -134,42 +131,74 @@ void run(const MeshColorsOptions& o) {
               model.triangles.size(), model.dropped_faces, model.textures.size());
   for (size_t i = 0; i < model.textures.size(); ++i)
     std::printf("%s %dx%d", i == 0 ? ":" : ",", model.textures[i].width, model.textures[i].height);
-  std::printf("\nresolutions:");
-  std::vector<size_t> hist(mc::kMaxResLog2 + 1, 0);
-  for (uint8_t r : mcm.face_res) ++hist[r];
-  for (int r = 0; r <= mc::kMaxResLog2; ++r)
-    if (hist[r] > 0) std::printf(" R=%d: %zu faces", 1 << r, hist[r]);
-  std::printf("\nlevels:");
-  for (int m = 0; m <= mcm.max_res; ++m) std::printf(" %d: %u samples", m, mcm.samples(m));
-  std::printf("\n\n codec | quality | level | bytes | ratio | PSNR Y' | PSNR Cb | PSNR Cr\n---|---:|---:|---:|---:|---:|---:|---:\n");
+  std::printf("\n");
+  // The mesh colors at each sample density used, converted once each.
+  std::map<double, enc::MeshColorsModel> converted;
+  auto colors = [&](double density) -> const enc::MeshColorsModel& {
+    auto it = converted.find(density);
+    if (it != converted.end()) return it->second;
+    enc::MeshColorsOptions mo;
+    mo.density = density;
+    mo.max_res_log2 = o.max_res;
+    enc::MeshColorsModel mcm;
+    try {
+      mcm = enc::to_mesh_colors(model, mo);
+    } catch (const std::runtime_error& e) {
+      throw Failure(kExitBadInput, e.what());
+    }
+    std::printf("density %g: resolutions", density);
+    std::vector<size_t> hist(mc::kMaxResLog2 + 1, 0);
+    for (uint8_t r : mcm.face_res) ++hist[r];
+    for (int r = 0; r <= mc::kMaxResLog2; ++r)
+      if (hist[r] > 0) std::printf(" R=%d: %zu faces", 1 << r, hist[r]);
+    std::printf("; samples per level");
+    for (int m = 0; m <= mcm.max_res; ++m) std::printf(" %d: %u", m, mcm.samples(m));
+    std::printf("; header %zu bytes (vds)\n", enc::encode_mesh_colors(mcm, 1).header.size());
+    return converted.emplace(density, std::move(mcm)).first->second;
+  };
+  // The vds codec's density follows the quality unless --density fixes it;
+  // the thesis's codec keeps one sample per texel.
+  auto density_of = [&](const std::string& codec, double q) {
+    return o.density > 0 ? o.density : (codec == "paper" ? 1.0 : enc::density_for_quality(q));
+  };
   std::ofstream csv;
   if (!o.csv.empty()) {
     csv.open(o.csv);
     if (!csv) throw Failure(kExitBadInput, o.csv + ": cannot write");
-    csv << "codec,quality,level,samples,bytes,ratio,psnr_y,psnr_cb,psnr_cr\n";
+    csv << "codec,quality,density,level,samples,bytes,ratio,psnr_y,psnr_cb,psnr_cr\n";
   }
-  const size_t V = mcm.positions.size();
-  auto options = [](const std::string& codec) {
+  auto options = [&o](const std::string& codec) {
     enc::MccOptions mo;
     mo.paper = codec == "paper";
+    mo.deadzone = o.deadzone;
     return mo;
   };
+  std::vector<std::string> table;
   for (const std::string& codec : o.codecs)
-  for (double q : o.quality) {
-    const enc::MccEncoded e = enc::encode_mesh_colors(mcm, q, options(codec));
-    for (int m = 0; m < mcm.max_res; ++m) {
-      const auto planes = enc::decode_mesh_colors_level(mcm, e, m);
-      const size_t coded = mcm.samples(m) - V;  // the codec's samples: edges and faces
-      const size_t bytes = e.levels[m].size();
-      const double ratio = 3.0 * coded / bytes;
-      double p[3];
-      for (int c = 0; c < 3; ++c) p[c] = plane_psnr(mcm.levels[m][c], planes[c], V);
-      std::printf("%s | %.3g | %d | %zu | %.2f | %.2f | %.2f | %.2f\n", codec.c_str(), q, m, bytes, ratio, p[0], p[1], p[2]);
-      if (csv) csv << codec << "," << q << "," << m << "," << coded << "," << bytes << "," << ratio << "," << p[0] << "," << p[1] << "," << p[2] << "\n";
+    for (double q : o.quality) {
+      const double density = density_of(codec, q);
+      const enc::MeshColorsModel& mcm = colors(density);
+      const size_t V = mcm.positions.size();
+      const enc::MccEncoded e = enc::encode_mesh_colors(mcm, q, options(codec));
+      for (int m = 0; m < mcm.max_res; ++m) {
+        const auto planes = enc::decode_mesh_colors_level(mcm, e, m);
+        const size_t coded = mcm.samples(m) - V;  // the codec's samples: edges and faces
+        const size_t bytes = e.levels[m].size();
+        const double ratio = 3.0 * coded / bytes;
+        double p[3];
+        for (int c = 0; c < 3; ++c) p[c] = plane_psnr(mcm.levels[m][c], planes[c], V);
+        char line[160];
+        std::snprintf(line, sizeof line, "%s | %.3g | %g | %d | %zu | %.2f | %.2f | %.2f | %.2f", codec.c_str(), q, density,
+                      m, bytes, ratio, p[0], p[1], p[2]);
+        table.push_back(line);
+        if (csv)
+          csv << codec << "," << q << "," << density << "," << m << "," << coded << "," << bytes << "," << ratio << ","
+              << p[0] << "," << p[1] << "," << p[2] << "\n";
+      }
     }
-  }
-  std::printf("\nheader (resolutions and %zu vertex samples): %zu bytes for every quality\n", V,
-              enc::encode_mesh_colors(mcm, 1).header.size());
+  std::printf("\n codec | quality | density | level | bytes | ratio | PSNR Y' | PSNR Cb | PSNR Cr\n"
+              "---|---:|---:|---:|---:|---:|---:|---:|---:\n");
+  for (const std::string& line : table) std::printf("%s\n", line.c_str());
 
   if (!o.dump_textures.empty())
     for (size_t i = 0; i < model.textures.size(); ++i) {
@@ -202,12 +231,14 @@ void run(const MeshColorsOptions& o) {
     return std::make_pair(enc::psnr_of_mse(mse / views.cameras.size()), first);
   };
   {
+    const enc::MeshColorsModel& mcm = colors(o.density > 0 ? o.density : 1.0);
     auto [p, img] = measure([&](const ref::CameraD& c) { return enc::render_mesh_colors(mcm, mcm.levels[0], 0, c, views); });
     rows.push_back({"mesh colors", "uncoded", 3 * mcm.samples(0), p, img});
   }
   size_t coded_rows = 0;
   for (const std::string& codec : o.codecs)
     for (double q : o.quality) {
+      const enc::MeshColorsModel& mcm = colors(density_of(codec, q));
       const enc::MccEncoded e = enc::encode_mesh_colors(mcm, q, options(codec));
       const auto planes = enc::decode_mesh_colors_level(mcm, e, 0);
       auto [p, img] = measure([&](const ref::CameraD& c) { return enc::render_mesh_colors(mcm, planes, 0, c, views); });
@@ -267,7 +298,11 @@ void add_mesh_colors(CLI::App& app) {
   c->add_option("--quality", o->quality, "quality factors (the JPEG tables' multiplier)")->check(kPositive);
   c->add_option("--codec", o->codecs, "mesh colors codecs: vds (the improved one), paper (the thesis's)")
       ->check(CLI::IsMember({"vds", "paper"}));
-  c->add_option("--density", o->density, "samples per texel side")->check(kPositive);
+  c->add_option("--deadzone", o->deadzone, "vds codec: levels rounded down below 0.5 + this of a step")
+      ->check(CLI::Range(0.0, 0.5));
+  c->add_option("--density", o->density,
+                 "samples per texel side (default: the vds codec's follows the quality, the thesis's is 1)")
+      ->check(kPositive);
   c->add_option("--max-res", o->max_res, "largest face resolution exponent (R = 2^r)")->check(CLI::Range(0, 10));
   c->add_option("--csv", o->csv, "also write the table as CSV");
   c->add_option("--views", o->views, "rendered views round the model (0: none)")->check(CLI::Range(0, 360));

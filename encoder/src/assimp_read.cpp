@@ -7,12 +7,14 @@
 #include <stdexcept>
 
 #include <assimp/BaseImporter.h>
+#include <assimp/config.h>
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/MemoryIOWrapper.h>
 
 #include "mesh_glb_check.h"
 #include "mesh_collada_check.h"
 #include "mesh_iqm_check.h"
+#include "mesh_md3_check.h"
 #include "mesh_ply_check.h"
 #include "text.h"
 
@@ -60,14 +62,18 @@ std::string check_mtl(const uint8_t* data, size_t size, const std::string& name)
 // `main` (its own name with its format's extension), so that a loader's
 // fallback names derived from it (an OBJ's "NAME.mtl") resolve like any
 // other file. A model held in memory may open no other file. Material
-// libraries are checked (check_mtl) before the loader sees them.
+// libraries (check_mtl) and the further parts of an MD3 player (check_md3)
+// are checked before the loader sees them.
 class ConfinedIO : public Assimp::DefaultIOSystem {
  public:
   ConfinedIO(std::filesystem::path root, std::string main, const uint8_t* data, size_t size)
       : root_(std::move(root)), main_(std::move(main)), data_(data), size_(size) {}
+  // Asking whether a file outside the folder exists is not refused (loaders
+  // probe for optional files: an MD3's shader scripts); opening one is.
   bool Exists(const char* file) const override {
-    if (file != nullptr && main_ == file) return true;
-    const std::string p = resolve(file);
+    if (file == nullptr) return false;
+    if (main_ == file) return true;
+    const std::string p = confined_path(root_, file);
     return !p.empty() && DefaultIOSystem::Exists(p.c_str());
   }
   Assimp::IOStream* Open(const char* file, const char* mode) override {
@@ -75,17 +81,27 @@ class ConfinedIO : public Assimp::DefaultIOSystem {
     if (file != nullptr && main_ == file) return new Assimp::MemoryIOStream(data_, size_, false);
     const std::string p = resolve(file);
     if (p.empty()) return nullptr;
-    if (extension_of(p) != "mtl") return DefaultIOSystem::Open(p.c_str(), mode);
+    const std::string ext = extension_of(p);
+    if (ext != "mtl" && ext != "md3") return DefaultIOSystem::Open(p.c_str(), mode);
     std::unique_ptr<Assimp::IOStream> in(DefaultIOSystem::Open(p.c_str(), mode));
     if (!in) return nullptr;
     const size_t n = in->FileSize();
     if (n > (size_t{64} << 20)) {
-      if (problem_.empty()) problem_ = std::string(file) + ": a material library over 64 MiB";
+      if (problem_.empty()) problem_ = std::string(file) + ": a file over 64 MiB";
       return nullptr;
     }
     auto* bytes = new uint8_t[n == 0 ? 1 : n];
     const size_t got = n == 0 ? 0 : in->Read(bytes, 1, n);
-    const std::string bad = got == n ? check_mtl(bytes, n, file) : std::string(file) + ": cannot be read whole";
+    std::string bad = got == n ? std::string() : std::string(file) + ": cannot be read whole";
+    if (bad.empty() && ext == "mtl") bad = check_mtl(bytes, n, file);
+    // The other parts of a multi-part MD3 player (upper, head) are checked as the first was.
+    if (bad.empty() && ext == "md3") {
+      try {
+        check_md3(bytes, n, file);
+      } catch (const std::runtime_error& e) {
+        bad = e.what();
+      }
+    }
     if (!bad.empty()) {
       delete[] bytes;
       if (problem_.empty()) problem_ = bad;
@@ -101,10 +117,13 @@ class ConfinedIO : public Assimp::DefaultIOSystem {
  private:
   // A file the model names (relative to the model's folder), as an absolute
   // path inside that folder; "" (and noted) if it lies outside.
+  // A model held in memory (no root) opens nothing else, and a loader that
+  // needs another file says so itself; one on disk is told which file lay
+  // outside its folder.
   std::string resolve(const char* file) const {
     if (file == nullptr) return "";
     const std::string a = confined_path(root_, file);
-    if (a.empty() && refused_.empty()) refused_ = file;
+    if (a.empty() && refused_.empty() && !root_.empty()) refused_ = file;
     return a;
   }
   std::filesystem::path root_;
@@ -119,7 +138,7 @@ class ConfinedIO : public Assimp::DefaultIOSystem {
 // (tests/fuzz/fuzz_mesh_import.cpp). Assimp reads dozens more, some of
 // which trust the counts a file declares.
 bool imported_format(const std::string& ext) {
-  static const char* const kFormats[] = {"obj", "ply", "gltf", "glb", "3ds", "dae", "iqm"};
+  static const char* const kFormats[] = {"obj", "ply", "gltf", "glb", "3ds", "dae", "iqm", "md3"};
   for (const char* f : kFormats)
     if (ext == f) return true;
   return false;
@@ -142,12 +161,21 @@ const aiScene* read_with_assimp(Assimp::Importer& importer, const uint8_t* data,
   // IQM's counts and offsets are checked by the project's own reader first:
   // assimp's loader takes them as given.
   if (format == "iqm") check_iqm(data, size, name);
+  if (format == "md3") check_md3(data, size, name);
   // Collada's counts, strides and indices too.
   if (format == "dae") check_collada(data, size, name);
   // The model under its own name with its format's extension (see ConfinedIO).
   std::string stem = std::filesystem::path(name).stem().string();
   if (stem.empty() || stem.find('$') != std::string::npos) stem = "model";
   const std::string main = stem + "." + format;
+  // An MD3's shader scripts live in the game's folders, outside the model's:
+  // looked for in the model's folder only (the skin files beside the model
+  // name its textures).
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_MD3_LOAD_SHADERS, false);
+  // A player's parts are read one file at a time (assimp's multi-part
+  // loading reads them through importers of its own, without these settings).
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_MD3_HANDLE_MULTIPART, false);
+  if (!root.empty()) importer.SetPropertyString(AI_CONFIG_IMPORT_MD3_SHADER_SRC, root.string() + "/");
   ConfinedIO* io = new ConfinedIO(root, main, data, size);  // owned by the importer
   importer.SetIOHandler(io);
   // Only the loader of the format the name says: assimp would otherwise
@@ -155,7 +183,7 @@ const aiScene* read_with_assimp(Assimp::Importer& importer, const uint8_t* data,
   // looks like a PLY to it) and hand the bytes to a loader nothing checked.
   if (!imported_format(format) || importer.GetImporter(format.c_str()) == nullptr)
     throw std::runtime_error(name + ": not a mesh format this tool reads ('" + format +
-                             "'; it reads .obj, .ply, .gltf, .glb, .3ds, .dae, .iqm and .drc)");
+                             "'; it reads .obj, .ply, .gltf, .glb, .3ds, .dae, .iqm, .md3 and .drc)");
   for (size_t i = importer.GetImporterCount(); i-- > 0;) {
     Assimp::BaseImporter* loader = importer.GetImporter(i);
     std::set<std::string> extensions;

@@ -186,6 +186,10 @@ TexturedModel read_textured_model(const uint8_t* data, size_t size, const std::s
   return read_model(data, size, name, std::filesystem::path());
 }
 
+double density_for_quality(double quality) {
+  return std::clamp(0.5 / std::sqrt(std::max(quality, 1e-6)), 0.25, 1.0);
+}
+
 std::array<uint8_t, 3> rgb_to_ycc(double r, double g, double b) {
   const double y = 0.299 * r + 0.587 * g + 0.114 * b;
   const double cb = (b - y) * 0.5643 + 128, cr = (r - y) * 0.7132 + 128;

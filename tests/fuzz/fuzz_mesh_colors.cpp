@@ -28,8 +28,8 @@
 
 namespace {
 
-const char* const kNames[] = {"input.obj", "input.gltf", "input.glb", "input.dae", "input.iqm", "input.3ds"};
-constexpr int kFormats = 6;
+const char* const kNames[] = {"input.obj", "input.gltf", "input.glb", "input.dae", "input.iqm", "input.3ds", "input.md3"};
+constexpr int kFormats = 7;
 
 // A fixed 3 x 3 grid of quads with mixed resolutions, and a valid stream for it.
 struct Fixed {

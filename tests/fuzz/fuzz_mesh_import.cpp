@@ -1,7 +1,7 @@
 // libFuzzer: the host's mesh import (vds/enc/mesh_import.h), what `vds
 // encode-mesh` does with a user's file: the project's PLY check, assimp
 // (with its data-structure validation) for OBJ, PLY, glTF, GLB, Collada
-// and IQM (IQM checked by the project's own reader first), libdraco
+// IQM and MD3 (those two checked by the project's own readers first), libdraco
 // for Draco, then the repair rule. The first byte picks the format the
 // file's name says; the rest is the file. Invariants: no crash, sanitizer
 // report, hang or allocation beyond libFuzzer's limit; a refusal is a
@@ -10,7 +10,7 @@
 //
 // Seed corpus: when the corpus directory is empty, small valid files are
 // written to it first (an OBJ, an ASCII and a binary PLY, a glTF with its
-// buffer inline, a GLB, a Draco mesh, a Collada file, an IQM file).
+// buffer inline, a GLB, a Draco mesh, a Collada file, an IQM file, an MD3).
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -27,8 +27,8 @@
 namespace {
 
 const char* const kNames[] = {"input.obj", "input.ply", "input.gltf", "input.glb", "input.drc",
-                              "input.3ds", "input.off", "input.dae", "input.iqm"};
-constexpr int kFormats = 9;  // .off: a format the tool refuses
+                              "input.3ds", "input.off", "input.dae", "input.iqm", "input.md3"};
+constexpr int kFormats = 10;  // .off: a format the tool refuses
 
 void write(const std::filesystem::path& p, uint8_t pick, const std::string& body) {
   std::ofstream f(p, std::ios::binary);
@@ -134,6 +134,26 @@ void seed(const std::filesystem::path& dir) {
     for (const auto& p : tri) iqm += lef(p[0]) + lef(p[1]) + lef(p[2]);
     iqm += le32(0) + le32(1) + le32(2);
     write(dir / "seed_iqm", 8, iqm);
+  }
+  // MD3: one frame, one surface of three vertices and one triangle.
+  {
+    auto pad = [](std::string s, size_t n) { s.resize(n, '\0'); return s; };
+    const uint32_t surface_at = 108 + 56;
+    std::string md3 = "IDP3" + le32(15) + pad("t", 64) + le32(0) + le32(1) + le32(0) + le32(1) + le32(0) + le32(108) +
+                      le32(surface_at) + le32(surface_at) + le32(0);
+    md3 += std::string(56, '\0');  // the frame
+    const uint32_t tri = 108, st = tri + 12, xyz = st + 24, end = xyz + 24;
+    std::string surface = "IDP3" + pad("s", 64) + le32(0) + le32(1) + le32(0) + le32(3) + le32(1) + le32(tri) +
+                          le32(tri) + le32(st) + le32(xyz) + le32(end);
+    surface += le32(0) + le32(1) + le32(2);
+    for (int i = 0; i < 3; ++i) surface += lef(i == 1 ? 1.0f : 0.0f) + lef(i == 2 ? 1.0f : 0.0f);
+    const int16_t xyzs[3][4] = {{0, 0, 0, 0}, {64, 0, 0, 0}, {0, 64, 0, 0}};
+    for (const auto& v : xyzs)
+      for (int16_t c : v) surface += std::string(1, static_cast<char>(c & 255)) + std::string(1, static_cast<char>((c >> 8) & 255));
+    md3 += surface;
+    const uint32_t eof = static_cast<uint32_t>(md3.size());
+    md3.replace(104, 4, le32(eof));
+    write(dir / "seed_md3", 9, md3);
   }
   write(dir / "seed_off", 6, "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n");
 }

@@ -204,6 +204,11 @@ huge_iqm = bytearray(iqm)
 struct.pack_into("<I", huge_iqm, 16 + 4 * 8, 1000000000)
 run("iqm_claims_1e9_vertices", ["mesh-colors", write("huge.iqm", bytes(huge_iqm))], os.path.join(TMP, "huge.iqm"), 1,
     "do not fit the file")
+# An MD3 whose header claims 100000 surfaces: refused by the project's check before assimp.
+md3 = (b"IDP3" + struct.pack("<i", 15) + b"t".ljust(64, b"\0") + struct.pack("<9i", 0, 1, 0, 100000, 0, 108, 164, 164, 164) +
+       b"\0" * 56)
+run("md3_claims_100000_surfaces", ["mesh-colors", write("huge.md3", md3)], os.path.join(TMP, "huge.md3"), 1,
+    "surfaces 100000 (0..32)")
 os.makedirs(os.path.join(TMP, "textured"), exist_ok=True)
 tex_obj = "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3\n"
 write(os.path.join("textured", "t.png"), png(4, 2, b"".join(b"\0" + bytes(range(12)) for _ in range(2))))

@@ -261,6 +261,22 @@ TEST(MeshColorsCodec, AFlatColourCostsAlmostNothingInTheVdsMode) {
   }
 }
 
+TEST(MeshColorsCodec, TheVdsEncodersSampleDensityFallsWithQualityAndSoDoTheSamples) {
+  EXPECT_EQ(enc::density_for_quality(0.125), 1.0);
+  EXPECT_EQ(enc::density_for_quality(0.25), 1.0);
+  EXPECT_DOUBLE_EQ(enc::density_for_quality(1), 0.5);
+  EXPECT_EQ(enc::density_for_quality(100), 0.25);
+  const enc::Image tex = ref::make_noise_texture(128, 11, 0x203040, 0xE0C060);
+  uint32_t previous = UINT32_MAX;
+  for (double q : {0.25, 1.0, 4.0}) {
+    enc::MeshColorsOptions o;
+    o.density = enc::density_for_quality(q);
+    const uint32_t samples = enc::to_mesh_colors(grid_model(4, tex), o).samples(0);
+    EXPECT_LT(samples, previous) << "quality " << q;
+    previous = samples;
+  }
+}
+
 TEST(MeshColorsCodec, HeadersAClientCannotTakeAreRefused) {
   const enc::MeshColorsModel m = test_colors(3);
   const enc::MccEncoded e = enc::encode_mesh_colors(m, 1, paper_mode());
@@ -438,6 +454,61 @@ TEST(MeshColorsImport, ColladaCountsAndIndicesThatLieAreRefusedNamingTheFile) {
   EXPECT_NE(refusal(collada("9", "3", "0 1 -2")).find("is not a non-negative integer"), std::string::npos);
   EXPECT_NE(refusal(collada("99999999999", "3", "0 1 2")).find("is not a count"), std::string::npos);
   EXPECT_NE(refusal("<COLLADA><unclosed></COLLADA>").find("m.dae: not an XML document"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+std::string le32s(uint32_t v) {
+  std::string s(4, '\0');
+  for (int i = 0; i < 4; ++i) s[i] = static_cast<char>(v >> (8 * i));
+  return s;
+}
+
+// A Quake III model: one frame, one surface of three vertices, one triangle.
+std::string md3(uint32_t tri_index) {
+  auto pad = [](std::string s, size_t n) {
+    s.resize(n, '\0');
+    return s;
+  };
+  const uint32_t surface_at = 108 + 56, tri = 108, st = tri + 12, xyz = st + 24, end = xyz + 24;
+  std::string m = "IDP3" + le32s(15) + pad("t", 64) + le32s(0) + le32s(1) + le32s(0) + le32s(1) + le32s(0) + le32s(108) +
+                  le32s(surface_at) + le32s(surface_at) + le32s(surface_at + end);
+  m += std::string(56, '\0');
+  m += "IDP3" + pad("s", 64) + le32s(0) + le32s(1) + le32s(0) + le32s(3) + le32s(1) + le32s(tri) + le32s(tri) +
+       le32s(st) + le32s(xyz) + le32s(end);
+  m += le32s(0) + le32s(1) + le32s(tri_index);
+  m += std::string(24, '\0');  // texture coordinates
+  const char xyzs[24] = {0, 0, 0, 0, 0, 0, 0, 0, 64, 0, 0, 0, 0, 0, 0, 0, 0, 0, 64, 0, 0, 0, 0, 0};
+  m += std::string(xyzs, 24);
+  return m;
+}
+
+std::string md3_refusal(const std::string& bytes) {
+  try {
+    vds::enc::read_textured_model(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), "p.md3");
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MeshColorsImport, Md3CountsAndIndicesThatLieAreRefusedNamingTheFile) {
+  // The valid file passes the check (from memory it stops at its texture,
+  // which it cannot open).
+  EXPECT_EQ(md3_refusal(md3(2)).find("(byte "), std::string::npos) << md3_refusal(md3(2));
+  EXPECT_NE(md3_refusal(md3(3)).find("p.md3: surface 0 triangle 0 names vertex 3 of 3"), std::string::npos);
+  std::string b = md3(2);
+  b.replace(76, 4, le32s(5000));  // frames
+  EXPECT_NE(md3_refusal(b).find("frames 5000 (0..1024)"), std::string::npos);
+  b = md3(2);
+  b.replace(164 + 80, 4, le32s(4000));  // the surface's vertices: their table no longer fits
+  EXPECT_NE(md3_refusal(b).find("do not fit the file"), std::string::npos);
+  b = md3(2);
+  b.replace(4, 4, le32s(16));
+  EXPECT_NE(md3_refusal(b).find("MD3 version 16"), std::string::npos);
+  EXPECT_NE(md3_refusal(md3(2).substr(0, 200)).find("p.md3: "), std::string::npos);
 }
 
 }  // namespace

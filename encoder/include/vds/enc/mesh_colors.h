@@ -82,6 +82,12 @@ struct MeshColorsModel {
   uint32_t samples(int m) const { return static_cast<uint32_t>(levels[m][0].size()); }
 };
 
+// The vds encoder's sample density for quality factor q: one sample per
+// texel side at q <= 0.25, then fewer as q grows (0.5 / sqrt(q), at least
+// 0.25): as a video encoder lowers the resolution at low rates, a coarser
+// lattice coded finely beats a fine one coded coarsely.
+double density_for_quality(double quality);
+
 // Converts (the rule above). Throws std::runtime_error for a model beyond
 // the client's limits (65,535 vertices, vds::mc::kMaxFaces faces).
 MeshColorsModel to_mesh_colors(const TexturedModel& model, const MeshColorsOptions& o = MeshColorsOptions{});
@@ -103,7 +109,7 @@ struct MccOptions {
   // position (the image codec's scheme, docs/texture-codec.md).
   bool paper = false;
   // vds mode: AC levels rounded down below 0.5 + deadzone of a step.
-  double deadzone = 0.2;
+  double deadzone = 0.35;
 };
 
 // Every level of `mc` at quality factor `quality` (the JPEG tables'
