@@ -51,6 +51,7 @@ struct MeshColorsOptions {
   std::string up = "y";
   std::vector<std::string> codecs{"vds", "paper"};
   double deadzone = enc::MccOptions{}.deadzone;
+  bool no_seam_boost = false;
 };
 
 void write_ppm(const std::string& path, const Image& img) {
@@ -140,6 +141,7 @@ void run(const MeshColorsOptions& o) {
     enc::MeshColorsOptions mo;
     mo.density = density;
     mo.max_res_log2 = o.max_res;
+    mo.seam_boost = !o.no_seam_boost;
     enc::MeshColorsModel mcm;
     try {
       mcm = enc::to_mesh_colors(model, mo);
@@ -300,6 +302,7 @@ void add_mesh_colors(CLI::App& app) {
       ->check(CLI::IsMember({"vds", "paper"}));
   c->add_option("--deadzone", o->deadzone, "vds codec: levels rounded down below 0.5 + this of a step")
       ->check(CLI::Range(0.0, 0.5));
+  c->add_flag("--no-seam-boost", o->no_seam_boost, "keep faces on seams whose sides differ at their own resolution");
   c->add_option("--density", o->density,
                  "samples per texel side (default: the vds codec's follows the quality, the thesis's is 1)")
       ->check(kPositive);

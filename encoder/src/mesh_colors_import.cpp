@@ -338,8 +338,7 @@ MeshColorsModel to_mesh_colors(const TexturedModel& model, const MeshColorsOptio
   std::vector<uint8_t> work(mc::MeshColors::init_bytes(F, V));
   Arena arena(work.data(), work.size());
   mc::MeshColors layout;
-  if (layout.init(arena, out.triangles.data(), F, V) != Status::ok ||
-      layout.set(out.face_res.data(), nullptr, 256) != Status::ok)
+  if (layout.init(arena, out.triangles.data(), F, V) != Status::ok)
     throw std::logic_error("mesh colors: layout set-up failed");
   const mc::Topology& topo = layout.topology();
 
@@ -359,6 +358,52 @@ MeshColorsModel to_mesh_colors(const TexturedModel& model, const MeshColorsOptio
     }
     return c;
   };
+  // A seam of the map where the two sides' colours differ (islands painted
+  // apart) is one row of averaged samples: the faces on it get twice the
+  // resolution, so that row is half as wide.
+  auto textured = [&](uint32_t f) { return model.materials[static_cast<size_t>(model.material[f])].texture >= 0; };
+  if (o.seam_boost) {
+    std::vector<std::array<int64_t, 2>> sides(topo.edges, {-1, -1});
+    std::vector<uint8_t> many(topo.edges, 0);
+    for (uint32_t f = 0; f < F; ++f)
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t e = topo.face_edge[3 * f + k] >> 1;
+        if (sides[e][0] < 0)
+          sides[e][0] = 3 * int64_t{f} + k;
+        else if (sides[e][1] < 0)
+          sides[e][1] = 3 * int64_t{f} + k;
+        else
+          many[e] = 1;
+      }
+    std::vector<uint8_t> boost(F, 0);
+    for (uint32_t e = 0; e < topo.edges; ++e) {
+      if (many[e] || sides[e][1] < 0) continue;
+      const uint32_t f = static_cast<uint32_t>(sides[e][0] / 3), g = static_cast<uint32_t>(sides[e][1] / 3);
+      const int kf = static_cast<int>(sides[e][0] % 3), kg = static_cast<int>(sides[e][1] % 3);
+      if (!textured(f) || !textured(g)) continue;
+      // Point t along the edge from its start: in f's corners kf -> kf+1 when f runs it forward.
+      const bool f_rev = (topo.face_edge[3 * f + kf] & 1u) != 0, g_rev = (topo.face_edge[3 * g + kg] & 1u) != 0;
+      double mismatch = 0;
+      for (int i = 0; i < 8; ++i) {
+        const double t = (i + 0.5) / 8;
+        std::array<double, 3> wf{0, 0, 0}, wg{0, 0, 0};
+        wf[kf] = f_rev ? t : 1 - t;
+        wf[(kf + 1) % 3] = f_rev ? 1 - t : t;
+        wg[kg] = g_rev ? t : 1 - t;
+        wg[(kg + 1) % 3] = g_rev ? 1 - t : t;
+        const auto a = colour_at(f, wf, extent[f] / mc::resolution(out.face_res[f]));
+        const auto b = colour_at(g, wg, extent[g] / mc::resolution(out.face_res[g]));
+        double d = 0;
+        for (int c = 0; c < 3; ++c) d = std::max(d, std::fabs(a[c] - b[c]));
+        mismatch += d / 8;
+      }
+      if (mismatch > 24) boost[f] = boost[g] = 1;
+    }
+    for (uint32_t f = 0; f < F; ++f)
+      if (boost[f] && out.face_res[f] < max_allowed) out.max_res = std::max<int>(out.max_res, ++out.face_res[f]);
+  }
+  if (layout.set(out.face_res.data(), nullptr, 256) != Status::ok) throw std::logic_error("mesh colors: layout set-up failed");
+
   auto to_planes = [](const Accum& a, uint32_t from, uint32_t to, std::array<std::vector<uint8_t>, 3>& planes) {
     for (uint32_t i = from; i < to; ++i) {
       const double n = a.count[i] > 0 ? a.count[i] : 1;
@@ -370,7 +415,6 @@ MeshColorsModel to_mesh_colors(const TexturedModel& model, const MeshColorsOptio
   // Where a textured face meets an untextured one, the textured face alone
   // gives the shared samples.
   std::vector<uint8_t> textured_vertex(V, 0), textured_edge(topo.edges, 0);
-  auto textured = [&](uint32_t f) { return model.materials[static_cast<size_t>(model.material[f])].texture >= 0; };
   for (uint32_t f = 0; f < F; ++f)
     if (textured(f))
       for (int k = 0; k < 3; ++k) {

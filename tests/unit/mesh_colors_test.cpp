@@ -277,6 +277,39 @@ TEST(MeshColorsCodec, TheVdsEncodersSampleDensityFallsWithQualityAndSoDoTheSampl
   }
 }
 
+TEST(MeshColorsLayout, FacesOnASeamWhoseSidesDifferGetTwiceTheResolution) {
+  // Two halves of a black-and-white texture: the grid's right half maps to
+  // the white half, so the seam down the middle has a different colour on
+  // each side.
+  enc::Image tex(64, 64, 3);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) tex.at(x, y, c) = x < 32 ? 0 : 255;
+  enc::TexturedModel m = grid_model(4, tex);
+  for (size_t f = 0; f < m.triangles.size(); ++f)
+    for (int k = 0; k < 3; ++k) m.uv[f][k][0] *= 0.45;  // all of it in the black half
+  enc::MeshColorsOptions off;
+  off.seam_boost = false;
+  // A map without seams: nothing changes.
+  EXPECT_EQ(enc::to_mesh_colors(m).face_res, enc::to_mesh_colors(m, off).face_res);
+  enc::TexturedModel seam = m;
+  for (size_t f = 0; f < seam.triangles.size(); ++f) {
+    double cx = 0;
+    for (int k = 0; k < 3; ++k) cx += seam.positions[seam.triangles[f][k]][0] / 3;
+    if (cx > 0.5)
+      for (int k = 0; k < 3; ++k) seam.uv[f][k][0] += 0.5;  // the right half's faces: white
+  }
+  const enc::MeshColorsModel a = enc::to_mesh_colors(seam, off), b = enc::to_mesh_colors(seam);
+  int boosted = 0;
+  for (size_t f = 0; f < a.face_res.size(); ++f) {
+    EXPECT_GE(b.face_res[f], a.face_res[f]);
+    boosted += b.face_res[f] > a.face_res[f];
+  }
+  // The faces along the middle column of edges: 2 of each of the 4 rows, on each side.
+  EXPECT_GE(boosted, 8);
+  EXPECT_LE(boosted, 16);
+}
+
 TEST(MeshColorsCodec, HeadersAClientCannotTakeAreRefused) {
   const enc::MeshColorsModel m = test_colors(3);
   const enc::MccEncoded e = enc::encode_mesh_colors(m, 1, paper_mode());

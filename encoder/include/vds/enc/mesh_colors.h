@@ -16,7 +16,9 @@
 //    change at a window in a painted body is as sharp as the texture
 //    beside it), or where untextured faces of different colours meet and
 //    no textured face is near, the model's median textured density; else
-//    R = 1 (vertex samples only);
+//    R = 1 (vertex samples only); faces on a seam of the map whose two
+//    sides' colours differ (by more than 24 levels, on average along it)
+//    get twice their resolution;
 //  - a sample's colour is the texture's, filtered to the sample spacing
 //    (trilinear on a box-filtered pyramid, coordinates repeating), times
 //    the material colour and the barycentric blend of the corners' vertex
@@ -67,6 +69,7 @@ struct MeshColorsOptions {
   double density = 1.0;   // samples per texel side
   int max_res_log2 = 10;  // R <= 1024
   int min_res_log2 = 0;   // for textured faces
+  bool seam_boost = true;  // faces on a seam whose sides' colours differ get twice the resolution
 };
 
 // A model's mesh colors on the host.
