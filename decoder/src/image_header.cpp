@@ -7,17 +7,8 @@ namespace vds {
 
 namespace {
 
-// T.81 Annex K tables K.1 (luminance) and K.2 (chrominance), natural order.
-// Only their shape is used: each entry relative to the DC entry.
-constexpr uint8_t kAnnexKLuma[64] = {
-    16, 11, 10, 16, 24,  40,  51,  61,  12, 12, 14, 19, 26,  58,  60,  55,
-    14, 13, 16, 24, 40,  57,  69,  56,  14, 17, 22, 29, 51,  87,  80,  62,
-    18, 22, 37, 56, 68,  109, 103, 77,  24, 35, 55, 64, 81,  104, 113, 92,
-    49, 64, 78, 87, 103, 121, 120, 101, 72, 92, 95, 98, 112, 100, 103, 99};
-constexpr uint8_t kAnnexKChroma[64] = {
-    17, 18, 24, 47, 99, 99, 99, 99, 18, 21, 26, 66, 99, 99, 99, 99, 24, 26, 56, 99, 99, 99,
-    99, 99, 47, 66, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99,
-    99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99};
+// The shapes of T.81's Annex K tables (image_model::kAnnexKLuma, kAnnexKChroma)
+// are used only relative to their DC entries.
 
 // Q8 (256 = 1.0) weight of each zig-zag position at full slope: K[k] / K[0].
 constexpr int kWeightFracBits = 8;
@@ -32,8 +23,8 @@ constexpr Shape make_shape(const uint8_t* k) {
   }
   return s;
 }
-constexpr Shape kLumaShape = make_shape(kAnnexKLuma);
-constexpr Shape kChromaShape = make_shape(kAnnexKChroma);
+constexpr Shape kLumaShape = make_shape(image_model::kAnnexKLuma);
+constexpr Shape kChromaShape = make_shape(image_model::kAnnexKChroma);
 
 // 2^(j/32) in Q15 for j = 0..31: the base step of index i is
 // 2^(i >> 5) * kPow2FracQ15[i & 31] / 2^15.

@@ -7,16 +7,6 @@
 namespace vds::mc {
 namespace {
 
-// ITU-T T.81 Annex K, tables K.1 (luminance) and K.2 (chrominance), natural order.
-constexpr uint8_t kJpegQuant[2][64] = {
-    {16, 11, 10, 16, 24,  40,  51,  61,  12, 12, 14, 19, 26,  58,  60,  55,
-     14, 13, 16, 24, 40,  57,  69,  56,  14, 17, 22, 29, 51,  87,  80,  62,
-     18, 22, 37, 56, 68,  109, 103, 77,  24, 35, 55, 64, 81,  104, 113, 92,
-     49, 64, 78, 87, 103, 121, 120, 101, 72, 92, 95, 98, 112, 100, 103, 99},
-    {17, 18, 24, 47, 99, 99, 99, 99, 18, 21, 26, 66, 99, 99, 99, 99, 24, 26, 56, 99, 99, 99,
-     99, 99, 47, 66, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99,
-     99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99, 99}};
-
 // round(2/N cos(pi k (n + 1/2) / N) 2^14) for N = 2..8, n = 0..N-1, k = 1..N-1.
 constexpr int16_t kCos[] = {
     // N = 2
@@ -50,8 +40,6 @@ constexpr int64_t kCoefLimit = int64_t{1} << 26;
 
 int32_t clamp32(int64_t v, int64_t limit) { return static_cast<int32_t>(v < -limit ? -limit : (v > limit ? limit : v)); }
 
-// a / b rounded to nearest (halves away from zero), b > 0.
-int64_t div_round(int64_t a, int64_t b) { return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b); }
 
 uint8_t to_sample(int32_t q4) {
   const int32_t v = (q4 + 8) >> 4;
@@ -112,19 +100,6 @@ int32_t rescale(int32_t v, int n, int k) {
   return clamp32((int64_t{v} * r + 8192) >> 14, kCoefLimit);
 }
 
-// Positions of a face block of diagonal D: those with row + column < D.
-int block_positions(int32_t D) {
-  if (D >= 15) return 64;
-  int p = 0;
-  for (int d = 0; d < D; ++d) p += d < 8 ? d + 1 : 15 - d;
-  return p;
-}
-
-int64_t block_mean_q4(const uint8_t* s, uint32_t count) {
-  int64_t sum = 0;
-  for (uint32_t i = 0; i < count; ++i) sum += s[i];
-  return div_round(16 * sum, count);
-}
 
 // The vds mode's levels of one block of `positions` (scan order, lv[0..]):
 // the count of nonzero levels, then per position a significance bin (left
@@ -153,7 +128,7 @@ bool read_levels(ArithDecoder& dec, BlockContexts& cx, int cls, int kind, int po
         const uint32_t rest = dec.decode_exp_golomb(nullptr, 0, order);
         if (rest > static_cast<uint32_t>(kMaxQuantised)) return false;
         mag = 3 + rest;
-        if (rest > (kRestRaise << order) && order < kRestMaxOrder) ++order;
+        if (rest > (image_model::kRestRaise << order) && order < image_model::kRestMaxOrder) ++order;
       }
     }
     lv[z] = dec.decode_bypass() != 0 ? -static_cast<int32_t>(mag) : static_cast<int32_t>(mag);
@@ -163,16 +138,18 @@ bool read_levels(ArithDecoder& dec, BlockContexts& cx, int cls, int kind, int po
 }
 }  // namespace
 
+int64_t div_round(int64_t a, int64_t b) { return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b); }
+
 void make_steps(uint16_t quality_q8, uint8_t mode, Steps* out) {
   for (int cls = 0; cls < 2; ++cls) {
+    const uint8_t* table = cls == 0 ? image_model::kAnnexKLuma : image_model::kAnnexKChroma;
     for (int i = 0; i < 64; ++i) {
-      const uint32_t s = (static_cast<uint32_t>(kJpegQuant[cls][i]) * quality_q8 + 8) >> 4;
+      const uint32_t s = (static_cast<uint32_t>(table[i]) * quality_q8 + 8) >> 4;
       out->face[cls][i] = s < 1 ? 1 : s;
     }
     for (int k = 0; k < 8; ++k) {
-      const uint32_t s = mode == kModePaper
-                             ? (static_cast<uint32_t>(kJpegQuant[cls][image_model::kZigzag[k]]) * quality_q8 + 80) / 160
-                             : (static_cast<uint32_t>(kJpegQuant[cls][k]) * quality_q8 + 8) >> 4;
+      const uint32_t s = mode == kModePaper ? (static_cast<uint32_t>(table[image_model::kZigzag[k]]) * quality_q8 + 80) / 160
+                                            : (static_cast<uint32_t>(table[k]) * quality_q8 + 8) >> 4;
       out->edge[cls][k] = s < 1 ? 1 : s;
     }
   }
@@ -189,8 +166,19 @@ void inverse_dct(const int32_t* in, int n, int32_t* out, int in_stride, int out_
 }
 
 uint32_t mean_step(uint32_t step0) { return step0 < 12 ? 1 : (step0 + 4) / 8; }
-int64_t mean_q4(const uint8_t* samples, uint32_t count) { return count == 0 ? 0 : block_mean_q4(samples, count); }
-int face_block_positions(int32_t D) { return block_positions(D); }
+int64_t mean_q4(const uint8_t* samples, uint32_t count) {
+  if (count == 0) return 0;
+  int64_t sum = 0;
+  for (uint32_t i = 0; i < count; ++i) sum += samples[i];
+  return div_round(16 * sum, count);
+}
+
+int face_block_positions(int32_t D) {
+  if (D >= 15) return 64;
+  int p = 0;
+  for (int d = 0; d < D; ++d) p += d < 8 ? d + 1 : 15 - d;
+  return p;
+}
 
 void reconstruct_edge_block(const int32_t* q, int len, const uint32_t* step, uint8_t mode, int64_t mean_q4,
                             uint8_t* dst) {
@@ -513,6 +501,22 @@ uint32_t MeshColors::sample_index(uint32_t f, int m, uint32_t i, uint32_t j) con
   return layout_.edge_base + layout_.edge_offset[e] + q - 1;
 }
 
+int64_t MeshColors::corner_sum_q4(uint32_t f, int m, const uint8_t* plane) const {
+  int64_t sum = 0;
+  for (int k = 0; k < 3; k += 2) {
+    const uint32_t fe = topo_.face_edge[3 * f + k];
+    const uint32_t e = fe >> 1;
+    const uint32_t ne = edge_samples(level_res(edge_res_[e], m));
+    const uint8_t* src = plane + layout_.edge_base + layout_.edge_offset[e];
+    // Corner a is where edge 0 starts and edge 2 ends (in the face's direction).
+    const bool at_start = (k == 0) == ((fe & 1u) == 0);
+    const uint32_t from = at_start ? 0 : 8 * ((ne - 1) / 8);
+    const uint32_t to = at_start ? (ne < 8 ? ne : 8) : ne;
+    sum += mean_q4(src + from, to - from);
+  }
+  return sum;
+}
+
 Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& out) {
   if (!header_ || out.y == nullptr || out.cb == nullptr || out.cr == nullptr) return Status::invalid_argument;
   if (data == nullptr || size < 1) return Status::truncated;
@@ -544,7 +548,7 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
         uint8_t* dst = out.plane(c) + base + 8 * b;
         const int64_t vertex_q4 = int64_t{16} * vertex_ycc_[3 * topo_.edge_vertex[2 * e] + c];
         const uint32_t dc_step = paper ? step[0] : mean_step(step[0]);
-        const int64_t pred = paper && b > 0 ? prev_q[c] : div_round(b == 0 ? vertex_q4 : block_mean_q4(dst - 8, 8), dc_step);
+        const int64_t pred = paper && b > 0 ? prev_q[c] : div_round(b == 0 ? vertex_q4 : mean_q4(dst - 8, 8), dc_step);
         const int64_t q = pred + (paper ? dec.decode_signed(ctx_->dc_zero[c][1], ctx_->dc_mag[c][1], CodecContexts::kDcCtx,
                                                             kDcCutoff, kDcOrder)
                                         : dec.decode_signed(bctx_->dc_zero[cls][1], bctx_->dc_mag[cls][1],
@@ -570,23 +574,8 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
     if (face_samples(rf) == 0) continue;
     const int32_t n = static_cast<int32_t>(resolution(rf)) - 2;
     const uint32_t base = layout_.face_base + layout_.face_offset[f];
-    // The prediction of the first block: the reconstructed blocks of edges 0 and 2 at corner a.
     int64_t corner_q4[3];
-    for (int c = 0; c < 3; ++c) {
-      int64_t sum = 0;
-      for (int k = 0; k < 3; k += 2) {
-        const uint32_t fe = topo_.face_edge[3 * f + k];
-        const uint32_t e = fe >> 1;
-        const uint32_t ne = edge_samples(level_res(edge_res_[e], m));
-        const uint8_t* src = out.plane(c) + layout_.edge_base + layout_.edge_offset[e];
-        // Corner a is where edge 0 starts and edge 2 ends (in the face's direction).
-        const bool at_start = (k == 0) == ((fe & 1u) == 0);
-        const uint32_t from = at_start ? 0 : 8 * ((ne - 1) / 8);
-        const uint32_t to = at_start ? (ne < 8 ? ne : 8) : ne;
-        sum += block_mean_q4(src + from, to - from);
-      }
-      corner_q4[c] = sum;
-    }
+    for (int c = 0; c < 3; ++c) corner_q4[c] = corner_sum_q4(f, m, out.plane(c));
     int64_t left_q[3] = {0, 0, 0}, row_q[3] = {0, 0, 0};
     int64_t left_mean[3] = {0, 0, 0}, row_mean[3] = {0, 0, 0};
     for (int32_t br = 0; 8 * br < n; ++br) {
@@ -605,7 +594,7 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
                                                               BlockContexts::kDcCtx, kDcCutoff, kDcOrder));
           if (q > kMaxQuantised || q < -kMaxQuantised) return Status::malformed;
           int32_t qn[64] = {};
-          const int positions = block_positions(D);
+          const int positions = face_block_positions(D);
           if (paper) {
             qn[0] = static_cast<int32_t>(q);
             for (int z = 1; z < positions; ++z) qn[image_model::kZigzag[z]] = next_ac(dec, *ctx_, ac[c][0], c, 0);

@@ -27,11 +27,9 @@ void forward_dct(const double* x, int n, double* out, int in_stride = 1, int out
   }
 }
 
-int64_t div_round(int64_t a, int64_t b) { return a >= 0 ? (a + b / 2) / b : -((-a + b / 2) / b); }
 
 int32_t quantise(double coef, uint32_t step_q4) { return static_cast<int32_t>(std::lround(coef * 16 / step_q4)); }
 
-uint8_t to_sample(int32_t q4) { return static_cast<uint8_t>(std::clamp((q4 + 8) >> 4, 0, 255)); }
 
 struct Block {
   int comp = 0;
@@ -103,7 +101,7 @@ void write_levels(ArithEncoder& enc, mc::BlockContexts& cx, int cls, int kind, i
       if (mag > 2) {
         const uint32_t rest = mag - 3;
         enc.encode_exp_golomb(nullptr, 0, rest, order);
-        if (rest > (mc::kRestRaise << order) && order < mc::kRestMaxOrder) ++order;
+        if (rest > (image_model::kRestRaise << order) && order < image_model::kRestMaxOrder) ++order;
       }
     }
     enc.encode_bypass(v < 0);
@@ -140,7 +138,7 @@ std::vector<uint8_t> encode_level(const MeshColorsModel& model, mc::MeshColors& 
         const int64_t vertex_q4 = int64_t{16} * model.vertex_ycc[3 * topo.edge_vertex[2 * e] + c];
         uint8_t* dst = recon[c].data() + base + 8 * b;
         const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
-        const int64_t pred = paper && b > 0 ? prev_q[c] : div_round(b == 0 ? vertex_q4 : mc::mean_q4(dst - 8, 8), dc_step);
+        const int64_t pred = paper && b > 0 ? prev_q[c] : mc::div_round(b == 0 ? vertex_q4 : mc::mean_q4(dst - 8, 8), dc_step);
         Block blk;
         blk.comp = c;
         blk.kind = 1;
@@ -177,19 +175,7 @@ std::vector<uint8_t> encode_level(const MeshColorsModel& model, mc::MeshColors& 
     const int32_t n = static_cast<int32_t>(mc::resolution(rf)) - 2;
     const uint32_t base = l.face_base + l.face_offset[f];
     int64_t corner_q4[3];
-    for (int c = 0; c < 3; ++c) {
-      int64_t sum = 0;
-      for (int k = 0; k < 3; k += 2) {
-        const uint32_t fe = topo.face_edge[3 * f + k], e = fe >> 1;
-        const uint32_t ne = mc::edge_samples(mc::level_res(layout.edge_res()[e], m));
-        const uint8_t* src = recon[c].data() + l.edge_base + l.edge_offset[e];
-        const bool at_start = (k == 0) == ((fe & 1u) == 0);
-        const uint32_t from = at_start ? 0 : 8 * ((ne - 1) / 8);
-        const uint32_t to = at_start ? std::min<uint32_t>(ne, 8) : ne;
-        sum += mc::mean_q4(src + from, to - from);
-      }
-      corner_q4[c] = sum;
-    }
+    for (int c = 0; c < 3; ++c) corner_q4[c] = layout.corner_sum_q4(f, m, recon[c].data());
     int64_t left_q[3] = {0, 0, 0}, row_q[3] = {0, 0, 0}, left_mean[3] = {0, 0, 0}, row_mean[3] = {0, 0, 0};
     for (int32_t br = 0; 8 * br < n; ++br)
       for (int32_t bc = 0; n - 8 * (br + bc) >= 1; ++bc) {
@@ -201,8 +187,8 @@ std::vector<uint8_t> encode_level(const MeshColorsModel& model, mc::MeshColors& 
           double x[64] = {}, rowX[64] = {}, Z[64] = {};
           const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
           const int64_t pred =
-              paper ? (bc > 0 ? left_q[c] : (br > 0 ? row_q[c] : div_round(corner_q4[c], 2 * dc_step)))
-                    : div_round(bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : div_round(corner_q4[c], 2)), dc_step);
+              paper ? (bc > 0 ? left_q[c] : (br > 0 ? row_q[c] : mc::div_round(corner_q4[c], 2 * dc_step)))
+                    : mc::div_round(bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : mc::div_round(corner_q4[c], 2)), dc_step);
           double sum = 0;
           for (int r = 0; r < rows; ++r) {
             const int32_t gr = 8 * br + r;

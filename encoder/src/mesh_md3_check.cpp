@@ -4,6 +4,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "binary_check.h"
 #include "vds/bytes.h"
 
 namespace vds::enc {
@@ -14,10 +15,6 @@ constexpr size_t kSurfaceBytes = 108;
 constexpr uint32_t kMaxFrames = 1024, kMaxTags = 16, kMaxSurfaces = 32, kMaxShaders = 256, kMaxVerts = 4096,
                    kMaxTriangles = 8192;
 
-[[noreturn]] void fail(const std::string& name, const std::string& what, size_t at) {
-  throw std::runtime_error(name + ": " + what + " (byte " + std::to_string(at) + ")");
-}
-
 // `count` items of `item` bytes at `base` + the offset stored at `field`:
 // inside [0, size).
 void table(const uint8_t* d, size_t size, size_t base, size_t field, uint64_t count, uint64_t item, const char* what,
@@ -26,7 +23,7 @@ void table(const uint8_t* d, size_t size, size_t base, size_t field, uint64_t co
   const int64_t off = static_cast<int32_t>(load_le32(d + field));
   const int64_t at = static_cast<int64_t>(base) + off;
   if (off < 0 || at > static_cast<int64_t>(size) || count * item > size - static_cast<size_t>(at))
-    fail(name, std::string(what) + ": " + std::to_string(count) + " of " + std::to_string(item) + " bytes at offset " +
+    refuse_at_byte(name, std::string(what) + ": " + std::to_string(count) + " of " + std::to_string(item) + " bytes at offset " +
                    std::to_string(off) + " do not fit the file",
          field);
 }
@@ -34,7 +31,7 @@ void table(const uint8_t* d, size_t size, size_t base, size_t field, uint64_t co
 uint32_t count(const uint8_t* d, size_t at, uint32_t limit, const char* what, const std::string& name) {
   const int32_t v = static_cast<int32_t>(load_le32(d + at));
   if (v < 0 || static_cast<uint32_t>(v) > limit)
-    fail(name, std::string(what) + " " + std::to_string(v) + " (0.." + std::to_string(limit) + ")", at);
+    refuse_at_byte(name, std::string(what) + " " + std::to_string(v) + " (0.." + std::to_string(limit) + ")", at);
   return static_cast<uint32_t>(v);
 }
 
@@ -42,8 +39,8 @@ uint32_t count(const uint8_t* d, size_t at, uint32_t limit, const char* what, co
 
 void check_md3(const uint8_t* d, size_t size, const std::string& name) {
   if (size < kHeaderBytes || std::memcmp(d, "IDP3", 4) != 0)
-    fail(name, "not a Quake III model (it must start with 'IDP3')", 0);
-  if (load_le32(d + 4) != 15) fail(name, "MD3 version " + std::to_string(load_le32(d + 4)) + " (15 is read)", 4);
+    refuse_at_byte(name, "not a Quake III model (it must start with 'IDP3')", 0);
+  if (load_le32(d + 4) != 15) refuse_at_byte(name, "MD3 version " + std::to_string(load_le32(d + 4)) + " (15 is read)", 4);
   const uint32_t frames = count(d, 76, kMaxFrames, "frames", name);
   const uint32_t tags = count(d, 80, kMaxTags, "tags", name);
   const uint32_t surfaces = count(d, 84, kMaxSurfaces, "surfaces", name);
@@ -51,15 +48,15 @@ void check_md3(const uint8_t* d, size_t size, const std::string& name) {
   table(d, size, 0, 96, uint64_t{tags} * frames, 112, "the tags", name);
   const int32_t eof = static_cast<int32_t>(load_le32(d + 104));
   if (eof < 0 || static_cast<size_t>(eof) > size)
-    fail(name, "the end offset " + std::to_string(eof) + " lies past the file's " + std::to_string(size) + " bytes", 104);
+    refuse_at_byte(name, "the end offset " + std::to_string(eof) + " lies past the file's " + std::to_string(size) + " bytes", 104);
   size_t at = static_cast<size_t>(static_cast<int32_t>(load_le32(d + 100)));
   for (uint32_t s = 0; s < surfaces; ++s) {
     if (static_cast<int32_t>(at) < 0 || at > size || size - at < kSurfaceBytes)
-      fail(name, "surface " + std::to_string(s) + " at byte " + std::to_string(at) + " lies past the file", 100);
+      refuse_at_byte(name, "surface " + std::to_string(s) + " at byte " + std::to_string(at) + " lies past the file", 100);
     const uint8_t* h = d + at;
-    if (std::memcmp(h, "IDP3", 4) != 0) fail(name, "surface " + std::to_string(s) + " does not start with 'IDP3'", at);
+    if (std::memcmp(h, "IDP3", 4) != 0) refuse_at_byte(name, "surface " + std::to_string(s) + " does not start with 'IDP3'", at);
     if (load_le32(h + 72) != frames)
-      fail(name, "surface " + std::to_string(s) + " has " + std::to_string(load_le32(h + 72)) + " frames, the model " +
+      refuse_at_byte(name, "surface " + std::to_string(s) + " has " + std::to_string(load_le32(h + 72)) + " frames, the model " +
                      std::to_string(frames),
            at + 72);
     const uint32_t shaders = count(d, at + 76, kMaxShaders, "shaders", name);
@@ -73,13 +70,13 @@ void check_md3(const uint8_t* d, size_t size, const std::string& name) {
     for (uint64_t i = 0; i < 3 * uint64_t{tris}; ++i) {
       const int32_t v = static_cast<int32_t>(load_le32(d + tri_at + 4 * i));
       if (v < 0 || static_cast<uint32_t>(v) >= verts)
-        fail(name, "surface " + std::to_string(s) + " triangle " + std::to_string(i / 3) + " names vertex " +
+        refuse_at_byte(name, "surface " + std::to_string(s) + " triangle " + std::to_string(i / 3) + " names vertex " +
                        std::to_string(v) + " of " + std::to_string(verts),
              tri_at + 4 * i);
     }
     const int32_t end = static_cast<int32_t>(load_le32(h + 104));
     if (end < static_cast<int32_t>(kSurfaceBytes) || static_cast<size_t>(end) > size - at)
-      fail(name, "surface " + std::to_string(s) + " ends at offset " + std::to_string(end) + ", past the file", at + 104);
+      refuse_at_byte(name, "surface " + std::to_string(s) + " ends at offset " + std::to_string(end) + ", past the file", at + 104);
     at += static_cast<size_t>(end);
   }
 }

@@ -87,10 +87,6 @@ ModelFrame rasterise(const std::vector<std::array<double, 3>>& positions, size_t
 
 Rgb bilinear(const Image& img, double u, double v) { return io::bilinear_repeat(img, u * img.width, (1 - v) * img.height); }
 
-Rgb ycc_to_rgb(double y, double cb, double cr) {
-  return {y + 1.402 * (cr - 128), y - 0.344136 * (cb - 128) - 0.714136 * (cr - 128), y + 1.772 * (cb - 128)};
-}
-
 }  // namespace
 
 ModelViews orbit_views(const std::vector<std::array<double, 3>>& positions, int count, int width, int height,
@@ -154,7 +150,7 @@ ModelFrame render_mesh_colors(const MeshColorsModel& mc, const std::array<std::v
   if (layout.layout_level(m) != planes[0].size()) throw std::invalid_argument("render_mesh_colors: planes of another level");
   auto sample = [&](uint32_t f, uint32_t i, uint32_t j) {
     const uint32_t s = layout.sample_index(f, m, i, j);
-    return ycc_to_rgb(planes[0][s], planes[1][s], planes[2][s]);
+    return ref::ycbcr_to_rgb(planes[0][s], planes[1][s], planes[2][s]);
   };
   return rasterise(
       mc.positions, F,

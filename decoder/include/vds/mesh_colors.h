@@ -167,8 +167,10 @@ int face_block_positions(int32_t D);
 // The vds mode's step of a block's mean (Q4): the DC step / 8, so a full
 // block's mean is quantised as JPEG quantises its DC.
 uint32_t mean_step(uint32_t step0);
-// The mean of `count` samples in Q4, rounded.
+// The mean of `count` samples in Q4, rounded (0 for none).
 int64_t mean_q4(const uint8_t* samples, uint32_t count);
+// a / b rounded to nearest, halves away from zero (b > 0).
+int64_t div_round(int64_t a, int64_t b);
 
 // Context sets: [component][0 face, 1 edge].
 struct CodecContexts {
@@ -202,8 +204,6 @@ struct BlockContexts {
 };
 constexpr uint32_t kNzCutoff = 6;
 constexpr int kNzOrder = 1;
-constexpr int kRestMaxOrder = 4;
-constexpr uint32_t kRestRaise = 3;
 
 // --- The header chunk (MCLH) ------------------------------------------------
 //   u8 version (1), u8 mode (0 = paper, 1 = vds), u8 max_res_log2 (0..10), u8 flags (0),
@@ -262,6 +262,11 @@ class MeshColors {
   // The level-m sample of face f at lattice point (i, j) (i + j <= R_m) in a
   // level's planes: its index.
   uint32_t sample_index(uint32_t f, int m, uint32_t i, uint32_t j) const;
+  // The first block's DC prediction of face f at level m, before halving:
+  // the sum of the Q4 means of the reconstructed blocks of its edges 0 and 2
+  // at corner a, in `plane` (a level's plane with those edges decoded; the
+  // layout of level m set).
+  int64_t corner_sum_q4(uint32_t f, int m, const uint8_t* plane) const;
 
  private:
   Arena* arena_ = nullptr;  // for read_header's scratch

@@ -88,10 +88,8 @@ class Sampler {
     const bool repeat = t.address == TexAddress::repeat && is_pow2(t.image.width) && is_pow2(t.image.height);
     if (t.ycbcr) {
       const bool crep = repeat && is_pow2(t.cb.width) && is_pow2(t.cb.height);
-      const double y = sample_plane(t.y, u, v, f, repeat);
-      const double cb = sample_plane(t.cb, u / 2, v / 2, f, crep) - 128;
-      const double cr = sample_plane(t.cr, u / 2, v / 2, f, crep) - 128;
-      return {y + 1.402 * cr, y - 0.344136 * cb - 0.714136 * cr, y + 1.772 * cb};
+      return ycbcr_to_rgb(sample_plane(t.y, u, v, f, repeat), sample_plane(t.cb, u / 2, v / 2, f, crep),
+                          sample_plane(t.cr, u / 2, v / 2, f, crep));
     }
     if (!opt_.mipmap || lod <= 0 || !repeat) return sample_rgb(t.image, u, v, f, repeat);
     const TextureLevels& lv = levels(tex);

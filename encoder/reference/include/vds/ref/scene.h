@@ -7,6 +7,7 @@
 // ClientScene. Textures are generated in code, so nothing depends on data
 // packages.
 #pragma once
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -137,6 +138,12 @@ Scene client_textures(const Scene& scene, vds::TexFormat format);
 
 // JFIF full-range conversion with 2x2 chroma averaging (rounded).
 void rgb_to_ycbcr420(const Image& rgb, Image& y, Image& cb, Image& cr);
+// JFIF full-range Y'CbCr -> R'G'B' of one colour, unrounded and unclamped.
+inline std::array<double, 3> ycbcr_to_rgb(double y, double cb, double cr) {
+  cb -= 128;
+  cr -= 128;
+  return {y + 1.402 * cr, y - 0.344136 * cb - 0.714136 * cr, y + 1.772 * cb};
+}
 
 // The fixed-point copy of a Scene: owns every array the DrawList points to.
 // View-mapped meshes get their homography from vds::plane_homography
