@@ -2,6 +2,7 @@
 // the mesh colors codec (decoder side). The rules are in vds/mesh_colors.h.
 #include "vds/mesh_colors.h"
 
+#include "vds/bytes.h"
 #include "vds/image_model.h"
 
 namespace vds::mc {
@@ -501,6 +502,30 @@ uint32_t MeshColors::sample_index(uint32_t f, int m, uint32_t i, uint32_t j) con
   return layout_.edge_base + layout_.edge_offset[e] + q - 1;
 }
 
+void MeshColors::face_lattice(uint32_t f, LatticeFace* out) const {
+  const int m = layout_m_ < 0 ? 0 : layout_m_;
+  const uint16_t* v = topo_.tri + 3 * f;
+  const int r = level_res(face_res_[f], m);
+  out->res_log2 = static_cast<uint8_t>(r);
+  for (int k = 0; k < 3; ++k) {
+    out->vertex[k] = v[k];
+    const uint32_t fe = topo_.face_edge[3 * f + k];
+    const uint32_t e = fe >> 1;
+    const int re = level_res(edge_res_[e], m);
+    // sample_index's q = p 2^(re - r), reversed Re - q; the sample at q - 1.
+    const uint32_t first = layout_.edge_base + layout_.edge_offset[e] - 1;
+    const int32_t step = static_cast<int32_t>(resolution(re > r ? re - r : 0));
+    if (fe & 1u) {
+      out->edge_base[k] = first + resolution(re);
+      out->edge_step[k] = -step;
+    } else {
+      out->edge_base[k] = first;
+      out->edge_step[k] = step;
+    }
+  }
+  out->face_base = layout_.face_base + layout_.face_offset[f];
+}
+
 int64_t MeshColors::corner_sum_q4(uint32_t f, int m, const uint8_t* plane) const {
   int64_t sum = 0;
   for (int k = 0; k < 3; k += 2) {
@@ -517,16 +542,36 @@ int64_t MeshColors::corner_sum_q4(uint32_t f, int m, const uint8_t* plane) const
   return sum;
 }
 
+Status level_chunk_info(const uint8_t* data, size_t size, LevelChunk* out) {
+  if (data == nullptr || size < kLevelHeadBytes) return Status::truncated;
+  out->level = data[0];
+  out->first = load_le32(data + 1);
+  out->count = load_le32(data + 5);
+  return Status::ok;
+}
+
 Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& out) {
   if (!header_ || out.y == nullptr || out.cb == nullptr || out.cr == nullptr) return Status::invalid_argument;
-  if (data == nullptr || size < 1) return Status::truncated;
-  const int m = data[0];
-  if (m >= max_res_) return Status::malformed;
-  layout_level(m);
-  for (uint32_t v = 0; v < topo_.vertices; ++v)
-    for (int c = 0; c < 3; ++c) out.plane(c)[v] = vertex_ycc_[3 * v + c];
+  LevelChunk lc;
+  Status s = level_chunk_info(data, size, &lc);
+  if (s != Status::ok) return s;
+  const int m = lc.level;
+  const uint32_t elements = topo_.edges + topo_.faces;
+  if (m >= max_res_ || lc.count == 0 || lc.first >= elements || lc.count > elements - lc.first) return Status::malformed;
+  if (lc.first == 0) {
+    layout_level(m);
+    for (uint32_t v = 0; v < topo_.vertices; ++v)
+      for (int c = 0; c < 3; ++c) out.plane(c)[v] = vertex_ycc_[3 * v + c];
+  } else if (decoding_ != m || next_element_ != lc.first) {
+    return Status::malformed;  // not the chunk after the last one of this level
+  }
+  decoding_ = -1;  // until this chunk is whole
+  const uint32_t end = lc.first + lc.count;
+  const uint32_t edge_end = end < topo_.edges ? end : topo_.edges;
+  const uint32_t face_first = lc.first > topo_.edges ? lc.first - topo_.edges : 0;
+  const uint32_t face_end = end > topo_.edges ? end - topo_.edges : 0;
   ArithDecoder dec;
-  Status s = dec.init(data + 1, size - 1);
+  s = dec.init(data + kLevelHeadBytes, size - kLevelHeadBytes);
   if (s != Status::ok) return s;
   const bool paper = mode_ == kModePaper;
   ctx_->reset();
@@ -536,7 +581,7 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
   int32_t lv[64];
 
   // Edges.
-  for (uint32_t e = 0; e < topo_.edges; ++e) {
+  for (uint32_t e = lc.first; e < edge_end; ++e) {
     const uint32_t n = edge_samples(level_res(edge_res_[e], m));
     const uint32_t base = layout_.edge_base + layout_.edge_offset[e];
     int64_t prev_q[3] = {0, 0, 0};
@@ -569,7 +614,7 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
   }
 
   // Faces.
-  for (uint32_t f = 0; f < topo_.faces; ++f) {
+  for (uint32_t f = face_first; f < face_end; ++f) {
     const int rf = level_res(face_res_[f], m);
     if (face_samples(rf) == 0) continue;
     const int32_t n = static_cast<int32_t>(resolution(rf)) - 2;
@@ -617,7 +662,12 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
       }
     }
   }
-  return dec.finish();
+  s = dec.finish();
+  if (s == Status::ok) {
+    decoding_ = m;
+    next_element_ = end;
+  }
+  return s;
 }
 
 }  // namespace vds::mc

@@ -101,7 +101,8 @@ Status ModelView::init(const ModelViewConfig& cfg, Arena& arena, uint32_t max_ve
   return Status::ok;
 }
 
-Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx) {
+Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx, const MeshColorsSurface* colors,
+                       Filter filter) {
   const uint32_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
   if (!ready_ || nv == 0 || nv > cap_v_ || nt > cap_t_) return Status::invalid_argument;
   const int bits = mesh.bits();
@@ -168,8 +169,9 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
   // corner table (one fan per vertex, from its first face on a boundary),
   // so no per-vertex sums are stored.
   const int shift = bits > 10 ? 2 * (bits - 10) : 0;
+  const uint32_t nlit = colors != nullptr ? 0 : nv;  // mesh colors are drawn unlit
   const uint32_t base_rgb[3] = {(cfg_.surface_rgb >> 16) & 255, (cfg_.surface_rgb >> 8) & 255, cfg_.surface_rgb & 255};
-  for (uint32_t v = 0; v < nv; ++v) {
+  for (uint32_t v = 0; v < nlit; ++v) {
     int32_t n[3];
     if (bits <= 15)
       fan_normal<int32_t>(mesh, tri, pos, v, shift, n);
@@ -204,6 +206,11 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
   m.shading = Shading::gouraud;
   m.cull = Cull::none;
   m.colors = colors_;
+  if (colors != nullptr) {
+    m.shading = Shading::mesh_colors;
+    m.surface = colors;
+    m.filter = filter;
+  }
   // World positions, read by the renderer from the decoder's grid: 2^bits
   // grid steps = 2 units, i.e. (2 g - (lo + hi)) 2^(16 - bits) in Q16.16.
   const int up = 16 - bits;

@@ -81,7 +81,7 @@ Status check_list(const DrawList& list) {
   if (list.num_meshes && !list.meshes) return Status::invalid_argument;
   for (uint32_t i = 0; i < list.num_meshes; ++i) {
     const Mesh& m = list.meshes[i];
-    if (static_cast<uint8_t>(m.shading) > 3 || static_cast<uint8_t>(m.filter) > 2 || static_cast<uint8_t>(m.cull) > 2) {
+    if (static_cast<uint8_t>(m.shading) > 4 || static_cast<uint8_t>(m.filter) > 2 || static_cast<uint8_t>(m.cull) > 2) {
       return Status::invalid_argument;
     }
     if (m.num_triangles == 0) continue;
@@ -92,6 +92,9 @@ Status check_list(const DrawList& list) {
     }
     if (m.shading == Shading::gouraud && !m.colors) return Status::malformed;
     if (m.shading == Shading::texture && !m.uvs) return Status::malformed;
+    if (m.shading == Shading::mesh_colors &&
+        (!m.surface || !m.surface->face || !m.surface->y || !m.surface->cb || !m.surface->cr))
+      return Status::malformed;
     if (m.shading == Shading::texture || m.shading == Shading::view_mapped) {
       const Status st = check_texture(m.texture);
       if (st != Status::ok) return st;
@@ -104,6 +107,7 @@ int num_attribs(Shading s) {
   switch (s) {
     case Shading::gouraud: return 3;
     case Shading::texture: return 2;
+    case Shading::mesh_colors: return 2;
     default: return 0;
   }
 }
@@ -330,8 +334,14 @@ struct RenderFrame {
     return project(i, out);
   }
 
-  static void attributes(const Mesh& m, uint32_t i, int32_t* a) {
-    if (m.shading == Shading::texture) {
+  // Vertex i at corner k of its triangle.
+  static void attributes(const Mesh& m, uint32_t i, int k, int32_t* a) {
+    if (m.shading == Shading::mesh_colors) {
+      // Barycentric weights of corners b and c in Q16.16 (the set-up scales them by R).
+      a[0] = k == 1 ? 65536 : 0;
+      a[1] = k == 2 ? 65536 : 0;
+      a[2] = 0;
+    } else if (m.shading == Shading::texture) {
       a[0] = m.uvs[i].u.raw();
       a[1] = m.uvs[i].v.raw();
       a[2] = 0;
@@ -440,7 +450,7 @@ struct RenderFrame {
   // Draws mesh m into the band; `first_tri` is the running index of its first
   // triangle (for the triangle cache), `band_index` the band's number.
   void draw_mesh(const BandTarget& band, const Mesh& m, uint32_t first_tri, uint16_t band_index) {
-    const MaterialCtx mat{&m, num_attribs(m.shading)};
+    MaterialCtx mat{&m, num_attribs(m.shading), 0};
     const uint32_t tcap = r.cfg_.triangle_cache;
     const uint16_t* const tb = r.tri_bands_;
     // A triangle misses the band when raster_row(ymax) <= y0 or
@@ -466,6 +476,7 @@ struct RenderFrame {
         }
       }
       const uint32_t g = first_tri + t;
+      mat.tri = t;
       if (cursor < live) {
         // Live tags ascend and so do the triangles of a band's walk.
         const uint32_t* const tags = r.setup_tags_;
@@ -534,7 +545,7 @@ struct RenderFrame {
           sv[k].x = cv[k].x;
           sv[k].y = cv[k].y;
           sv[k].q = cv[k].q;
-          attributes(m, idx[k], sv[k].a);
+          attributes(m, idx[k], k, sv[k].a);
         }
         draw(band, mat, sv, 3, g, false);
         continue;
@@ -543,7 +554,7 @@ struct RenderFrame {
       ClipVertex in[3], out[kMaxPolyVerts];
       for (int k = 0; k < 3; ++k) {
         in[k] = camera_vertex(idx[k]);
-        attributes(m, idx[k], in[k].a);
+        attributes(m, idx[k], k, in[k].a);
       }
       const int n = clip_polygon(fc, static_cast<uint8_t>(any & kOutAll), in, 3, out, scratch.clip, mat.num_attribs);
       if (n < 3) {

@@ -69,7 +69,8 @@ int clip_polygon(const FrameCamera& fc, uint8_t planes, const ClipVertex* in, in
 // What a polygon is drawn with.
 struct MaterialCtx {
   const Mesh* mesh;
-  int num_attribs;  // 0 flat, 2 texture, 3 gouraud, 0 view_mapped
+  int num_attribs;  // 0 flat, 2 texture, 3 gouraud, 0 view_mapped, 2 mesh_colors
+  uint32_t tri;     // the triangle's index in the mesh (mesh_colors)
 };
 
 // The band being drawn.

@@ -217,6 +217,18 @@ void texture_values(const Texture& t, bool repeat, int f, const ScreenVertex* v,
   vv.g = f - 16;  // u (Q16.16) = N / q, wanted in Q.f
 }
 
+// Mesh colors: the corners' barycentric weights (Q16.16) scaled to the
+// face's lattice, N = (R a + 1/2 for nearest sampling) q.
+void lattice_values(int res_log2, int f, const ScreenVertex* v, int n, VertexValues& vv) {
+  const int64_t half = f ? 0 : 32768;  // nearest: the lattice point nearest, by rounding
+  for (int i = 0; i < n; ++i) {
+    const int64_t nvals[2] = {((int64_t{v[i].a[0]} << res_log2) + half) * v[i].q,  // < 2^27 * 2^30
+                              ((int64_t{v[i].a[1]} << res_log2) + half) * v[i].q};
+    vv.note(i, v[i].q, nvals, 2);
+  }
+  vv.g = f - 16;
+}
+
 // View-mapped: the rows of the homography (vds/homography.h), which works on
 // coordinates / 256: per pixel, 256 W = h20 x + h21 y + 256 h22 and 65536 S =
 // 256 (h00 x + h01 y) + 65536 h02, so that texel u = 65536 S / (256 W).
@@ -387,6 +399,15 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   } else if (m.shading == Shading::gouraud) {
     s.nn = 3;
     gouraud_values(v, n, vv);
+  } else if (m.shading == Shading::mesh_colors) {
+    const MeshColorsSurface& sf = *m.surface;
+    if (!sf.face(sf.ctx, mat.tri, &s.lat.face) || !lattice_face_valid(s.lat.face, sf.samples)) return;
+    s.lat.y = sf.y;
+    s.lat.cb = sf.cb;
+    s.lat.cr = sf.cr;
+    s.lat.res = int32_t{1} << s.lat.face.res_log2;
+    s.nn = 2;
+    lattice_values(s.lat.face.res_log2, m.filter == Filter::nearest ? 0 : kLatticeFracBits, v, n, vv);
   } else {
     repeat = texture_repeats(*m.texture);
     s.tex = make_tex_ctx(*m.texture, repeat);

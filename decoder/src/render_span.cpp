@@ -133,8 +133,14 @@ inline uint32_t texel8888(const TexCtx& t, uint32_t index) {
   }
 }
 
+// What a texture sampler reads of a polygon's set-up.
+struct TexSampler {
+  using Ctx = TexCtx;
+  static const TexCtx& ctx(const PolySetup& s) { return s.tex; }
+};
+
 template <TexFormat TF, TexAddress A, PixelFormat O>
-struct NearestSampler {
+struct NearestSampler : TexSampler {
   static constexpr int kFracBits = 0;
   static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
   // (u, v): the texel containing the sample point.
@@ -163,7 +169,7 @@ constexpr int bilinear_frac_bits(TexFormat tf, PixelFormat o) {
 // kNearestChroma (Y'CbCr 4:2:0, Filter::bilinear_luma): chroma from the
 // chroma texel the sample point lies in instead of blended.
 template <TexFormat TF, TexAddress A, PixelFormat O, bool kNearestChroma>
-struct BilinearBlend {
+struct BilinearBlend : TexSampler {
   static constexpr int kFracBits = bilinear_frac_bits(TF, O);
   static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
   static constexpr uint32_t kFracMask = (1u << kFracBits) - 1;
@@ -218,7 +224,7 @@ using LumaBilinearSampler = BilinearBlend<TF, A, O, true>;
 // addressing clamps the sample position to [0, size - 1] before splitting it,
 // which gives exactly the clamp-to-edge result (the neighbour then has weight 0).
 template <TexFormat TF, TexAddress A, PixelFormat O>
-struct BilinearApronSampler {
+struct BilinearApronSampler : TexSampler {
   static constexpr int kFracBits = bilinear_frac_bits(TF, O);
   static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
   static constexpr uint32_t kFracMask = (1u << kFracBits) - 1;
@@ -248,6 +254,110 @@ struct BilinearApronSampler {
       return from8888<O>(bilerp8888(texel8888<TF>(t, index), texel8888<TF>(t, index + 1), texel8888<TF>(t, index + t.stride),
                                     texel8888<TF>(t, index + t.stride + 1), fu, fv));
     }
+  }
+};
+
+// ---------------------------------------------------------------------------
+// Mesh colors (Shading::mesh_colors): samples on a face's lattice
+// ---------------------------------------------------------------------------
+// The index of lattice point (i, j) of a face of resolution R (render.h's
+// LatticeFace); 0 <= i, j and i + j <= R.
+inline uint32_t lattice_index(const LatticeFace& f, int32_t R, int32_t i, int32_t j) {
+  if (j == 0) {
+    if (i == 0) return f.vertex[0];
+    if (i == R) return f.vertex[1];
+    return f.edge_base[0] + static_cast<uint32_t>(i * f.edge_step[0]);
+  }
+  if (i == 0) {
+    if (j == R) return f.vertex[2];
+    return f.edge_base[2] + static_cast<uint32_t>((R - j) * f.edge_step[2]);
+  }
+  if (i + j == R) return f.edge_base[1] + static_cast<uint32_t>(j * f.edge_step[1]);
+  const int32_t r = j - 1;  // rows 1 .. j - 1 hold R - 2, R - 3, ... samples
+  return f.face_base + static_cast<uint32_t>(r * (R - 1) - ((r * (r + 1)) >> 1) + i - 1);
+}
+
+struct LatticeSampler {
+  using Ctx = LatticeCtx;
+  static const LatticeCtx& ctx(const PolySetup& s) { return s.lat; }
+};
+
+// The nearest lattice point: (u, v) arrive rounded (the set-up adds a
+// half); points just outside the triangle (rounding at its edges) are
+// brought back to its border.
+template <PixelFormat O>
+struct LatticeNearestSampler : LatticeSampler {
+  static constexpr bool kInlineStart = false;
+  static OutColor<O> sample(const LatticeCtx& t, int32_t u, int32_t v) {
+    const int32_t R = t.res;
+    u = u < 0 ? 0 : (u > R ? R : u);
+    v = v < 0 ? 0 : (v > R ? R : v);
+    if (u + v > R) {
+      const int32_t e = u + v - R;
+      u -= e >> 1;
+      v -= e - (e >> 1);
+    }
+    const uint32_t k = lattice_index(t.face, R, u, v);
+    return from_ycbcr<O>(t.y[k], t.cb[k], t.cr[k]);
+  }
+};
+
+// The linear filter: (u, v) in Q.8 lattice units.
+template <PixelFormat O>
+struct LatticeLinearSampler : LatticeSampler {
+  static constexpr bool kInlineStart = false;
+  static constexpr int kF = kLatticeFracBits;
+  static constexpr int32_t kOne = 1 << kF;
+  static OutColor<O> sample(const LatticeCtx& t, int32_t u, int32_t v) {
+    const int32_t R = t.res;
+    const int32_t lim = R << kF;
+    u = u < 0 ? 0 : u;
+    v = v < 0 ? 0 : v;
+    if (u + v > lim) {  // beyond the edge opposite corner a: onto it
+      const int32_t e = u + v - lim;
+      u -= e >> 1;
+      v -= e - (e >> 1);
+      if (u < 0) {
+        u = 0;
+        v = lim;
+      } else if (v < 0) {
+        v = 0;
+        u = lim;
+      }
+    }
+    int32_t i0 = u >> kF, j0 = v >> kF;
+    int32_t fu = u & (kOne - 1), fv = v & (kOne - 1);
+    if (i0 + j0 >= R) {  // a lattice point on that edge: the cell beside it
+      if (i0 > 0) {
+        --i0;
+        fu = kOne;
+      } else {
+        --j0;
+        fv = kOne;
+      }
+    }
+    uint32_t k0, k1, k2;
+    int32_t w0, w1, w2;
+    if (fu + fv <= kOne) {  // the cell (i0, j0), (i0 + 1, j0), (i0, j0 + 1)
+      k0 = lattice_index(t.face, R, i0, j0);
+      k1 = lattice_index(t.face, R, i0 + 1, j0);
+      k2 = lattice_index(t.face, R, i0, j0 + 1);
+      w0 = kOne - fu - fv;
+      w1 = fu;
+      w2 = fv;
+    } else {  // the cell (i0 + 1, j0 + 1), (i0, j0 + 1), (i0 + 1, j0)
+      k0 = lattice_index(t.face, R, i0 + 1, j0 + 1);
+      k1 = lattice_index(t.face, R, i0, j0 + 1);
+      k2 = lattice_index(t.face, R, i0 + 1, j0);
+      w0 = fu + fv - kOne;
+      w1 = kOne - fu;
+      w2 = kOne - fv;
+    }
+    constexpr int32_t kHalf = kOne / 2;
+    const int32_t y = (w0 * t.y[k0] + w1 * t.y[k1] + w2 * t.y[k2] + kHalf) >> kF;
+    const int32_t cb = (w0 * t.cb[k0] + w1 * t.cb[k1] + w2 * t.cb[k2] + kHalf) >> kF;
+    const int32_t cr = (w0 * t.cr[k0] + w1 * t.cr[k1] + w2 * t.cr[k2] + kHalf) >> kF;
+    return from_ycbcr<O>(y, cb, cr);
   }
 };
 
@@ -517,7 +627,7 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
   using DT = typename Depth<D>::T;
   DT* const zrow = static_cast<DT*>(b.depth) + static_cast<uint32_t>(y - b.y0) * static_cast<uint32_t>(b.width);
   uint8_t* const crow = b.color + static_cast<uint32_t>(y - b.y0) * b.color_stride;
-  const TexCtx tex = s.tex;  // a local copy: the stores below cannot alias it
+  const typename Sampler::Ctx tex = Sampler::ctx(s);  // a local copy: the stores below cannot alias it
   while (xa < xb) {
     int32_t len = xb - xa;
     RowState r;
@@ -629,6 +739,9 @@ SpanFn pick_span(const Mesh& m, bool repeat) {
   switch (m.shading) {
     case Shading::flat: return &flat_span<O, D>;
     case Shading::gouraud: return &gouraud_span<O, D>;
+    case Shading::mesh_colors:
+      return m.filter == Filter::nearest ? &texture_span<LatticeNearestSampler<O>, false, O, D>
+                                         : &texture_span<LatticeLinearSampler<O>, false, O, D>;
     default: break;
   }
   const bool proj = m.shading == Shading::view_mapped;
@@ -674,6 +787,21 @@ TexCtx make_tex_ctx(const Texture& t, bool repeat) {
   }
   (void)repeat;
   return c;
+}
+
+bool lattice_face_valid(const LatticeFace& f, uint32_t samples) {
+  if (f.res_log2 > 10) return false;
+  const int64_t R = int64_t{1} << f.res_log2;
+  for (int k = 0; k < 3; ++k) {
+    if (f.vertex[k] >= samples) return false;
+    if (R >= 2) {  // steps 1 and R - 1: the ends of a straight run
+      const int64_t first = int64_t{f.edge_base[k]} + f.edge_step[k];
+      const int64_t last = int64_t{f.edge_base[k]} + (R - 1) * f.edge_step[k];
+      if (first < 0 || last < 0 || first >= samples || last >= samples) return false;
+    }
+  }
+  const int64_t face = (R - 1) * (R - 2) / 2;
+  return face == 0 || int64_t{f.face_base} + face <= samples;
 }
 
 int fraction_bits(const Mesh& m, PixelFormat out) {

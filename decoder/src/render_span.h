@@ -24,6 +24,14 @@ struct TexCtx {
   int32_t cwmask, chmask, cwmax, chmax;
 };
 
+// A mesh-colors face as the span loops sample it (Shading::mesh_colors).
+struct LatticeCtx {
+  const uint8_t* y;
+  const uint8_t* cb;
+  const uint8_t* cr;
+  LatticeFace face;
+  int32_t res;  // R
+};
 
 struct PolySetup;
 using SpanFn = void (*)(const BandTarget&, const PolySetup&, int32_t, int32_t, int32_t);
@@ -39,6 +47,7 @@ struct PolySetup {
   int b0;
   uint32_t flat;   // flat colour in the output format
   TexCtx tex;
+  LatticeCtx lat;  // mesh_colors
   // Fast span set-up (fast == true): the planes' own scale serves the whole
   // polygon (chosen from the values at its vertices with a margin), so a span
   // start is (a0 + gx dx + gy dy + 2^15) >> 16 and the steps are fixed. A
@@ -71,5 +80,9 @@ SpanFn select_span(const PolygonTarget& target, const Mesh& m, bool repeat);
 TexCtx make_tex_ctx(const Texture& t, bool repeat);
 // Fraction bits of the texture coordinates: 0 for nearest sampling.
 int fraction_bits(const Mesh& m, PixelFormat out);
+// Fraction bits of the lattice coordinates of the mesh-colors linear filter.
+constexpr int kLatticeFracBits = 8;
+// Whether every sample index a face can give lies below `samples`.
+bool lattice_face_valid(const LatticeFace& f, uint32_t samples);
 
 }  // namespace vds::detail

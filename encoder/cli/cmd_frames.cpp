@@ -17,6 +17,8 @@ namespace {
 struct Options {
   std::string file;
   std::string png_dir;
+  size_t workspace = 0;
+  size_t player_from = 0;
 };
 
 void run(const Options& o) {
@@ -24,7 +26,8 @@ void run(const Options& o) {
   std::vector<enc::Image> frames;
   std::vector<uint32_t> crcs;
   try {
-    crcs = enc::client_frame_crcs(stream, o.png_dir.empty() ? nullptr : &frames);
+    const enc::ClientArena board{o.workspace, o.player_from};
+    crcs = enc::client_frame_crcs(stream, o.png_dir.empty() ? nullptr : &frames, o.workspace ? &board : nullptr);
   } catch (const std::runtime_error& e) {
     throw Failure(kExitBadInput, o.file + ": " + e.what());
   }
@@ -46,6 +49,11 @@ void add_frames(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("frames", "Print the CRC-32C of every frame a client displays");
   sub->add_option("STREAM", o->file, "vds stream")->required();
   sub->add_option("--png", o->png_dir, "Also write each frame as DIR/frameNNNN.png");
+  auto* w = sub->add_option("--workspace", o->workspace,
+                            "Replay a board: its workspace, bytes (its log: \"client: ready, workspace B bytes, player from byte U\")")
+                ->check(CLI::Range(size_t{1024}, size_t{1} << 30));
+  sub->add_option("--player-from", o->player_from, "With --workspace: where the board's player starts in it (U)")
+      ->needs(w);
   sub->callback([o] { run(*o); });
 }
 

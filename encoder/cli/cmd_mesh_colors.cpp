@@ -190,7 +190,7 @@ void run(const MeshColorsOptions& o) {
       for (int m = 0; m < mcm.max_res; ++m) {
         const auto planes = enc::decode_mesh_colors_level(mcm, e, m);
         const size_t coded = mcm.samples(m) - V;  // the codec's samples: edges and faces
-        const size_t bytes = e.levels[m].size();
+        const size_t bytes = e.level_bytes(m);
         const double ratio = 3.0 * coded / bytes;
         double p[3];
         for (int c = 0; c < 3; ++c) p[c] = plane_psnr(mcm.levels[m][c], planes[c], V);
@@ -254,7 +254,7 @@ void run(const MeshColorsOptions& o) {
       auto [p, img] = measure([&](const ref::CameraD& c) { return enc::render_mesh_colors(mcm, planes, 0, c, views); });
       char param[32];
       std::snprintf(param, sizeof param, "%g", q);
-      rows.push_back({"mcc-" + codec, param, e.header.size() + e.levels[0].size(), p, img});
+      rows.push_back({"mcc-" + codec, param, e.header.size() + e.level_bytes(0), p, img});
       ++coded_rows;
     }
   for (const Anchor& a : anchors) {

@@ -6,6 +6,8 @@
 // reported, and checks every frame's CRC against the host replay of the
 // client (what `vds frames` computes).
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -22,9 +24,24 @@ struct PlayArgs : BoardArgs {
   std::string stream;
 };
 
+// The board's workspace as its log states it ("client: ready, workspace B
+// bytes, player from byte U"), if it does.
+bool board_arena(const std::filesystem::path& log, enc::ClientArena* out) {
+  std::ifstream f(log);
+  std::string line;
+  while (std::getline(f, line)) {
+    unsigned long long b = 0, u = 0;
+    if (std::sscanf(line.c_str(), "client: ready, workspace %llu bytes, player from byte %llu", &b, &u) == 2) {
+      *out = enc::ClientArena{static_cast<size_t>(b), static_cast<size_t>(u)};
+      return true;
+    }
+  }
+  return false;
+}
+
 void run_play(const PlayArgs& a) {
   const std::vector<uint8_t> bytes = enc::read_file(a.stream);  // (main reports its refusal, naming the file)
-  // What the client must show.
+  // What any client must show; the stream is checked before it is served.
   std::vector<uint32_t> want;
   try {
     want = enc::client_frame_crcs(bytes);
@@ -34,6 +51,9 @@ void run_play(const PlayArgs& a) {
   const BoardResult r = run_on_board(a, a.stream, [&](const link::ServeOptions& o, const std::function<void(const std::string&)>& say) {
     return link::serve_stream(bytes, o, say);
   });
+  // What this board must show: its workspace decides how fine a model's colours are.
+  enc::ClientArena board;
+  if (board_arena(r.log, &board)) want = enc::client_frame_crcs(bytes, nullptr, &board);
   check_board_frames(a, a.stream, r, want);
 }
 

@@ -52,5 +52,6 @@ void add_fly(CLI::App& app);
 void add_encode_terrain(CLI::App& app);
 void add_serve_terrain(CLI::App& app);
 void add_mesh_colors(CLI::App& app);
+void add_encode_model(CLI::App& app);
 
 }  // namespace vds::cli

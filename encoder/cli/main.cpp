@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   vds::cli::add_encode_terrain(app);
   vds::cli::add_serve_terrain(app);
   vds::cli::add_mesh_colors(app);
+  vds::cli::add_encode_model(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

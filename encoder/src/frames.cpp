@@ -98,15 +98,25 @@ bool replay_band(void* ctx, const PixelRect& r) {
 
 // The client's own player with the boards' configuration: only its chunk
 // buffer is sized to the stream (it changes no pixel).
-std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames) {
+std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames,
+                                        const ClientArena* board) {
   auto player = std::make_unique<Player>();
   Replay rp;
   rp.frames = frames;
-  // The chunk buffer, then what the header declares, as on a client.
-  std::vector<uint8_t> ws((1u << 24) + ImageDecoder::kWorkspaceBytes + (1u << 23));  // or a model of <= 65,536 vertices
-  Arena arena(ws.data(), ws.size());
   PlayerConfig cfg = kClientPlayerConfig;
-  cfg.max_chunk_bytes = 1u << 24;
+  std::vector<uint8_t> ws;
+  if (board != nullptr) {
+    if (board->player_from >= board->budget || board->budget > (size_t{1} << 30))
+      throw std::runtime_error("client player: a board workspace of " + std::to_string(board->budget) +
+                               " bytes with the player from byte " + std::to_string(board->player_from));
+    ws.resize(board->budget);  // (aligned as the board's: the offsets below are the same modulo 8)
+  } else {
+    // The chunk buffer, then what the header declares, as on a client.
+    ws.resize((1u << 24) + ImageDecoder::kWorkspaceBytes + (1u << 25));  // or a model of <= 65,536 vertices
+    cfg.max_chunk_bytes = 1u << 24;
+  }
+  Arena arena(ws.data(), ws.size());
+  if (board != nullptr) arena.alloc(board->player_from, 1);
   PlayerCallbacks cb;
   cb.ctx = &rp;
   cb.begin_frame = [](void* ctx, uint16_t w, uint16_t h) {

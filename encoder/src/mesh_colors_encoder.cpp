@@ -32,6 +32,7 @@ int32_t quantise(double coef, uint32_t step_q4) { return static_cast<int32_t>(st
 
 
 struct Block {
+  uint32_t element = 0;  // edges 0 .. E - 1, then faces E + f
   int comp = 0;
   int kind = 0;  // 0 face, 1 edge
   int positions = 0;
@@ -109,8 +110,9 @@ void write_levels(ArithEncoder& enc, mc::BlockContexts& cx, int cls, int kind, i
   }
 }
 
-std::vector<uint8_t> encode_level(const MeshColorsModel& model, mc::MeshColors& layout, const mc::Steps& steps, int m,
-                                  uint8_t mode, double deadzone) {
+// Every block of level m, quantised, in the decoder's order.
+std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& layout, const mc::Steps& steps, int m,
+                                uint8_t mode, double deadzone) {
   layout.layout_level(m);
   const mc::Layout& l = layout.layout();
   const mc::Topology& topo = layout.topology();
@@ -140,6 +142,7 @@ std::vector<uint8_t> encode_level(const MeshColorsModel& model, mc::MeshColors& 
         const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
         const int64_t pred = paper && b > 0 ? prev_q[c] : mc::div_round(b == 0 ? vertex_q4 : mc::mean_q4(dst - 8, 8), dc_step);
         Block blk;
+        blk.element = e;
         blk.comp = c;
         blk.kind = 1;
         blk.positions = len;
@@ -197,6 +200,7 @@ std::vector<uint8_t> encode_level(const MeshColorsModel& model, mc::MeshColors& 
             for (int i = 0; i < len; ++i) sum += x[8 * r + i] = src[i];
           }
           Block blk;
+          blk.element = topo.edges + f;
           blk.comp = c;
           blk.kind = 0;
           blk.positions = positions;
@@ -239,6 +243,15 @@ std::vector<uint8_t> encode_level(const MeshColorsModel& model, mc::MeshColors& 
       }
   }
 
+  return blocks;
+}
+
+// The MCLV payload of blocks [b0, b1) of level m, whose elements are
+// [first, first + count): the contexts start afresh in every chunk.
+std::vector<uint8_t> code_chunk(const std::vector<Block>& all, size_t b0, size_t b1, int m, uint32_t first,
+                                uint32_t count, bool paper) {
+  const std::vector<Block> blocks(all.begin() + static_cast<std::ptrdiff_t>(b0),
+                                  all.begin() + static_cast<std::ptrdiff_t>(b1));
   ArithEncoder enc;
   if (paper) {
     // The pairs of each context set, then everything in the decoder's order.
@@ -294,9 +307,54 @@ std::vector<uint8_t> encode_level(const MeshColorsModel& model, mc::MeshColors& 
       write_levels(enc, cx, cls, b.kind, b.positions, prev_nz[cls][b.kind], b.ac);
     }
   }
-  std::vector<uint8_t> out{static_cast<uint8_t>(m)};
+  std::vector<uint8_t> out(mc::kLevelHeadBytes);
+  out[0] = static_cast<uint8_t>(m);
+  for (int i = 0; i < 4; ++i) {
+    out[1 + i] = static_cast<uint8_t>(first >> (8 * i));
+    out[5 + i] = static_cast<uint8_t>(count >> (8 * i));
+  }
   const std::vector<uint8_t> body = enc.finish();
   out.insert(out.end(), body.begin(), body.end());
+  return out;
+}
+
+// Level m as chunks of at most max_chunk bytes (0: one chunk): each the
+// most elements from where the last ended that fit (found by bisection).
+std::vector<std::vector<uint8_t>> encode_level(const MeshColorsModel& model, mc::MeshColors& layout,
+                                               const mc::Steps& steps, int m, uint8_t mode, double deadzone,
+                                               size_t max_chunk) {
+  const std::vector<Block> blocks = level_blocks(model, layout, steps, m, mode, deadzone);
+  const uint32_t n = layout.topology().edges + layout.topology().faces;
+  const bool paper = mode == mc::kModePaper;
+  // begin[e]: the first block of element e (blocks come in element order).
+  std::vector<size_t> begin(n + 1, blocks.size());
+  for (size_t i = blocks.size(); i-- > 0;) begin[blocks[i].element] = i;
+  for (uint32_t e = n; e-- > 0;) begin[e] = std::min(begin[e], begin[e + 1]);
+  auto chunk = [&](uint32_t a, uint32_t b) { return code_chunk(blocks, begin[a], begin[b], m, a, b - a, paper); };
+  std::vector<std::vector<uint8_t>> out;
+  uint32_t at = 0;
+  while (at < n) {
+    std::vector<uint8_t> whole = chunk(at, n);
+    if (max_chunk == 0 || whole.size() <= max_chunk) {
+      out.push_back(std::move(whole));
+      break;
+    }
+    uint32_t lo = at + 1, hi = n - 1;  // the most elements that fit: at least one
+    std::vector<uint8_t> best = chunk(at, lo);
+    if (best.size() > max_chunk) throw std::invalid_argument("mesh colors: one face takes more than a chunk");
+    while (lo < hi) {
+      const uint32_t mid = lo + (hi - lo + 1) / 2;
+      std::vector<uint8_t> c = chunk(at, mid);
+      if (c.size() <= max_chunk) {
+        lo = mid;
+        best = std::move(c);
+      } else {
+        hi = mid - 1;
+      }
+    }
+    out.push_back(std::move(best));
+    at = lo;
+  }
   return out;
 }
 
@@ -360,7 +418,8 @@ MccEncoded encode_mesh_colors(const MeshColorsModel& model, double quality, cons
   h.insert(h.end(), body.begin(), body.end());
   mc::Steps steps;
   mc::make_steps(q8, mode, &steps);
-  for (int m = 0; m < model.max_res; ++m) out.levels.push_back(encode_level(model, l.mc, steps, m, mode, o.deadzone));
+  for (int m = 0; m < model.max_res; ++m)
+    out.levels.push_back(encode_level(model, l.mc, steps, m, mode, o.deadzone, o.max_chunk));
   return out;
 }
 
@@ -377,9 +436,11 @@ std::array<std::vector<uint8_t>, 3> decode_mesh_colors_level(const MeshColorsMod
       for (int c = 0; c < 3; ++c) planes[c][v] = l.mc.vertex_samples()[3 * v + c];
     return planes;
   }
-  s = l.mc.decode_level(enc.levels.at(static_cast<size_t>(m)).data(), enc.levels[static_cast<size_t>(m)].size(),
-                        mc::Planes{planes[0].data(), planes[1].data(), planes[2].data()});
-  if (s != Status::ok) throw std::runtime_error(std::string("mesh colors level refused: ") + status_name(s));
+  for (const std::vector<uint8_t>& c : enc.levels.at(static_cast<size_t>(m))) {
+    s = l.mc.decode_level(c.data(), c.size(), mc::Planes{planes[0].data(), planes[1].data(), planes[2].data()});
+    if (s != Status::ok) throw std::runtime_error(std::string("mesh colors level refused: ") + status_name(s));
+  }
+  if (!l.mc.level_complete()) throw std::logic_error("mesh colors: a level's chunks do not cover it");
   return planes;
 }
 

@@ -145,6 +145,13 @@ void notice(void*, vds::PlayerNotice what, uint32_t a, uint32_t b, uint32_t c) {
     case vds::PlayerNotice::model_base_too_big:
       l.str("client: model: the base mesh needs ").dec(a).str(" bytes of workspace, ").dec(b).str(" are left\n");
       break;
+    case vds::PlayerNotice::model_colors_level:
+      l.str("client: model: colours down to MIP level ").dec(a).str(" of ").dec(b).str(" fit the workspace\n");
+      break;
+    case vds::PlayerNotice::model_no_colors:
+      l.str(a == 1 ? "client: model: the mesh is not whole: drawn without its colours\n"
+                   : "client: model: no room for the colours: drawn without them\n");
+      break;
   }
   board::log(l.c_str());
 }
@@ -300,7 +307,7 @@ extern "C" int vds_app_main() {
     log_status("workspace", s);
     return 3;
   }
-  board::log(Line().str("client: ready, workspace ").dec(budget).str(" bytes\n").c_str());
+  board::log(Line().str("client: ready, workspace ").dec(budget).str(" bytes, player from byte ").dec(g.stream_mark).str("\n").c_str());
 
   uint8_t rx[256];
   uint8_t tx[256];

@@ -85,8 +85,8 @@ void seed(const std::filesystem::path& dir) {
   const Fixed& f = fixed();
   write(dir / "seed_header", 0, std::string(f.stream.header.begin(), f.stream.header.end()));
   for (size_t m = 0; m < f.stream.levels.size(); ++m) {
-    write(dir / ("seed_level" + std::to_string(m)), 1, std::string(f.stream.levels[m].begin(), f.stream.levels[m].end()));
-    const auto& p = f.paper_stream.levels[m];
+    write(dir / ("seed_level" + std::to_string(m)), 1, std::string(f.stream.levels[m][0].begin(), f.stream.levels[m][0].end()));
+    const auto& p = f.paper_stream.levels[m][0];
     write(dir / ("seed_paper_level" + std::to_string(m)), 2, std::string(p.begin(), p.end()));
   }
   write(dir / "seed_obj", 3, std::string(1, '\0') +
@@ -118,7 +118,7 @@ void decode(const uint8_t* data, size_t size, bool as_level, bool paper) {
     if (!as_level) return;
     abort();  // the valid header must be taken
   }
-  const std::vector<uint8_t>& level = as_level ? std::vector<uint8_t>(data, data + size) : f.stream.levels[0];
+  const std::vector<uint8_t>& level = as_level ? std::vector<uint8_t>(data, data + size) : f.stream.levels[0][0];
   if (level.empty()) return;
   if (level[0] >= mc.max_res_log2()) {
     std::vector<uint8_t> one(1);

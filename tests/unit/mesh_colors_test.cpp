@@ -192,7 +192,7 @@ TEST(MeshColorsCodec, RoundTripThroughTheClientWithinBoundsAndSmallerAtLowerQual
     ASSERT_EQ(e.levels.size(), 5u);
     size_t bytes = 0;
     for (int level = 0; level < m.max_res; ++level) {
-      bytes += e.levels[level].size();
+      bytes += e.level_bytes(level);
       const auto planes = enc::decode_mesh_colors_level(m, e, level);
       for (int c = 0; c < 3; ++c) {
         ASSERT_EQ(planes[c].size(), m.levels[level][c].size());
@@ -213,7 +213,7 @@ TEST(MeshColorsCodec, TheVdsModeRoundTripsWithinBoundsAndBeatsThePaperMode) {
     const enc::MccEncoded e = enc::encode_mesh_colors(m, quality, o);
     const auto planes = enc::decode_mesh_colors_level(m, e, 0);
     *psnr = plane_psnr(planes[0], m.levels[0][0]);
-    return e.levels[0].size();
+    return e.level_bytes(0);
   };
   // Bounds, and fewer bytes at lower quality.
   const double quality[] = {0.125, 0.25, 0.5, 1, 2, 4, 8};
@@ -250,7 +250,7 @@ TEST(MeshColorsCodec, AFlatColourCostsAlmostNothingInTheVdsMode) {
   for (size_t i = 0; i < m.vertex_ycc.size(); ++i) m.vertex_ycc[i] = static_cast<uint8_t>(90 + 40 * (i % 3));
   const enc::MccEncoded e = enc::encode_mesh_colors(m, 2);
   for (int level = 0; level < m.max_res; ++level) {
-    EXPECT_LT(e.levels[level].size(), 40u) << "level " << level;
+    EXPECT_LT(e.level_bytes(level), 40u) << "level " << level;
     const auto planes = enc::decode_mesh_colors_level(m, e, level);
     // Flat everywhere, within half the mean's step (4 levels at quality 2) of the colour.
     for (int c = 0; c < 3; ++c)
@@ -339,14 +339,14 @@ TEST(MeshColorsCodec, HeadersAClientCannotTakeAreRefused) {
   EXPECT_EQ(h.mc.read_header(longer.data(), longer.size()), Status::malformed);
   // A level beyond the header's, and a level before any header.
   ASSERT_EQ(h.mc.read_header(e.header.data(), e.header.size()), Status::ok);
-  std::vector<uint8_t> level = e.levels[0];
+  std::vector<uint8_t> level = e.levels[0][0];
   level[0] = 3;
   const uint32_t total = h.mc.layout_level(0);
   std::vector<uint8_t> y(total), cb(total), cr(total);
   EXPECT_EQ(h.mc.decode_level(level.data(), level.size(), mc::Planes{y.data(), cb.data(), cr.data()}), Status::malformed);
   Held fresh;
   ASSERT_EQ(fresh.init(m.triangles, static_cast<uint32_t>(m.positions.size())), Status::ok);
-  EXPECT_EQ(fresh.mc.decode_level(e.levels[0].data(), e.levels[0].size(), mc::Planes{y.data(), cb.data(), cr.data()}),
+  EXPECT_EQ(fresh.mc.decode_level(e.levels[0][0].data(), e.levels[0][0].size(), mc::Planes{y.data(), cb.data(), cr.data()}),
             Status::invalid_argument);
 }
 
@@ -366,7 +366,8 @@ TEST_P(MeshColorsModes, EveryPrefixAndFlippedBytesAreRefusedCleanly) {
   std::vector<uint8_t> y(total), cb(total), cr(total);
   const mc::Planes planes{y.data(), cb.data(), cr.data()};
   for (int level = 0; level < 4; ++level) {
-    const std::vector<uint8_t>& b = e.levels[level];
+    ASSERT_EQ(e.levels[level].size(), 1u);
+    const std::vector<uint8_t>& b = e.levels[level][0];
     ASSERT_EQ(h.mc.decode_level(b.data(), b.size(), planes), Status::ok);
     for (size_t n = 0; n < b.size(); ++n) EXPECT_TRUE(is_error(h.mc.decode_level(b.data(), n, planes))) << n;
   }
@@ -375,12 +376,45 @@ TEST_P(MeshColorsModes, EveryPrefixAndFlippedBytesAreRefusedCleanly) {
   std::mt19937 rng(3);
   int refused = 0;
   for (int trial = 0; trial < 300; ++trial) {
-    std::vector<uint8_t> b = e.levels[trial % 4];
+    std::vector<uint8_t> b = e.levels[trial % 4][0];
     const size_t at = 1 + rng() % (b.size() - 1);
     b[at] ^= static_cast<uint8_t>(1 + rng() % 255);
     refused += is_error(h.mc.decode_level(b.data(), b.size(), planes));
   }
   EXPECT_GT(refused, 150);  // most damage is caught by the exact-length rule or a value no encoder writes
+}
+
+// A level cut into chunks that fit a client's chunk buffer decodes to the
+// same samples; its chunks must come in order, each after the last.
+TEST_P(MeshColorsModes, LevelsInChunksDecodeAlikeAndOnlyInOrder) {
+  const enc::MeshColorsModel m = test_colors();
+  enc::MccOptions o;
+  o.paper = GetParam();
+  const enc::MccEncoded whole = enc::encode_mesh_colors(m, 1, o);
+  o.max_chunk = 200;
+  const enc::MccEncoded cut = enc::encode_mesh_colors(m, 1, o);
+  ASSERT_GT(cut.levels[0].size(), 3u);
+  for (int level = 0; level < m.max_res; ++level) {
+    for (const auto& c : cut.levels[level]) EXPECT_LE(c.size(), 200u);
+    EXPECT_EQ(enc::decode_mesh_colors_level(m, cut, level), enc::decode_mesh_colors_level(m, whole, level)) << level;
+  }
+  Held h;
+  ASSERT_EQ(h.init(m.triangles, static_cast<uint32_t>(m.positions.size())), Status::ok);
+  ASSERT_EQ(h.mc.read_header(cut.header.data(), cut.header.size()), Status::ok);
+  const uint32_t total = h.mc.layout_level(0);
+  std::vector<uint8_t> y(total), cb(total), cr(total);
+  const mc::Planes planes{y.data(), cb.data(), cr.data()};
+  const auto& c0 = cut.levels[0];
+  const auto& c1 = cut.levels[1];
+  EXPECT_EQ(h.mc.decode_level(c0[1].data(), c0[1].size(), planes), Status::malformed);  // no first chunk yet
+  ASSERT_EQ(h.mc.decode_level(c0[0].data(), c0[0].size(), planes), Status::ok);
+  EXPECT_FALSE(h.mc.level_complete());
+  EXPECT_EQ(h.mc.decode_level(c0[2].data(), c0[2].size(), planes), Status::malformed);  // one skipped
+  ASSERT_EQ(h.mc.decode_level(c0[0].data(), c0[0].size(), planes), Status::ok);
+  EXPECT_EQ(h.mc.decode_level(c1[1].data(), c1[1].size(), planes), Status::malformed);  // another level's
+  for (const auto& c : c1) ASSERT_EQ(h.mc.decode_level(c.data(), c.size(), planes), Status::ok);
+  EXPECT_TRUE(h.mc.level_complete());
+  EXPECT_EQ(h.mc.decoding_level(), 1);
 }
 
 INSTANTIATE_TEST_SUITE_P(PaperAndVds, MeshColorsModes, ::testing::Values(true, false),

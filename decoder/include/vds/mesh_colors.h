@@ -63,6 +63,8 @@
 
 #include "vds/arena.h"
 #include "vds/arith.h"
+#include "vds/container.h"
+#include "vds/render.h"
 #include "vds/status.h"
 
 namespace vds::mc {
@@ -213,14 +215,26 @@ constexpr int kNzOrder = 1;
 //   truncated unary code (max max_res_log2) in the contexts of face f - 1's;
 //   vds mode: then every vertex's Y', Cb, Cr as signed differences from
 //   vertex_prediction (vertices in order).
+constexpr uint32_t kChunkHeader = fourcc('M', 'C', 'L', 'H');  // after the mesh's last level
+constexpr uint32_t kChunkLevel = fourcc('M', 'C', 'L', 'V');   // one MIP level, coarsest first
 constexpr uint8_t kVersion = 1;
 constexpr uint8_t kModePaper = 0;
 constexpr uint8_t kModeVds = 1;
 constexpr size_t kHeaderFixedBytes = 12;
 
-// --- A level chunk (MCLV) ----------------------------------------------------
-//   u8 level (0 .. max_res_log2 - 1), then the arithmetic-coded data (edges,
-//   then faces; per block Y', Cb, Cr, each its DC then its AC).
+// --- A level's chunks (MCLV) -------------------------------------------------
+//   u8 level (0 .. max_res_log2 - 1), u32 first element, u32 elements
+//   (elements: the edges 0 .. E - 1, then the faces as E + f), then the
+//   arithmetic-coded data of those elements (per block Y', Cb, Cr, each its
+//   DC then its AC), every context starting afresh. A level's chunks come
+//   in order and cover its elements, so each fits a client's chunk buffer.
+constexpr size_t kLevelHeadBytes = 9;
+struct LevelChunk {
+  int level = 0;
+  uint32_t first = 0, count = 0;
+};
+// The fixed fields of an MCLV payload; truncated if it is shorter.
+Status level_chunk_info(const uint8_t* data, size_t size, LevelChunk* out);
 
 // A client's (or the encoder's) mesh colors: topology, resolutions, vertex
 // samples, and the decoding of levels into caller planes.
@@ -245,11 +259,15 @@ class MeshColors {
   uint32_t layout_level(int m);
   const Layout& layout() const { return layout_; }
 
-  // The MCLV payload of level m (its first byte says which) into `out`, each
-  // plane at least layout_level(m) samples: the vertex samples, then every
-  // edge and face sample. malformed for data no encoder writes, truncated
-  // for data that ends early.
+  // An MCLV payload of level m (its first byte says which) into `out`, each
+  // plane at least layout_level(m) samples: a level's first chunk sets the
+  // layout and writes the vertex samples, each chunk its elements' edge and
+  // face samples. malformed for data no encoder writes or a chunk that does
+  // not follow the last one decoded, truncated for data that ends early.
   Status decode_level(const uint8_t* data, size_t size, const Planes& out);
+  // Whether the last chunk decoded completed its level, and which level that is.
+  bool level_complete() const { return decoding_ >= 0 && next_element_ == topo_.edges + topo_.faces; }
+  int decoding_level() const { return decoding_; }
 
   const Topology& topology() const { return topo_; }
   int max_res_log2() const { return max_res_; }
@@ -262,6 +280,10 @@ class MeshColors {
   // The level-m sample of face f at lattice point (i, j) (i + j <= R_m) in a
   // level's planes: its index.
   uint32_t sample_index(uint32_t f, int m, uint32_t i, uint32_t j) const;
+  // Where face f's samples lie in the planes of the level layout_level()
+  // last set, as the renderer samples them (Shading::mesh_colors).
+  void face_lattice(uint32_t f, LatticeFace* out) const;
+  int layout_level_shown() const { return layout_m_; }
   // The first block's DC prediction of face f at level m, before halving:
   // the sum of the Q4 means of the reconstructed blocks of its edges 0 and 2
   // at corner a, in `plane` (a level's plane with those edges decoded; the
@@ -283,6 +305,8 @@ class MeshColors {
   uint16_t quality_q8_ = 0;
   uint8_t mode_ = kModePaper;
   bool header_ = false;
+  int decoding_ = -1;           // the level the last chunk decoded belongs to
+  uint32_t next_element_ = 0;   // where its next chunk starts
 };
 
 }  // namespace vds::mc

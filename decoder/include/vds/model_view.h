@@ -56,7 +56,11 @@ class ModelView {
   // invalid_argument before init, for a mesh larger than init's counts or
   // one whose MeshState was initialised for more than 65,535 vertices (its
   // triangles are then 32-bit: MeshState::triangles16).
-  Status draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx);
+  // With `colors` (mesh colors of this mesh's triangles, vds/mesh_colors.h)
+  // the surface is drawn unlit in its own colours, with `filter` (nearest
+  // or the linear filter), instead of shaded.
+  Status draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx,
+              const MeshColorsSurface* colors = nullptr, Filter filter = Filter::bilinear);
 
   // Changes the axis shown up for later frames (e.g. once MSHH is in).
   void set_up(MeshUp up) { cfg_.up = up; }

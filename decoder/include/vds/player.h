@@ -109,6 +109,8 @@ enum class PlayerNotice : uint8_t {
   model_partial = 1,       // the workspace holds a (vertices) of the model's b: later levels are skipped
   model_full = 2,          // the workspace is full after level a of b (c vertices): the rest is not needed
   model_base_too_big = 3,  // the base mesh needs a bytes of workspace, b are left: the stream is refused
+  model_colors_level = 4,  // the workspace holds mesh colors down to MIP level a (of b levels, 0 the finest): finer ones are skipped
+  model_no_colors = 5,     // the model's colours cannot be shown (a: 1 the mesh is not whole, 2 no room): drawn shaded
 };
 
 struct PlayerCallbacks {
@@ -187,6 +189,9 @@ class Player {
   // Workspace a terrain stream needs beyond the parser (what its HEAD and
   // TERH declare).
   static size_t terrain_workspace_bytes(const StreamHeader& h, const terrain::Params& t, const PlayerConfig& config);
+  // Workspace a model's mesh colors need beyond its mesh and view (MCLH's
+  // counts) to show a level of `samples` samples.
+  static size_t model_colors_workspace_bytes(uint32_t faces, uint32_t vertices, uint32_t samples);
 
   Status init(Arena& arena, const PlayerConfig& config, const PlayerCallbacks& callbacks);
   Status feed(const uint8_t* data, size_t n);
@@ -275,6 +280,7 @@ class Player {
   ModelView view;
   ModelFrames model_frames;
   bool model_started = false;
+  struct ModelColors* colors = nullptr;  // decoder/src/player/mode_model.cpp
   WalkGeometry walk_geometry;
   WalkFrameDecoder walk_frames;
   struct WalkPlay* walk = nullptr;  // decoder/src/player/mode_walk.cpp

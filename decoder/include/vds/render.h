@@ -107,6 +107,7 @@ enum class Shading : uint8_t {
   gouraud = 1,      // Mesh::colors per vertex
   texture = 2,      // Mesh::texture at Mesh::uvs per vertex
   view_mapped = 3,  // Mesh::texture (a stored view) at Mesh::view_map(pixel)
+  mesh_colors = 4,  // Mesh::surface: samples on each face's lattice (nearest or linear)
 };
 
 enum class Cull : uint8_t { none = 0, back = 1, front = 2 };
@@ -140,6 +141,38 @@ struct TexCoord {
   Q16_16 u, v;  // texels
 };
 
+// Shading::mesh_colors (mesh colors, vds/mesh_colors.h): a face of
+// resolution R = 2^res_log2 has its samples at lattice points (i, j),
+// i, j >= 0, i + j <= R, barycentric ((R - i - j) / R, i / R, j / R) on its
+// corners (a, b, c). Where they lie in the surface's planes:
+//   (0, 0), (R, 0), (0, R)   vertex[0], vertex[1], vertex[2];
+//   edge k (corner k -> corner k + 1; lattice step p = i, j, R - j from
+//   corner k on edges 0, 1, 2)  edge_base[k] + p * edge_step[k];
+//   the rest                 face_base + the row offset of j + i - 1, row j
+//                            (1 .. R - 2) holding i = 1 .. R - 1 - j.
+// Filter::nearest takes the lattice point nearest in (i, j); the others
+// the linear filter of the mesh colors paper: the three samples of the
+// lattice triangle holding the point, weighted barycentrically (8 bits).
+// A face whose indices reach outside the planes is not drawn.
+struct LatticeFace {
+  uint32_t vertex[3];
+  uint32_t edge_base[3];
+  int32_t edge_step[3];
+  uint32_t face_base;
+  uint8_t res_log2;  // 0..10
+};
+
+struct MeshColorsSurface {
+  const uint8_t* y = nullptr;  // Y', Cb, Cr planes (JFIF full range), `samples` each
+  const uint8_t* cb = nullptr;
+  const uint8_t* cr = nullptr;
+  uint32_t samples = 0;
+  // Fills `out` for triangle t of the mesh (its index in Mesh::indices / 3),
+  // once per polygon set-up; false leaves the triangle undrawn.
+  bool (*face)(const void* ctx, uint32_t t, LatticeFace* out) = nullptr;
+  const void* ctx = nullptr;
+};
+
 // Triangles that share one material. Vertex attributes (colors, uvs) are
 // indexed by the same vertex index as DrawList::positions.
 struct Mesh {
@@ -153,6 +186,7 @@ struct Mesh {
   const TexCoord* uvs = nullptr;       // texture: per vertex
   const Texture* texture = nullptr;    // texture, view_mapped
   Homography view_map{};               // view_mapped: screen pixel -> texel (plane_homography(screen, view))
+  const MeshColorsSurface* surface = nullptr;  // mesh_colors
 };
 
 struct DrawList {

@@ -4,10 +4,35 @@
 // the mesh header (MSHH) for as much of the model as the workspace holds: a
 // client smaller than the full resolution plays the levels that fit and
 // says at once when it holds no more.
+//
+// A textured model's colour follows its geometry as mesh colors
+// (vds/mesh_colors.h): MCLH, once the mesh is whole, carries every face's
+// resolution and the vertex samples (the model is drawn with them at
+// once), then MCLV chunks its MIP levels coarsest first, each replacing
+// the one shown. The planes are carved at MCLH for the finest level the
+// workspace holds; finer levels are skipped, so a small client shows the
+// colour it can rather than none.
+#include "vds/mesh_colors.h"
 #include "vds/player.h"
 
 namespace vds {
+
+struct ModelColors {
+  mc::MeshColors mc;
+  mc::Planes planes;
+  MeshColorsSurface surface;
+  int finest = 0;  // the finest level the planes hold
+  int shown = 0;   // the level in the planes (max_res_log2: vertex samples only)
+};
+
 namespace {
+
+bool lattice_of(const void* ctx, uint32_t t, LatticeFace* out) {
+  const auto* c = static_cast<const ModelColors*>(ctx);
+  if (t >= c->mc.topology().faces) return false;
+  c->mc.face_lattice(t, out);
+  return true;
+}
 
 bool start(Player& p, const StreamHeader&) {
   if (p.config().format != PixelFormat::rgb565) {
@@ -15,6 +40,7 @@ bool start(Player& p, const StreamHeader&) {
     return false;
   }
   p.model_started = false;
+  p.colors = nullptr;
   p.level_mark = 0;
   p.model_frames = ModelFrames{};
   return true;  // the decoder and the view are set up when MSHH arrives
@@ -54,7 +80,137 @@ bool start_mesh(Player& p, const uint8_t* mshh, uint32_t size) {
   return true;
 }
 
+// Draws the current mesh (with its colours once they are in) as the next frame.
+ChunkResult draw_frame(Player& p) {
+  if (!p.begin_frame()) return ChunkResult::abort;
+  const uint64_t display_before = p.display_total();
+  const uint64_t d0 = p.work_clock();
+  const MeshColorsSurface* surface = p.colors != nullptr ? &p.colors->surface : nullptr;
+  const Status d = p.view.draw(p.mesh.mesh(), p.model_frames.angle(), detail::render_band_to_player, &p, surface);
+  p.model_frames.mark_drawn(p.mesh);
+  // Drawing counts as display: the bands have added their part, add the renderer's.
+  p.add_display((p.work_clock() - d0) - (p.display_total() - display_before));
+  if (d != Status::ok) {
+    p.fail(d, "the model view could not draw");
+    return ChunkResult::abort;
+  }
+  return p.end_frame() ? ChunkResult::consumed : ChunkResult::abort;
+}
+
+// MCLH: the mesh colors of the whole mesh, set up for the finest level the
+// workspace holds; the model is drawn with its vertex samples.
+ChunkResult start_colors(Player& p, const uint8_t* payload, uint32_t size) {
+  const MeshState& m = p.mesh.mesh();
+  if (!p.mesh.complete() || m.vertex_count() != p.mesh.header().vertices || m.triangles16() == nullptr) {
+    p.notice(PlayerNotice::model_no_colors, 1, 0, 0);  // they belong to the whole mesh
+    return ChunkResult::consumed;
+  }
+  Arena& a = p.arena();
+  const size_t mark = a.mark();
+  auto* c = a.alloc_array<ModelColors>(1);
+  Status s = c != nullptr ? Status::ok : Status::workspace_too_small;
+  if (s == Status::ok) {
+    *c = ModelColors{};
+    s = c->mc.init(a, m.triangles16(), m.triangle_count(), m.vertex_count());
+  }
+  if (s == Status::ok) s = c->mc.read_header(payload, size);
+  if (s != Status::ok && s != Status::workspace_too_small) {
+    p.fail(s, "the mesh colors header was refused");
+    return ChunkResult::abort;
+  }
+  // The finest level whose three planes fit what is left.
+  int level = -1;
+  if (s == Status::ok) {
+    for (int l = 0; l <= c->mc.max_res_log2(); ++l) {
+      if (size_t{3} * c->mc.layout_level(l) + 8 <= a.remaining()) {
+        level = l;
+        break;
+      }
+    }
+  }
+  if (level < 0) {
+    a.rewind(mark);
+    p.notice(PlayerNotice::model_no_colors, 2, 0, 0);
+    return ChunkResult::consumed;
+  }
+  const uint32_t total = c->mc.layout_level(level);
+  c->planes.y = a.alloc_array<uint8_t>(total);
+  c->planes.cb = a.alloc_array<uint8_t>(total);
+  c->planes.cr = a.alloc_array<uint8_t>(total);
+  c->finest = level;
+  if (level > 0) p.notice(PlayerNotice::model_colors_level, static_cast<uint32_t>(level), static_cast<uint32_t>(c->mc.max_res_log2()), 0);
+  // Shown first: the vertex samples alone (every face at R = 1).
+  const int coarsest = c->mc.max_res_log2();
+  c->mc.layout_level(coarsest);
+  const uint8_t* vs = c->mc.vertex_samples();
+  for (uint32_t v = 0; v < m.vertex_count(); ++v)
+    for (int k = 0; k < 3; ++k) c->planes.plane(k)[v] = vs[3 * v + k];
+  c->shown = coarsest;
+  c->surface.y = c->planes.y;
+  c->surface.cb = c->planes.cb;
+  c->surface.cr = c->planes.cr;
+  c->surface.samples = total;
+  c->surface.face = lattice_of;
+  c->surface.ctx = c;
+  p.colors = c;
+  return ChunkResult::consumed;
+}
+
+// MCLV: the chunks of a level finer than the one shown and no finer than
+// the planes hold replace it (drawn when the level is whole); others are
+// skipped.
+ChunkResult colors_level(Player& p, const uint8_t* payload, uint32_t size, bool* drawn) {
+  ModelColors* c = p.colors;
+  *drawn = false;
+  if (c == nullptr) return ChunkResult::consumed;  // colours not shown (noticed at MCLH)
+  mc::LevelChunk lc;
+  Status s = mc::level_chunk_info(payload, size, &lc);
+  if (s == Status::ok && lc.level >= c->mc.max_res_log2()) s = Status::malformed;
+  if (s != Status::ok) {
+    p.fail(s, "a mesh colors level chunk was refused");
+    return ChunkResult::abort;
+  }
+  const bool wanted = lc.first == 0 ? lc.level >= c->finest && lc.level < c->shown : c->mc.decoding_level() == lc.level;
+  if (!wanted) return ChunkResult::consumed;
+  s = c->mc.decode_level(payload, size, c->planes);
+  if (s != Status::ok) {
+    p.fail(s, "the mesh colors decoder refused a level");
+    return ChunkResult::abort;
+  }
+  if (c->mc.level_complete()) {
+    c->shown = lc.level;
+    *drawn = true;
+  }
+  return ChunkResult::consumed;
+}
+
+ChunkResult on_colors_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size) {
+  if (!p.model_started) {
+    p.fail(Status::malformed, "mesh colors before the mesh");
+    return ChunkResult::abort;
+  }
+  const uint64_t t0 = p.enter_chunk();
+  ChunkResult r;
+  bool draw = false;
+  if (type == mc::kChunkHeader) {
+    if (p.colors != nullptr) {
+      p.fail(Status::malformed, "a second mesh colors header");
+      r = ChunkResult::abort;
+    } else {
+      r = start_colors(p, payload, size);
+      draw = r == ChunkResult::consumed && p.colors != nullptr;
+    }
+  } else {
+    r = colors_level(p, payload, size, &draw);
+  }
+  p.add_decode(p.work_clock() - t0);
+  if (r == ChunkResult::consumed && draw && p.mesh.drawable()) r = draw_frame(p);
+  p.leave_chunk();
+  return r;
+}
+
 ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size) {
+  if (type == mc::kChunkHeader || type == mc::kChunkLevel) return on_colors_chunk(p, type, payload, size);
   if (!MeshDecoder::handles(type)) return ChunkResult::unknown;
   if (!p.model_started) {
     if (type != chunk::kMeshHeader) {
@@ -89,24 +245,7 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
   }
   // The level a chunk completed is drawn even when the decoder knows at once
   // that the next one will not fit (a version-2 stream's tail).
-  if (result == ChunkResult::consumed && p.model_frames.due(p.mesh)) {
-    if (!p.begin_frame()) {
-      result = ChunkResult::abort;
-    } else {
-      const uint64_t display_before = p.display_total();
-      const uint64_t d0 = p.work_clock();
-      const Status d = p.view.draw(p.mesh.mesh(), p.model_frames.angle(), detail::render_band_to_player, &p);
-      p.model_frames.mark_drawn(p.mesh);
-      // Drawing counts as display: the bands have added their part, add the renderer's.
-      p.add_display((p.work_clock() - d0) - (p.display_total() - display_before));
-      if (d != Status::ok) {
-        p.fail(d, "the model view could not draw");
-        result = ChunkResult::abort;
-      } else if (!p.end_frame()) {
-        result = ChunkResult::abort;
-      }
-    }
-  }
+  if (result == ChunkResult::consumed && p.model_frames.due(p.mesh)) result = draw_frame(p);
   p.leave_chunk();
   return result;
 }
@@ -116,6 +255,11 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
 size_t feed_limit(const Player&, uint32_t frames_room) { return detail::chunk_per_frame_feed_limit(frames_room); }
 
 }  // namespace
+
+size_t Player::model_colors_workspace_bytes(uint32_t faces, uint32_t vertices, uint32_t samples) {
+  return sizeof(ModelColors) + alignof(ModelColors) + mc::MeshColors::init_bytes(faces, vertices) + size_t{3} * samples +
+         64;
+}
 
 namespace detail {
 extern const PlayerMode kModelMode;

@@ -4,6 +4,7 @@
 // lightmaps and supersampling for ground-truth frames.
 #include "vds/ref/render.h"
 
+#include <stdexcept>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -255,6 +256,10 @@ RefFrame ref_render(const Scene& scene, const CameraD& camera_in, int width, int
   int32_t tri_id = 0;
 
   for (const MeshD& m : scene.meshes) {
+    // A scene carries textures, not mesh colors: those are drawn in double
+    // by vds::enc::render_mesh_colors (vds/enc/model_render.h).
+    if (m.shading == Shading::mesh_colors)
+      throw std::invalid_argument("ref_render: mesh colors are drawn by enc::render_mesh_colors");
     Mat3d view_map;
     if (m.shading == Shading::view_mapped && m.indices.size() >= 3) {
       const Vec3d pl[3] = {scene.positions[m.indices[0]], scene.positions[m.indices[1]], scene.positions[m.indices[2]]};
@@ -350,6 +355,7 @@ RefFrame ref_render(const Scene& scene, const CameraD& camera_in, int width, int
                 col = sampler.sample(m.texture, uv.x, uv.y, m.filter, lod);
                 break;
               }
+              case Shading::mesh_colors: break;  // refused above
               case Shading::view_mapped: {
                 // view_map is in pixels of the unscaled camera.
                 double u = 0, v = 0;

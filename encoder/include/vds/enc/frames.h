@@ -37,6 +37,17 @@ FrameSequenceResult encode_frames(const std::vector<Image>& frames, const FrameS
 // the client's player (vds/player.h) with the boards' configuration, and
 // returns each frame's CRC-32C (and its pixels if `frames` is given).
 // Throws std::runtime_error naming the client status on a bad stream.
-std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames = nullptr);
+//
+// A client's workspace decides some pictures (how fine a model's colours
+// it holds): `arena` replays one board exactly, its player given the
+// workspace from byte `player_from` to `budget` as on the board (whose log
+// says both: "client: ready, workspace B bytes, player from byte U"), with
+// the boards' chunk buffer. Without it the player has room for any stream.
+struct ClientArena {
+  size_t budget = 0;
+  size_t player_from = 0;
+};
+std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames = nullptr,
+                                        const ClientArena* arena = nullptr);
 
 }  // namespace vds::enc

@@ -100,8 +100,14 @@ std::array<uint8_t, 3> rgb_to_ycc(double r, double g, double b);
 
 // --- The codec ---------------------------------------------------------------
 struct MccEncoded {
-  std::vector<uint8_t> header;               // MCLH payload
-  std::vector<std::vector<uint8_t>> levels;  // MCLV payloads, index = level (0 .. max_res - 1)
+  std::vector<uint8_t> header;  // MCLH payload
+  // MCLV payloads: per level (0 .. max_res - 1), its chunks in order.
+  std::vector<std::vector<std::vector<uint8_t>>> levels;
+  size_t level_bytes(int m) const {
+    size_t n = 0;
+    for (const auto& c : levels.at(static_cast<size_t>(m))) n += c.size();
+    return n;
+  }
 };
 
 struct MccOptions {
@@ -113,6 +119,8 @@ struct MccOptions {
   bool paper = false;
   // vds mode: AC levels rounded down below 0.5 + deadzone of a step.
   double deadzone = 0.35;
+  // The largest MCLV payload (a client's chunk buffer); 0: a level in one chunk.
+  size_t max_chunk = 0;
 };
 
 // Every level of `mc` at quality factor `quality` (the JPEG tables'

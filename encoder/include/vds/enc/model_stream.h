@@ -1,0 +1,65 @@
+// vds encoder: a textured model as one model-mode stream — the progressive
+// mesh (vds/enc/mesh_encoder.h), then its colour as mesh colors
+// (vds/enc/mesh_colors.h): MCLH once the mesh is whole, then the MIP
+// levels coarsest first, each in chunks a client's chunk buffer holds
+// (docs/model-mode.md, "The model stream").
+//
+// The colours are keyed to the mesh as the client decodes it: the encoder
+// decodes its own geometry with the client library and converts the model
+// in that vertex and face order, so vertex v and face f of MCLH are the
+// client's vertex v and triangle f.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "vds/enc/mesh_colors.h"
+#include "vds/enc/mesh_encoder.h"
+#include "vds/enc/mesh_import.h"
+
+namespace vds::enc {
+
+struct ModelStreamOptions {
+  ModelStreamOptions() {
+    mesh.tail_fraction = kMeshDefaultTail;
+    colors.max_res_log2 = 8;
+  }
+  MeshEncodeOptions mesh;     // geometry (grid bits, up axis, frame size, chunk size)
+  MeshColorsOptions colors;   // conversion; its density is set from the quality unless fixed_density
+  bool fixed_density = false;
+  MccOptions codec;           // mesh colors codec (max_chunk: the mesh's max_chunk_payload)
+  double quality = 1;         // the codec's quality factor (JPEG tables' multiplier)
+  // > 0: the finest quality (of a ladder from 1/8 to 64) whose whole stream
+  // takes at most this many bytes; the quality above is then ignored.
+  size_t max_bytes = 0;
+};
+
+// Where the stream's bytes go (chunk framing included).
+struct ModelStreamParts {
+  size_t geometry = 0;             // preamble, HEAD, mesh chunks, END
+  size_t colors_header = 0;        // MCLH
+  std::vector<size_t> level_bytes; // MCLV chunks per level (0 the finest)
+  std::vector<size_t> level_end;   // stream offset where each level's last chunk ends
+  size_t geometry_end = 0;         // stream offset after the mesh's last chunk
+  size_t colors_header_end = 0;    // after MCLH
+};
+
+struct ModelStreamResult {
+  std::vector<uint8_t> stream;
+  StreamHeader header{};      // its HEAD
+  double quality = 0;
+  MeshRepairReport repair;
+  MeshEncodeResult mesh;      // the geometry alone (its own stream)
+  TexturedModel decoded;      // the model in the client's vertex and face order
+  MeshColorsModel colors;     // its mesh colors (uncoded)
+  MccEncoded coded;           // and coded
+  ModelStreamParts parts;
+};
+
+// Encodes `model` (load_textured_model). Throws std::invalid_argument for a
+// model the codecs cannot take (not made manifold by the repair, above the
+// client's limits) or a byte budget no quality meets.
+ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStreamOptions& o);
+
+}  // namespace vds::enc

@@ -1,0 +1,197 @@
+// A textured model as one model-mode stream (vds/enc/model_stream.h).
+#include "vds/enc/model_stream.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <stdexcept>
+
+#include "vds/bytes.h"
+#include "vds/container.h"
+#include "vds/enc/stream_writer.h"
+#include "vds/mesh_colors.h"
+#include "vds/player.h"
+
+namespace vds::enc {
+namespace {
+
+struct Chunk {
+  uint32_t type;
+  std::span<const uint8_t> payload;
+};
+
+// The chunks of a stream this encoder wrote, HEAD and END left out.
+std::vector<Chunk> body_chunks(std::span<const uint8_t> s) {
+  std::vector<Chunk> out;
+  size_t at = kPreambleBytes;
+  while (at + kChunkHeadBytes + kChunkTailBytes <= s.size()) {
+    const uint32_t type = load_le32(s.data() + at), n = load_le32(s.data() + at + 4);
+    if (at + kChunkHeadBytes + n + kChunkTailBytes > s.size()) break;
+    if (type != chunk::kHeader && type != chunk::kEnd) out.push_back({type, s.subspan(at + kChunkHeadBytes, n)});
+    at += kChunkHeadBytes + n + kChunkTailBytes;
+  }
+  if (at != s.size()) throw std::logic_error("model stream: the mesh stream does not parse");
+  return out;
+}
+
+// The client's mesh after the whole geometry stream: its triangles (3 per
+// face, the client's vertex numbers).
+std::vector<uint32_t> client_triangles(std::span<const uint8_t> stream, uint32_t* vertices) {
+  auto player = std::make_unique<Player>();
+  std::vector<uint8_t> ws((1u << 24) + (1u << 25));
+  Arena arena(ws.data(), ws.size());
+  PlayerConfig cfg = kClientPlayerConfig;
+  cfg.max_chunk_bytes = 1u << 24;
+  if (player->init(arena, cfg, PlayerCallbacks{}) != Status::ok) throw std::logic_error("model stream: player");
+  Status s = player->feed(stream.data(), stream.size());
+  if (s == Status::more_input) s = player->finish();
+  const MeshState& m = player->mesh.mesh();
+  if (s != Status::ok || !player->mesh.complete())
+    throw std::logic_error(std::string("model stream: the client does not decode the geometry: ") + status_name(s));
+  std::vector<uint32_t> tri(3 * size_t{m.triangle_count()});
+  for (size_t c = 0; c < tri.size(); ++c) tri[c] = m.corner_vertex(static_cast<uint32_t>(c));
+  *vertices = m.vertex_count();
+  return tri;
+}
+
+// `model` renumbered as the client holds its mesh: the client's vertex d
+// is the repaired mesh's vertex order[d], at a position of the model's;
+// the client's face (a, b, c) is the model's face over those vertices,
+// its corners' attributes turned to start at a.
+TexturedModel in_client_order(const TexturedModel& model, const Mesh& repaired, const std::vector<uint32_t>& order,
+                              const std::vector<uint32_t>& tri) {
+  std::map<std::array<double, 3>, uint32_t> at;
+  for (uint32_t v = 0; v < model.positions.size(); ++v) at.emplace(model.positions[v], v);
+  std::vector<uint32_t> model_vertex(order.size());
+  for (size_t d = 0; d < order.size(); ++d) {
+    const auto it = at.find(repaired.positions.at(order[d]));
+    if (it == at.end()) throw std::logic_error("model stream: a repaired vertex is not the model's");
+    model_vertex[d] = it->second;
+  }
+  // Faces by their vertices, turned to start at the smallest.
+  auto key = [](uint32_t a, uint32_t b, uint32_t c) {
+    const uint32_t m = std::min({a, b, c});
+    return m == a ? std::array<uint32_t, 3>{a, b, c} : (m == b ? std::array<uint32_t, 3>{b, c, a} : std::array<uint32_t, 3>{c, a, b});
+  };
+  std::map<std::array<uint32_t, 3>, std::vector<uint32_t>> faces;
+  for (uint32_t f = 0; f < model.triangles.size(); ++f) {
+    const auto& t = model.triangles[f];
+    faces[key(t[0], t[1], t[2])].push_back(f);
+  }
+  TexturedModel out;
+  out.name = model.name;
+  out.materials = model.materials;
+  out.textures = model.textures;
+  out.texture_files = model.texture_files;
+  for (uint32_t v : model_vertex) out.positions.push_back(model.positions[v]);
+  for (size_t t = 0; 3 * t < tri.size(); ++t) {
+    const uint32_t a = model_vertex.at(tri[3 * t]), b = model_vertex.at(tri[3 * t + 1]), c = model_vertex.at(tri[3 * t + 2]);
+    auto it = faces.find(key(a, b, c));
+    if (it == faces.end() || it->second.empty()) throw std::logic_error("model stream: a client face is not the model's");
+    const uint32_t f = it->second.back();
+    it->second.pop_back();
+    const auto& mt = model.triangles[f];
+    const int turn = mt[0] == a ? 0 : (mt[1] == a ? 1 : 2);
+    out.triangles.push_back({tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]});
+    std::array<std::array<double, 2>, 3> uv{};
+    std::array<std::array<double, 3>, 3> colour{};
+    for (int k = 0; k < 3; ++k) {
+      uv[k] = model.uv[f][(k + turn) % 3];
+      colour[k] = model.colour[f][(k + turn) % 3];
+    }
+    out.uv.push_back(uv);
+    out.colour.push_back(colour);
+    out.material.push_back(model.material[f]);
+  }
+  return out;
+}
+
+struct Colours {
+  double quality;
+  MeshColorsModel mc;
+  MccEncoded coded;
+};
+
+Colours colours_at(const TexturedModel& dm, const ModelStreamOptions& o, double quality, size_t max_chunk) {
+  MeshColorsOptions co = o.colors;
+  if (!o.fixed_density) co.density = density_for_quality(quality);
+  Colours c{quality, to_mesh_colors(dm, co), {}};
+  MccOptions mo = o.codec;
+  mo.max_chunk = max_chunk;
+  c.coded = encode_mesh_colors(c.mc, quality, mo);
+  return c;
+}
+
+size_t framed(size_t payload) { return kChunkHeadBytes + payload + kChunkTailBytes; }
+
+size_t stream_bytes(const MeshEncodeResult& mesh, const MccEncoded& coded) {
+  size_t n = mesh.stream.size() + framed(coded.header.size());
+  for (const auto& level : coded.levels)
+    for (const auto& c : level) n += framed(c.size());
+  return n;
+}
+
+}  // namespace
+
+ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStreamOptions& o) {
+  ModelStreamResult r;
+  Mesh mesh;
+  mesh.positions = model.positions;
+  mesh.triangles = model.triangles;
+  const Mesh repaired = repair_mesh(mesh, &r.repair);
+  r.mesh = encode_mesh(repaired, o.mesh);
+  uint32_t vertices = 0;
+  const std::vector<uint32_t> tri = client_triangles(r.mesh.stream, &vertices);
+  if (vertices != r.mesh.vertex_order.size()) throw std::logic_error("model stream: the client's vertex count differs");
+  r.decoded = in_client_order(model, repaired, r.mesh.vertex_order, tri);
+
+  const size_t max_chunk = r.mesh.stream_header.max_chunk_payload;
+  Colours c;
+  if (o.max_bytes > 0) {
+    bool found = false;
+    for (double q = 0.125; q <= 64 && !found; q *= std::sqrt(2.0)) {
+      c = colours_at(r.decoded, o, q, max_chunk);
+      found = stream_bytes(r.mesh, c.coded) <= o.max_bytes;
+    }
+    if (!found)
+      throw std::invalid_argument("no quality fits " + std::to_string(o.max_bytes) + " bytes (at quality 64: " +
+                                  std::to_string(stream_bytes(r.mesh, c.coded)) + ")");
+  } else {
+    c = colours_at(r.decoded, o, o.quality, max_chunk);
+  }
+  if (c.coded.header.size() > max_chunk)
+    throw std::invalid_argument("the mesh colors header takes " + std::to_string(c.coded.header.size()) +
+                                " bytes, more than a chunk (" + std::to_string(max_chunk) + "): raise the chunk size");
+  r.quality = c.quality;
+  r.colors = std::move(c.mc);
+  r.coded = std::move(c.coded);
+
+  StreamHeader h = r.mesh.stream_header;
+  const uint32_t faces = static_cast<uint32_t>(r.colors.face_res.size());
+  const size_t extra = Player::model_colors_workspace_bytes(faces, vertices, r.colors.samples(0));
+  if (h.workspace_bytes + extra > 0xFFFFFFFFu) throw std::invalid_argument("model too large for a client workspace");
+  h.workspace_bytes = static_cast<uint32_t>(h.workspace_bytes + extra);
+  StreamWriter w(h);
+  for (const Chunk& ch : body_chunks(r.mesh.stream)) w.add_chunk(ch.type, ch.payload);
+  r.parts.geometry_end = w.size();
+  w.add_chunk(mc::kChunkHeader, r.coded.header);
+  r.parts.colors_header_end = w.size();
+  r.parts.colors_header = framed(r.coded.header.size());
+  r.parts.level_bytes.assign(r.coded.levels.size(), 0);
+  r.parts.level_end.assign(r.coded.levels.size(), 0);
+  for (size_t m = r.coded.levels.size(); m-- > 0;) {
+    for (const auto& ch : r.coded.levels[m]) {
+      w.add_chunk(mc::kChunkLevel, ch);
+      r.parts.level_bytes[m] += framed(ch.size());
+    }
+    r.parts.level_end[m] = w.size();
+  }
+  r.stream = w.finish();
+  r.header = h;
+  r.parts.geometry = r.stream.size() - r.parts.colors_header;
+  for (size_t b : r.parts.level_bytes) r.parts.geometry -= b;
+  return r;
+}
+
+}  // namespace vds::enc
