@@ -80,9 +80,12 @@ def model_prefix(board_log):
             "levels": int(full.group(2)), "level_vertices": int(full.group(3))}
 
 
-def replay_crcs(vds, stream, png_dir=None):
-    """The CRC of every frame a client must display (`vds frames`), or None if it fails."""
+def replay_crcs(vds, stream, png_dir=None, workspace=None):
+    """The CRC of every frame a client must display (`vds frames`), or None if it fails;
+    with workspace=(budget, player_from), the frames of a board with that workspace."""
     cmd = [vds, "frames", stream] + (["--png", png_dir] if png_dir else [])
+    if workspace:
+        cmd += ["--workspace", str(workspace[0]), "--player-from", str(workspace[1])]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         print(r.stdout + r.stderr)

@@ -15,11 +15,14 @@
 #include <cstdlib>
 #include <cstring>
 #include <vector>
+#include <array>
 
 #include "jpeg_sample_422.h"
 #include "vds/container.h"
 #include "vds/enc/frames.h"
 #include "vds/enc/mesh_encoder.h"
+#include "vds/enc/model_stream.h"
+#include "vds/mesh_colors.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/enc/terrain_stream.h"
 #include "vds/image.h"
@@ -44,14 +47,14 @@ std::vector<uint8_t> container(vds::StreamMode mode, const uint8_t* data, size_t
   vds::enc::StreamWriter w(h);
   const uint32_t images[] = {vds::chunk::kImageHeader, vds::chunk::kImageData, vds::chunk::kJpeg};
   const uint32_t meshes[] = {vds::chunk::kMeshHeader, vds::chunk::kMeshBase, vds::chunk::kMeshLevel,
-                             vds::chunk::kMeshTail};
+                             vds::chunk::kMeshTail, vds::mc::kChunkHeader, vds::mc::kChunkLevel};
   size_t at = 0;
   while (at + 2 <= size) {
     const uint8_t pick = data[at];
     const size_t len = data[at + 1] * 8u % 600;
     at += 2;
     const size_t n = len < size - at ? len : size - at;
-    const uint32_t type = mode == vds::StreamMode::images ? images[pick % 3] : meshes[pick % 4];
+    const uint32_t type = mode == vds::StreamMode::images ? images[pick % 3] : meshes[pick % 6];
     w.add_chunk(type, std::vector<uint8_t>(data + at, data + at + n));
     at += n;
   }
@@ -119,18 +122,35 @@ const std::vector<uint8_t>& valid_jpeg_images() {
   return s;
 }
 
+// A textured 8 x 8-point grid (a 32 x 32 random texture): its mesh, then
+// its mesh colors (vds encode-model's stream).
 const std::vector<uint8_t>& valid_model() {
   static const std::vector<uint8_t> s = [] {
-    vds::enc::Mesh m;
+    vds::enc::TexturedModel m;
     for (int y = 0; y < 8; ++y)
       for (int x = 0; x < 8; ++x) m.positions.push_back({double(x), double(y), double((x * y) % 3)});
     for (uint32_t y = 0; y + 1 < 8; ++y)
       for (uint32_t x = 0; x + 1 < 8; ++x) {
         const uint32_t a = y * 8 + x, b = a + 1, c = a + 8, d = c + 1;
-        m.triangles.push_back({a, b, d});
-        m.triangles.push_back({a, d, c});
+        for (const std::array<uint32_t, 3>& t : {std::array<uint32_t, 3>{a, b, d}, std::array<uint32_t, 3>{a, d, c}}) {
+          m.triangles.push_back(t);
+          std::array<std::array<double, 2>, 3> uv{};
+          for (int k = 0; k < 3; ++k) uv[k] = {(t[k] % 8) / 7.0, (t[k] / 8) / 7.0};
+          m.uv.push_back(uv);
+          m.colour.push_back({{{1, 1, 1}, {1, 1, 1}, {1, 1, 1}}});
+          m.material.push_back(0);
+        }
       }
-    return vds::enc::encode_mesh(m, vds::enc::MeshEncodeOptions{}).stream;
+    vds::enc::Image tex(32, 32, 3);
+    uint32_t x = 7;
+    for (auto& p : tex.pixels) p = static_cast<uint8_t>((x = x * 1103515245u + 12345u) >> 24);
+    m.textures = {tex};
+    m.texture_files = {"noise"};
+    m.materials = {vds::enc::TexturedMaterial{0, {1, 1, 1}}};
+    vds::enc::ModelStreamOptions o;
+    o.colors.max_res_log2 = 4;
+    o.mesh.max_chunk_payload = 512;
+    return vds::enc::encode_model_stream(m, o).stream;
   }();
   return s;
 }

@@ -122,6 +122,24 @@ with open(anchors, "w") as f:
 code, out, err = run("mesh-colors", obj, "--views", "1", "--size", "16", "--anchors", anchors)
 check(code == 1 and "anchors.csv: line 1" in err, "a malformed anchors line is refused naming the file and line")
 
+# vds encode-model: an untextured model is its mesh and its vertex colours
+# (a client draws one more frame once they are in); a missing model names
+# the file; --quality and --bytes exclude each other; a byte budget below
+# the geometry is refused, nothing written.
+textured = os.path.join(TMP, "octa.vds")
+code, out, err = run("encode-model", obj, "-o", textured)
+check(code == 0 and "colour header" in out, "encode-model on an untextured model")
+code, frames, err = run("frames", textured)
+code2, mesh_frames, err2 = run("frames", model)
+check(code == 0 and code2 == 0 and len(frames.split()) >= 2, "its stream plays: the mesh, then its colours")
+code, out, err = run("encode-model", os.path.join(TMP, "no_such.obj"), "-o", textured + ".x")
+check(code == 1 and "no_such.obj" in err and not os.path.exists(textured + ".x"), "encode-model on a missing file names it (exit 1)")
+code, out, err = run("encode-model", obj, "-o", textured + ".x", "--quality", "2", "--bytes", "5000")
+check(code == 2 and not os.path.exists(textured + ".x"), "encode-model: --quality with --bytes is a usage error")
+code, out, err = run("encode-model", obj, "-o", textured + ".x", "--bytes", "50")
+check(code == 1 and "no quality fits 50 bytes" in err and not os.path.exists(textured + ".x"),
+      "encode-model: a byte budget no quality meets is refused, nothing written")
+
 # vds play and encode-walk: options checked before anything runs.
 code, out, err = run("play", stream, "--board", "fpga")
 check(code == 2 and "--board" in err, "vds play refuses a board it does not have")

@@ -74,6 +74,9 @@ def main():
     ap.add_argument("--psnr", type=float, default=0, help="encode each frame to this PSNR instead of --quality")
     ap.add_argument("--inputs", nargs="*", default=[], help="images to use instead of synthetic frames")
     ap.add_argument("--stream", default="", help="serve this stream instead of encoding frames")
+    ap.add_argument("--model", default="", help="serve this textured model, encoded by `vds encode-model`, instead; "
+                    "each board must show every level, each frame the replay of that board (its own workspace)")
+    ap.add_argument("--model-args", default="", help="options for `vds encode-model` (one string)")
     ap.add_argument("--report", default="", help="write the measurements as JSON")
     ap.add_argument("--timeout", type=float, default=300)
     ap.add_argument("--workspace", type=int, default=0, help="both boards' workspace budget, bytes (default: theirs)")
@@ -84,6 +87,14 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     failures = []
 
+    if a.model:
+        a.stream = os.path.join(a.work, "model.vds")
+        enc = subprocess.run([a.vds, "encode-model", a.model, "-o", a.stream, *a.model_args.split()],
+                             capture_output=True, text=True)
+        print("== vds encode-model\n" + enc.stdout + enc.stderr)
+        if enc.returncode != 0:
+            print("the encoder side failed")
+            return 1
     if a.stream:
         stream, want, encoder_log = a.stream, sim.replay_crcs(a.vds, a.stream), ""
         if not want:
@@ -141,6 +152,16 @@ def main():
                     failures.append(f"{name} board's log does not show the {full['bytes']} bytes it reported")
                 elif int(took.group(1)) + int(took.group(2)) >= full["stream"] or full["acked"] >= full["stream"]:
                     failures.append(f"{name} board received all {full['stream']} bytes: the host did not stop")
+        if a.model:
+            # The replay of this board: its workspace decides how fine the colours are.
+            ws = re.search(r"client: ready, workspace (\d+) bytes, player from byte (\d+)", log)
+            if not ws:
+                failures.append(f"{name} board did not state its workspace")
+            else:
+                expect = sim.replay_crcs(a.vds, stream, workspace=(int(ws.group(1)), int(ws.group(2))))
+                if expect != want:
+                    failures.append(f"{name} board holds fewer colour levels than the stream has: "
+                                    f"{len(expect or [])} of {len(want)} frames")
         if crcs != expect:
             failures.append(f"{name} board frame CRCs differ from the encoder's reconstruction")
     instr = sim.frame_instructions(qemu.serve.stdout)

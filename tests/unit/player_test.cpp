@@ -16,6 +16,7 @@
 #include "vds/enc/frames.h"
 #include "vds/enc/image_codec.h"
 #include "vds/enc/mesh_encoder.h"
+#include "vds/enc/model_stream.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/player.h"
 #include "xorshift.h"
@@ -219,6 +220,70 @@ TEST(Player, AModelLargerThanTheWorkspacePlaysWhatFitsAndEndsEarly) {
     EXPECT_EQ(seen.notices[1].first, vds::PlayerNotice::model_full);
   }
   EXPECT_TRUE(partial_seen) << "some workspace holds part of the model";
+}
+
+// A textured model (glTF's textured box from assimp-testmodels, which make
+// test installs): the mesh, then its vertex colours, then every mesh colors
+// level, coarsest first; a smaller workspace shows the finest level it
+// holds, a tiny one the shaded mesh; never a refusal.
+TEST(Player, ATexturedModelShowsEveryColourLevelItsWorkspaceHolds) {
+  const char* box = "/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf";
+  vds::enc::ModelStreamOptions o;
+  o.colors.max_res_log2 = 6;
+  o.codec.max_chunk = 1024;
+  o.mesh.max_chunk_payload = 1024;
+  const vds::enc::ModelStreamResult r = vds::enc::encode_model_stream(vds::enc::load_textured_model(box), o);
+  ASSERT_EQ(r.colors.max_res, 6);
+  const std::vector<uint32_t> want = vds::enc::client_frame_crcs(r.stream);
+  ASSERT_EQ(want.size(), r.mesh.levels.size() + 1 + 6);  // base and levels, vertex colours, 6 levels
+  for (size_t piece : {size_t{0}, size_t{1}, size_t{4096}}) {
+    Seen seen;
+    ASSERT_EQ(play(r.stream, seen, piece, 1u << 20), Status::ok) << piece;
+    EXPECT_EQ(seen.crcs, want) << piece;
+    EXPECT_TRUE(seen.notices.empty());
+  }
+  // Smaller workspaces: fewer colour levels, then none.
+  bool coarser = false, none = false;
+  size_t lo = 1024, hi = 1u << 20;  // the least workspace that plays the mesh
+  while (lo < hi) {
+    const size_t mid = (lo + hi) / 2;
+    Seen seen;
+    if (play(r.stream, seen, 4096, mid) == Status::ok)
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  for (size_t bytes = lo; bytes < (1u << 20); bytes += 256) {
+    Seen seen;
+    ASSERT_EQ(play(r.stream, seen, 0, bytes), Status::ok) << bytes;
+    if (seen.crcs == want) break;
+    ASSERT_FALSE(seen.notices.empty());
+    const size_t shown = seen.crcs.size();
+    ASSERT_GE(shown, r.mesh.levels.size());
+    // The geometry's frames are the replay's; then the colours it holds.
+    EXPECT_EQ(std::vector<uint32_t>(seen.crcs.begin(), seen.crcs.begin() + static_cast<std::ptrdiff_t>(r.mesh.levels.size())),
+              std::vector<uint32_t>(want.begin(), want.begin() + static_cast<std::ptrdiff_t>(r.mesh.levels.size())));
+    if (seen.notices.back().first == vds::PlayerNotice::model_no_colors) {
+      none = true;
+      EXPECT_EQ(shown, r.mesh.levels.size());
+    } else {
+      ASSERT_EQ(seen.notices.back().first, vds::PlayerNotice::model_colors_level);
+      const uint32_t finest = seen.notices.back().second;
+      EXPECT_GT(finest, 0u);
+      EXPECT_EQ(shown, r.mesh.levels.size() + 1 + (6 - finest));
+      // Up to its finest level, the same pictures as a client that holds them all.
+      EXPECT_EQ(seen.crcs, std::vector<uint32_t>(want.begin(), want.begin() + static_cast<std::ptrdiff_t>(shown)));
+      coarser = true;
+    }
+  }
+  EXPECT_TRUE(coarser) << "some workspace holds the mesh and part of its colour";
+  EXPECT_TRUE(none) << "some workspace holds the mesh and none of its colour";
+  // Every prefix of the stream fails cleanly (truncated) or, past the END, plays.
+  for (size_t n = 0; n + 1 < r.stream.size(); n += 97) {
+    Seen seen;
+    const std::vector<uint8_t> prefix(r.stream.begin(), r.stream.begin() + static_cast<std::ptrdiff_t>(n));
+    EXPECT_TRUE(vds::is_error(play(prefix, seen, 0))) << n;
+  }
 }
 
 // Two JPEG images (the 24x18 sample) in JPEG chunks of `piece` bytes.
