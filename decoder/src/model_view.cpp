@@ -101,16 +101,12 @@ Status ModelView::init(const ModelViewConfig& cfg, Arena& arena, uint32_t max_ve
   return Status::ok;
 }
 
-Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx, const MeshColorsSurface* colors,
-                       Filter filter) {
-  const uint32_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
-  if (!ready_ || nv == 0 || nv > cap_v_ || nt > cap_t_) return Status::invalid_argument;
+Status ModelView::camera(const MeshState& mesh, uint16_t angle, Camera* out, uint8_t* grid_shift,
+                         Vec3<Q16_16>* grid_origin) const {
+  const uint32_t nv = mesh.vertex_count();
   const int bits = mesh.bits();
-  if (bits < 2 || bits > 16) return Status::invalid_argument;
+  if (!ready_ || nv == 0 || bits < 2 || bits > 16) return Status::invalid_argument;
   const uint16_t* pos = mesh.positions();
-  const uint16_t* tri = mesh.triangles16();
-  if (tri == nullptr) return Status::invalid_argument;
-
   // Camera basis (rows: right, down, forward) in Q2.30.
   const uint32_t theta = static_cast<uint32_t>(angle) << 16;
   const int32_t st = sin_q2_30(theta).raw(), ct = cos_q2_30(theta).raw();
@@ -127,7 +123,7 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
   int32_t rows[3][3];
   for (int i = 0; i < 3; ++i)
     for (int k = 0; k < 3; ++k) rows[i][kAxis[u][k]] = kSign[u][k] * view_rows[i][k];
-  Camera cam;
+  Camera& cam = *out;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) cam.rotation.m[i][j] = Q2_30::from_raw(rows[i][j]);
   // The centre of projection: D units back along the forward axis.
@@ -144,13 +140,6 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
   cam.near_z = Q16_16::from_raw(65536 / 2);
   cam.far_z = Q16_16::from_raw(8 * 65536);
 
-  // The light in world space: R^T applied to its camera-space direction (Q15).
-  int32_t light[3];
-  for (int a = 0; a < 3; ++a)
-    light[a] = static_cast<int32_t>(
-        (int64_t{kLightCam[0]} * rows[0][a] + int64_t{kLightCam[1]} * rows[1][a] + int64_t{kLightCam[2]} * rows[2][a]) >>
-        30);
-
   // The current bounding box: its centre is put at the origin.
   uint32_t lo[3] = {65535, 65535, 65535}, hi[3] = {0, 0, 0};
   for (uint32_t v = 0; v < nv; ++v)
@@ -159,6 +148,41 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
       if (p < lo[a]) lo[a] = p;
       if (p > hi[a]) hi[a] = p;
     }
+  // World positions, read by the renderer from the decoder's grid: 2^bits
+  // grid steps = 2 units, i.e. (2 g - (lo + hi)) 2^(16 - bits) in Q16.16.
+  const int up = 16 - bits;
+  *grid_shift = static_cast<uint8_t>(up + 1);
+  *grid_origin = {Q16_16::from_raw(-static_cast<int32_t>((lo[0] + hi[0]) << up)),
+                  Q16_16::from_raw(-static_cast<int32_t>((lo[1] + hi[1]) << up)),
+                  Q16_16::from_raw(-static_cast<int32_t>((lo[2] + hi[2]) << up))};
+  return Status::ok;
+}
+
+Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx, const MeshColorsSurface* colors,
+                       Filter filter) {
+  const uint32_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
+  if (!ready_ || nv == 0 || nv > cap_v_ || nt > cap_t_) return Status::invalid_argument;
+  const int bits = mesh.bits();
+  if (bits < 2 || bits > 16) return Status::invalid_argument;
+  const uint16_t* pos = mesh.positions();
+  const uint16_t* tri = mesh.triangles16();
+  if (tri == nullptr) return Status::invalid_argument;
+
+  Camera cam;
+  uint8_t grid_shift = 0;
+  Vec3<Q16_16> grid_origin{};
+  const Status cs = camera(mesh, angle, &cam, &grid_shift, &grid_origin);
+  if (cs != Status::ok) return cs;
+  int32_t rows[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) rows[i][j] = cam.rotation.m[i][j].raw();
+  // The light in world space: R^T applied to its camera-space direction (Q15).
+  int32_t light[3];
+  for (int a = 0; a < 3; ++a)
+    light[a] = static_cast<int32_t>(
+        (int64_t{kLightCam[0]} * rows[0][a] + int64_t{kLightCam[1]} * rows[1][a] + int64_t{kLightCam[2]} * rows[2][a]) >>
+        30);
+
   for (uint32_t i = 0; i < 3 * nt; ++i)
     if (tri[i] >= nv) return Status::invalid_argument;
 
@@ -211,15 +235,10 @@ Status ModelView::draw(const MeshState& mesh, uint16_t angle, BandSink sink, voi
     m.surface = colors;
     m.filter = filter;
   }
-  // World positions, read by the renderer from the decoder's grid: 2^bits
-  // grid steps = 2 units, i.e. (2 g - (lo + hi)) 2^(16 - bits) in Q16.16.
-  const int up = 16 - bits;
   DrawList list;
   list.grid = pos;
-  list.grid_shift = static_cast<uint8_t>(up + 1);
-  list.grid_origin = {Q16_16::from_raw(-static_cast<int32_t>((lo[0] + hi[0]) << up)),
-                      Q16_16::from_raw(-static_cast<int32_t>((lo[1] + hi[1]) << up)),
-                      Q16_16::from_raw(-static_cast<int32_t>((lo[2] + hi[2]) << up))};
+  list.grid_shift = grid_shift;
+  list.grid_origin = grid_origin;
   list.num_positions = nv;
   list.meshes = &m;
   list.num_meshes = 1;

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "anchors.h"
 #include "commands.h"
 #include "vds/enc/model_stream.h"
 #include "vds/enc/stream_writer.h"
@@ -27,7 +28,34 @@ struct EncodeModelOptions {
   bool paper = false;
   uint32_t max_chunk = 4096;
   bool quiet = false;
+  std::string timeline;
+  int views = 8;
+  std::string anchors;
 };
+
+// The stream as it arrives (enc::model_timeline) and, with anchors, each
+// anchor's texture on the whole model: CSV rows
+// kind,parameter,bytes,vertices,colour_level,psnr.
+void write_timeline(const EncodeModelOptions& o, const enc::TexturedModel& model, const enc::ModelStreamResult& r) {
+  enc::TimelineOptions t;
+  t.views = o.views;
+  std::vector<Anchor> anchors;
+  if (!o.anchors.empty()) anchors = read_anchors(o.anchors, model.textures.size());
+  std::FILE* f = std::fopen(o.timeline.c_str(), "w");
+  if (f == nullptr) throw Failure(kExitBadInput, o.timeline + ": cannot write");
+  std::fprintf(f, "kind,parameter,bytes,vertices,colour_level,psnr\n");
+  for (const enc::TimelinePoint& p : enc::model_timeline(model, r, t)) {
+    std::fprintf(f, "vds,%.4g,%zu,%u,%d,%.3f\n", r.quality, p.bytes, p.vertices, p.colour_level, p.psnr);
+    if (!o.quiet)
+      std::printf("  at %7zu bytes: %5u vertices, colour level %2d: %.2f dB\n", p.bytes, p.vertices, p.colour_level, p.psnr);
+  }
+  for (const Anchor& a : anchors) {
+    const double psnr = enc::model_views_psnr(model, a.textures, r, t);
+    std::fprintf(f, "%s,%s,%zu,%zu,-1,%.3f\n", a.codec.c_str(), a.param.c_str(), a.bytes, model.positions.size(), psnr);
+    if (!o.quiet) std::printf("  %s %s: %zu bytes of texture: %.2f dB\n", a.codec.c_str(), a.param.c_str(), a.bytes, psnr);
+  }
+  std::fclose(f);
+}
 
 void run_encode_model(const EncodeModelOptions& o) {
   enc::ModelStreamOptions e;
@@ -56,6 +84,7 @@ void run_encode_model(const EncodeModelOptions& o) {
     throw Failure(kExitBadInput, o.input + ": " + err.what());
   }
   enc::write_file(o.output, r.stream);
+  if (!o.timeline.empty()) write_timeline(o, model, r);
   if (o.quiet) return;
   if (r.repair.repaired()) std::printf("%s", r.repair.summary().c_str());
   const uint32_t faces = static_cast<uint32_t>(r.colors.face_res.size());
@@ -96,6 +125,13 @@ void add_encode_model(CLI::App& app) {
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes (the client's chunk buffer)")
       ->capture_default_str()
       ->check(CLI::Range(512u, 1u << 24));
+  sub->add_option("--timeline", o->timeline,
+                  "Write the stream as it arrives as CSV: after each chunk that completes a client frame, the client's "
+                  "picture from --views orbit angles against the model with its own texture (PSNR)");
+  sub->add_option("--views", o->views, "Orbit angles of --timeline")->capture_default_str()->check(CLI::Range(1, 64));
+  sub->add_option("--anchors", o->anchors,
+                  "With --timeline: the model's textures coded by other codecs (CSV codec,parameter,bytes,files), "
+                  "each measured on the whole model at the same cameras");
   sub->add_flag("-q,--quiet", o->quiet, "Print nothing");
   sub->callback([o] { run_encode_model(*o); });
 }

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "anchors.h"
 #include "commands.h"
 #include "vds/enc/mesh_colors.h"
 #include "vds/enc/model_render.h"
@@ -59,58 +60,6 @@ void write_ppm(const std::string& path, const Image& img) {
   f << "P6\n" << img.width << " " << img.height << "\n255\n";
   f.write(reinterpret_cast<const char*>(img.pixels.data()), static_cast<std::streamsize>(img.pixels.size()));
   if (!f) throw Failure(kExitBadInput, path + ": cannot write");
-}
-
-struct Anchor {
-  std::string codec, param;
-  size_t bytes = 0;
-  std::vector<Image> textures;
-};
-
-std::vector<Anchor> read_anchors(const std::string& path, size_t textures) {
-  std::ifstream f(path);
-  if (!f) throw Failure(kExitBadInput, path + ": cannot read");
-  std::vector<Anchor> out;
-  std::string line;
-  int n = 0;
-  while (std::getline(f, line)) {
-    ++n;
-    if (line.empty() || line[0] == '#') continue;
-    std::vector<std::string> cols;
-    size_t at = 0;
-    for (int k = 0; k < 3; ++k) {
-      const size_t comma = line.find(',', at);
-      if (comma == std::string::npos) throw Failure(kExitBadInput, path + ": line " + std::to_string(n) + ": want codec,parameter,bytes,files");
-      cols.push_back(line.substr(at, comma - at));
-      at = comma + 1;
-    }
-    Anchor a;
-    a.codec = cols[0];
-    a.param = cols[1];
-    try {
-      a.bytes = std::stoul(cols[2]);
-    } catch (const std::exception&) {
-      throw Failure(kExitBadInput, path + ": line " + std::to_string(n) + ": bytes '" + cols[2] + "' is not a number");
-    }
-    std::string files = line.substr(at);
-    size_t from = 0;
-    while (from <= files.size()) {
-      const size_t semi = files.find(';', from);
-      const std::string file = files.substr(from, semi == std::string::npos ? std::string::npos : semi - from);
-      try {
-        a.textures.push_back(load_image(file, 3));
-      } catch (const std::runtime_error& e) {
-        throw Failure(kExitBadInput, path + ": line " + std::to_string(n) + ": " + e.what());
-      }
-      if (semi == std::string::npos) break;
-      from = semi + 1;
-    }
-    if (a.textures.size() != textures)
-      throw Failure(kExitBadInput, path + ": line " + std::to_string(n) + ": " + std::to_string(a.textures.size()) +
-                                       " images for a model of " + std::to_string(textures) + " textures");
-    out.push_back(std::move(a));
-  }
-  return out;
 }
 
 double plane_psnr(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b, size_t from) {

@@ -7,6 +7,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "host_player.h"
 #include "vds/bytes.h"
 #include "vds/container.h"
 #include "vds/enc/stream_writer.h"
@@ -38,16 +39,10 @@ std::vector<Chunk> body_chunks(std::span<const uint8_t> s) {
 // The client's mesh after the whole geometry stream: its triangles (3 per
 // face, the client's vertex numbers).
 std::vector<uint32_t> client_triangles(std::span<const uint8_t> stream, uint32_t* vertices) {
-  auto player = std::make_unique<Player>();
-  std::vector<uint8_t> ws((1u << 24) + (1u << 25));
-  Arena arena(ws.data(), ws.size());
-  PlayerConfig cfg = kClientPlayerConfig;
-  cfg.max_chunk_bytes = 1u << 24;
-  if (player->init(arena, cfg, PlayerCallbacks{}) != Status::ok) throw std::logic_error("model stream: player");
-  Status s = player->feed(stream.data(), stream.size());
-  if (s == Status::more_input) s = player->finish();
-  const MeshState& m = player->mesh.mesh();
-  if (s != Status::ok || !player->mesh.complete())
+  HostPlayer host;
+  const Status s = host.play(stream);
+  const MeshState& m = host.player->mesh.mesh();
+  if (s != Status::ok || !host.player->mesh.complete())
     throw std::logic_error(std::string("model stream: the client does not decode the geometry: ") + status_name(s));
   std::vector<uint32_t> tri(3 * size_t{m.triangle_count()});
   for (size_t c = 0; c < tri.size(); ++c) tri[c] = m.corner_vertex(static_cast<uint32_t>(c));

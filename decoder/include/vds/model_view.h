@@ -62,6 +62,11 @@ class ModelView {
   Status draw(const MeshState& mesh, uint16_t angle, BandSink sink, void* ctx,
               const MeshColorsSurface* colors = nullptr, Filter filter = Filter::bilinear);
 
+  // The camera and the grid's placement draw() uses for `mesh` at `angle`:
+  // world = (grid << grid_shift) + grid_origin (DrawList's grid fields).
+  // invalid_argument for a mesh draw() would refuse.
+  Status camera(const MeshState& mesh, uint16_t angle, Camera* cam, uint8_t* grid_shift, Vec3<Q16_16>* grid_origin) const;
+
   // Changes the axis shown up for later frames (e.g. once MSHH is in).
   void set_up(MeshUp up) { cfg_.up = up; }
   const RenderStats& stats() const { return renderer_.stats(); }

@@ -192,6 +192,10 @@ class Player {
   // Workspace a model's mesh colors need beyond its mesh and view (MCLH's
   // counts) to show a level of `samples` samples.
   static size_t model_colors_workspace_bytes(uint32_t faces, uint32_t vertices, uint32_t samples);
+  // A model's colours as the player shows them (nullptr before MCLH or when
+  // they cannot be shown), and the MIP level shown (-1: none).
+  const MeshColorsSurface* model_colors() const;
+  int model_colors_level() const;
 
   Status init(Arena& arena, const PlayerConfig& config, const PlayerCallbacks& callbacks);
   Status feed(const uint8_t* data, size_t n);

@@ -261,6 +261,9 @@ size_t Player::model_colors_workspace_bytes(uint32_t faces, uint32_t vertices, u
          64;
 }
 
+const MeshColorsSurface* Player::model_colors() const { return colors != nullptr ? &colors->surface : nullptr; }
+int Player::model_colors_level() const { return colors != nullptr ? colors->shown : -1; }
+
 namespace detail {
 extern const PlayerMode kModelMode;
 const PlayerMode kModelMode{StreamMode::model, start, on_chunk, feed_limit};

@@ -62,4 +62,30 @@ struct ModelStreamResult {
 // client's limits) or a byte budget no quality meets.
 ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStreamOptions& o);
 
+// --- The stream as a viewer sees it arrive ------------------------------------
+// After every chunk that completes a client frame, the client's picture —
+// its mesh and the colours it holds, drawn by the client library's model
+// view — from `views` orbit angles, against the reference at the same
+// cameras: the model through its UV map with its own textures (double,
+// supersampled). PSNR over the pixels inside the reference's silhouette
+// (its coverage eroded by a pixel, so anti-aliased edges count for neither).
+struct TimelineOptions {
+  int views = 8;
+  int supersample = 3;
+};
+struct TimelinePoint {
+  size_t bytes = 0;          // stream bytes received when the frame is drawn
+  uint32_t vertices = 0;     // of the client's mesh
+  int colour_level = -1;     // the mesh colors level shown (-1: none, max_res: vertex samples)
+  double psnr = 0;
+};
+std::vector<TimelinePoint> model_timeline(const TexturedModel& model, const ModelStreamResult& r,
+                                          const TimelineOptions& o = TimelineOptions{});
+
+// The same measure of the model with `textures` in place of its own, on its
+// own geometry, at the cameras of the whole mesh: what a download of the
+// model with its texture coded by another codec shows once it is complete.
+double model_views_psnr(const TexturedModel& model, const std::vector<Image>& textures, const ModelStreamResult& r,
+                        const TimelineOptions& o = TimelineOptions{});
+
 }  // namespace vds::enc
