@@ -332,6 +332,60 @@ int32_t vertex_prediction(const Adjacency& adj, const uint8_t* ycc, uint32_t v, 
   return v > 0 ? ycc[3 * (v - 1) + c] : 128;
 }
 
+int32_t fan_prediction(const MeshState& mesh, const uint8_t* plane, uint32_t v) {
+  const uint32_t nc = 3 * mesh.triangle_count();
+  const uint32_t c0 = mesh.vertex_corner(v);
+  int64_t sum = 0, count = 0;
+  auto take = [&](uint32_t n) {
+    if (n < v) {
+      sum += plane[n];
+      ++count;
+    }
+  };
+  if (c0 < nc) {
+    // Each face's next corner, and the last face's previous one (a fan
+    // that ends at a border); a closed fan comes back to c0.
+    uint32_t c = c0;
+    for (uint32_t faces = 0; faces < 1023; ++faces) {
+      take(mesh.corner_vertex(MeshState::next(c)));
+      const int32_t o = mesh.opposite(MeshState::next(c));
+      if (o < 0 || static_cast<uint32_t>(o) >= nc) {
+        take(mesh.corner_vertex(MeshState::prev(c)));
+        break;
+      }
+      c = MeshState::next(static_cast<uint32_t>(o));
+      if (c == c0) break;
+    }
+  }
+  if (count > 0) return static_cast<int32_t>(div_round(sum, count));
+  return v > 0 ? plane[v - 1] : 128;
+}
+
+Status decode_vertex_colours(const uint8_t* data, size_t size, const MeshState& mesh, const Planes& out,
+                             uint32_t* coloured) {
+  if (data == nullptr || size < kVertexChunkHeadBytes) return Status::truncated;
+  const uint32_t first = load_le32(data), count = load_le32(data + 4);
+  const uint32_t nv = mesh.vertex_count();
+  if (first != *coloured || count == 0 || first > nv || count != nv - first) return Status::malformed;
+  ArithDecoder dec;
+  Status s = dec.init(data + kVertexChunkHeadBytes, size - kVertexChunkHeadBytes);
+  if (s != Status::ok) return s;
+  VertexContexts vx;
+  vx.reset();
+  for (uint32_t v = first; v < nv; ++v)
+    for (int c = 0; c < 3; ++c) {
+      const int cls = c == 0 ? 0 : 1;
+      const int32_t r = dec.decode_signed(vx.zero[cls], vx.mag[cls], VertexContexts::kMagCtx, kDcCutoff, kDcOrder);
+      if (!dec.ok()) return dec.status();
+      const int32_t value = fan_prediction(mesh, out.plane(c), v) + r;
+      if (value < 0 || value > 255) return Status::malformed;
+      out.plane(c)[v] = static_cast<uint8_t>(value);
+    }
+  s = dec.finish();
+  if (s == Status::ok) *coloured = nv;
+  return s;
+}
+
 void VertexContexts::reset() {
   arith_init_contexts(&zero[0], 2);
   arith_init_contexts(&mag[0][0], 2 * kMagCtx);

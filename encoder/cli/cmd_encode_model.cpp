@@ -31,6 +31,7 @@ struct EncodeModelOptions {
   std::string timeline;
   int views = 8;
   std::string anchors;
+  double tail = -1;
 };
 
 // The stream as it arrives (enc::model_timeline) and, with anchors, each
@@ -63,6 +64,7 @@ void run_encode_model(const EncodeModelOptions& o) {
   e.max_bytes = o.bytes;
   e.mesh.bits = o.bits;
   e.mesh.max_chunk_payload = o.max_chunk;
+  if (o.tail >= 0) e.mesh.tail_fraction = o.tail;
   if (!enc::mesh_up_from_name(o.up, &e.mesh.up))
     throw Failure(kExitUsage, "--up must be +y, +z, +x, -y, -z or -x (or y, z, x), not '" + o.up + "'");
   e.colors.max_res_log2 = o.max_res;
@@ -121,6 +123,10 @@ void add_encode_model(CLI::App& app) {
       ->check(CLI::Range(0.01, 16.0));
   sub->add_option("--up", o->up, "The model's up axis for viewers: +y (glTF), +z, +x, -y, -z or -x")
       ->capture_default_str();
+  sub->add_option("--tail", o->tail,
+                  "Send the whole mesh single-rate after the split levels that reach this fraction of the vertices "
+                  "(0: splits all the way; default as vds encode-mesh)")
+      ->check(CLI::Range(0.0, 1.0));
   sub->add_flag("--paper", o->paper, "Code the colours as the thesis does (for comparison)");
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes (the client's chunk buffer)")
       ->capture_default_str()

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <map>
 #include <memory>
 #include <stdexcept>
@@ -10,6 +11,7 @@
 #include "host_player.h"
 #include "vds/bytes.h"
 #include "vds/container.h"
+#include "vds/enc/arith_encoder.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/mesh_colors.h"
 #include "vds/player.h"
@@ -20,6 +22,7 @@ namespace {
 struct Chunk {
   uint32_t type;
   std::span<const uint8_t> payload;
+  size_t end;  // stream offset after it
 };
 
 // The chunks of a stream this encoder wrote, HEAD and END left out.
@@ -29,7 +32,8 @@ std::vector<Chunk> body_chunks(std::span<const uint8_t> s) {
   while (at + kChunkHeadBytes + kChunkTailBytes <= s.size()) {
     const uint32_t type = load_le32(s.data() + at), n = load_le32(s.data() + at + 4);
     if (at + kChunkHeadBytes + n + kChunkTailBytes > s.size()) break;
-    if (type != chunk::kHeader && type != chunk::kEnd) out.push_back({type, s.subspan(at + kChunkHeadBytes, n)});
+    if (type != chunk::kHeader && type != chunk::kEnd)
+      out.push_back({type, s.subspan(at + kChunkHeadBytes, n), at + kChunkHeadBytes + n + kChunkTailBytes});
     at += kChunkHeadBytes + n + kChunkTailBytes;
   }
   if (at != s.size()) throw std::logic_error("model stream: the mesh stream does not parse");
@@ -38,7 +42,8 @@ std::vector<Chunk> body_chunks(std::span<const uint8_t> s) {
 
 // The client's mesh after the whole geometry stream: its triangles (3 per
 // face, the client's vertex numbers).
-std::vector<uint32_t> client_triangles(std::span<const uint8_t> stream, uint32_t* vertices) {
+std::vector<uint32_t> client_triangles(std::span<const uint8_t> stream, uint32_t* vertices,
+                                       std::vector<std::array<uint16_t, 3>>* grid) {
   HostPlayer host;
   const Status s = host.play(stream);
   const MeshState& m = host.player->mesh.mesh();
@@ -47,6 +52,9 @@ std::vector<uint32_t> client_triangles(std::span<const uint8_t> stream, uint32_t
   std::vector<uint32_t> tri(3 * size_t{m.triangle_count()});
   for (size_t c = 0; c < tri.size(); ++c) tri[c] = m.corner_vertex(static_cast<uint32_t>(c));
   *vertices = m.vertex_count();
+  grid->resize(m.vertex_count());
+  for (uint32_t v = 0; v < m.vertex_count(); ++v)
+    for (int a = 0; a < 3; ++a) (*grid)[v][a] = m.positions()[3 * v + a];
   return tri;
 }
 
@@ -102,6 +110,65 @@ TexturedModel in_client_order(const TexturedModel& model, const Mesh& repaired, 
   return out;
 }
 
+// The MCVX payloads of the mesh stream: after chunk i (the key) that
+// completes the base or a split level, the colours of the vertices it
+// added — the final mesh's vertex samples of the vertices at their grid
+// positions — coded as the client decodes them (mc::decode_vertex_colours).
+std::map<size_t, std::vector<uint8_t>> vertex_colour_chunks(std::span<const uint8_t> stream,
+                                                            const std::vector<std::array<uint16_t, 3>>& grid,
+                                                            const std::vector<uint8_t>& final_ycc) {
+  std::map<std::array<uint16_t, 3>, uint32_t> at;
+  for (uint32_t v = 0; v < grid.size(); ++v) at.emplace(grid[v], v);
+  HostPlayer host;
+  Player& p = *host.player;
+  const std::vector<Chunk> chunks = body_chunks(stream);
+  std::map<size_t, std::vector<uint8_t>> out;
+  std::array<std::vector<uint8_t>, 3> planes;
+  for (auto& pl : planes) pl.assign(grid.size() + 1, 0);
+  uint32_t coloured = 0, levels = 0;
+  bool base = false;
+  size_t fed = 0;
+  for (size_t i = 0; i < chunks.size(); ++i) {
+    const Status st = p.feed(stream.data() + fed, chunks[i].end - fed);
+    fed = chunks[i].end;
+    if (is_error(st)) throw std::logic_error("model stream: the client refused the geometry");
+    const MeshState& m = p.mesh.mesh();
+    const uint32_t nv = m.vertex_count();
+    // The base, and each split level, once complete (the tail numbers the vertices anew).
+    const bool done = (!base && p.mesh.drawable()) || (base && p.mesh.levels_done() != levels);
+    base = p.mesh.drawable();
+    levels = p.mesh.levels_done();
+    if (!done || nv == coloured) continue;
+    if (p.mesh.header().tail() && p.mesh.levels_done() == p.mesh.header().levels) break;
+    if (nv > grid.size()) throw std::logic_error("model stream: a level has more vertices than the mesh");
+    ArithEncoder enc;
+    mc::VertexContexts vx;
+    vx.reset();
+    for (uint32_t v = coloured; v < nv; ++v) {
+      const std::array<uint16_t, 3> g{m.positions()[3 * v], m.positions()[3 * v + 1], m.positions()[3 * v + 2]};
+      const auto it = at.find(g);
+      if (it == at.end()) throw std::logic_error("model stream: a level's vertex is not the mesh's");
+      for (int c = 0; c < 3; ++c) {
+        const int cls = c == 0 ? 0 : 1;
+        const int32_t value = final_ycc[3 * size_t{it->second} + c];
+        const int32_t r = value - mc::fan_prediction(m, planes[c].data(), v);
+        enc.encode_signed(vx.zero[cls], vx.mag[cls], mc::VertexContexts::kMagCtx, r, mc::kDcCutoff, mc::kDcOrder);
+        planes[c][v] = static_cast<uint8_t>(value);
+      }
+    }
+    std::vector<uint8_t> payload(mc::kVertexChunkHeadBytes);
+    for (int k = 0; k < 4; ++k) {
+      payload[k] = static_cast<uint8_t>(coloured >> (8 * k));
+      payload[4 + k] = static_cast<uint8_t>((nv - coloured) >> (8 * k));
+    }
+    const std::vector<uint8_t> body = enc.finish();
+    payload.insert(payload.end(), body.begin(), body.end());
+    out[i] = std::move(payload);
+    coloured = nv;
+  }
+  return out;
+}
+
 struct Colours {
   double quality;
   MeshColorsModel mc;
@@ -137,23 +204,31 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
   const Mesh repaired = repair_mesh(mesh, &r.repair);
   r.mesh = encode_mesh(repaired, o.mesh);
   uint32_t vertices = 0;
-  const std::vector<uint32_t> tri = client_triangles(r.mesh.stream, &vertices);
+  std::vector<std::array<uint16_t, 3>> grid;
+  const std::vector<uint32_t> tri = client_triangles(r.mesh.stream, &vertices, &grid);
   if (vertices != r.mesh.vertex_order.size()) throw std::logic_error("model stream: the client's vertex count differs");
   r.decoded = in_client_order(model, repaired, r.mesh.vertex_order, tri);
 
   const size_t max_chunk = r.mesh.stream_header.max_chunk_payload;
   Colours c;
+  std::map<size_t, std::vector<uint8_t>> vertex_chunks;
+  auto colour = [&](double q) {
+    c = colours_at(r.decoded, o, q, max_chunk);
+    vertex_chunks.clear();
+    if (o.vertex_colours) vertex_chunks = vertex_colour_chunks(r.mesh.stream, grid, c.mc.vertex_ycc);
+    size_t n = stream_bytes(r.mesh, c.coded);
+    for (const auto& [at, payload] : vertex_chunks) n += framed(payload.size());
+    return n;
+  };
   if (o.max_bytes > 0) {
     bool found = false;
-    for (double q = 0.125; q <= 64 && !found; q *= std::sqrt(2.0)) {
-      c = colours_at(r.decoded, o, q, max_chunk);
-      found = stream_bytes(r.mesh, c.coded) <= o.max_bytes;
-    }
+    size_t bytes = 0;
+    for (double q = 0.125; q <= 64 && !found; q *= std::sqrt(2.0)) found = (bytes = colour(q)) <= o.max_bytes;
     if (!found)
       throw std::invalid_argument("no quality fits " + std::to_string(o.max_bytes) + " bytes (at quality 64: " +
-                                  std::to_string(stream_bytes(r.mesh, c.coded)) + ")");
+                                  std::to_string(bytes) + ")");
   } else {
-    c = colours_at(r.decoded, o, o.quality, max_chunk);
+    colour(o.quality);
   }
   if (c.coded.header.size() > max_chunk)
     throw std::invalid_argument("the mesh colors header takes " + std::to_string(c.coded.header.size()) +
@@ -168,7 +243,16 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
   if (h.workspace_bytes + extra > 0xFFFFFFFFu) throw std::invalid_argument("model too large for a client workspace");
   h.workspace_bytes = static_cast<uint32_t>(h.workspace_bytes + extra);
   StreamWriter w(h);
-  for (const Chunk& ch : body_chunks(r.mesh.stream)) w.add_chunk(ch.type, ch.payload);
+  const std::vector<Chunk> mesh_chunks = body_chunks(r.mesh.stream);
+  for (size_t i = 0; i < mesh_chunks.size(); ++i) {
+    w.add_chunk(mesh_chunks[i].type, mesh_chunks[i].payload);
+    const auto vc = vertex_chunks.find(i);
+    if (vc == vertex_chunks.end()) continue;
+    if (vc->second.size() > max_chunk) throw std::invalid_argument("a level's vertex colours take more than a chunk");
+    w.add_chunk(mc::kChunkVertices, vc->second);
+    r.parts.vertex_colours += framed(vc->second.size());
+    ++r.parts.vertex_chunks;
+  }
   r.parts.geometry_end = w.size();
   w.add_chunk(mc::kChunkHeader, r.coded.header);
   r.parts.colors_header_end = w.size();
@@ -184,7 +268,7 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
   }
   r.stream = w.finish();
   r.header = h;
-  r.parts.geometry = r.stream.size() - r.parts.colors_header;
+  r.parts.geometry = r.stream.size() - r.parts.colors_header - r.parts.vertex_colours;
   for (size_t b : r.parts.level_bytes) r.parts.geometry -= b;
   return r;
 }

@@ -235,7 +235,11 @@ TEST(Player, ATexturedModelShowsEveryColourLevelItsWorkspaceHolds) {
   const vds::enc::ModelStreamResult r = vds::enc::encode_model_stream(vds::enc::load_textured_model(box), o);
   ASSERT_EQ(r.colors.max_res, 6);
   const std::vector<uint32_t> want = vds::enc::client_frame_crcs(r.stream);
-  ASSERT_EQ(want.size(), r.mesh.levels.size() + 1 + 6);  // base and levels, vertex colours, 6 levels
+  // The base shaded, then in its colours and each level in its own (MCVX);
+  // then the vertex samples (MCLH) and 6 levels.
+  ASSERT_EQ(r.parts.vertex_chunks, r.mesh.levels.size());
+  const size_t geometry = 1 + r.parts.vertex_chunks;
+  ASSERT_EQ(want.size(), geometry + 1 + 6);
   for (size_t piece : {size_t{0}, size_t{1}, size_t{4096}}) {
     Seen seen;
     ASSERT_EQ(play(r.stream, seen, piece, 1u << 20), Status::ok) << piece;
@@ -259,18 +263,18 @@ TEST(Player, ATexturedModelShowsEveryColourLevelItsWorkspaceHolds) {
     if (seen.crcs == want) break;
     ASSERT_FALSE(seen.notices.empty());
     const size_t shown = seen.crcs.size();
-    ASSERT_GE(shown, r.mesh.levels.size());
+    ASSERT_GE(shown, geometry);
     // The geometry's frames are the replay's; then the colours it holds.
-    EXPECT_EQ(std::vector<uint32_t>(seen.crcs.begin(), seen.crcs.begin() + static_cast<std::ptrdiff_t>(r.mesh.levels.size())),
-              std::vector<uint32_t>(want.begin(), want.begin() + static_cast<std::ptrdiff_t>(r.mesh.levels.size())));
+    EXPECT_EQ(std::vector<uint32_t>(seen.crcs.begin(), seen.crcs.begin() + static_cast<std::ptrdiff_t>(geometry)),
+              std::vector<uint32_t>(want.begin(), want.begin() + static_cast<std::ptrdiff_t>(geometry)));
     if (seen.notices.back().first == vds::PlayerNotice::model_no_colors) {
       none = true;
-      EXPECT_EQ(shown, r.mesh.levels.size());
+      EXPECT_EQ(shown, geometry);  // in the colours that came with the vertices
     } else {
       ASSERT_EQ(seen.notices.back().first, vds::PlayerNotice::model_colors_level);
       const uint32_t finest = seen.notices.back().second;
       EXPECT_GT(finest, 0u);
-      EXPECT_EQ(shown, r.mesh.levels.size() + 1 + (6 - finest));
+      EXPECT_EQ(shown, geometry + 1 + (6 - finest));
       // Up to its finest level, the same pictures as a client that holds them all.
       EXPECT_EQ(seen.crcs, std::vector<uint32_t>(want.begin(), want.begin() + static_cast<std::ptrdiff_t>(shown)));
       coarser = true;

@@ -64,6 +64,7 @@
 #include "vds/arena.h"
 #include "vds/arith.h"
 #include "vds/container.h"
+#include "vds/mesh_model.h"
 #include "vds/render.h"
 #include "vds/status.h"
 
@@ -215,12 +216,33 @@ constexpr int kNzOrder = 1;
 //   truncated unary code (max max_res_log2) in the contexts of face f - 1's;
 //   vds mode: then every vertex's Y', Cb, Cr as signed differences from
 //   vertex_prediction (vertices in order).
+constexpr uint32_t kChunkVertices = fourcc('M', 'C', 'V', 'X');  // after the base and each split level
 constexpr uint32_t kChunkHeader = fourcc('M', 'C', 'L', 'H');  // after the mesh's last level
 constexpr uint32_t kChunkLevel = fourcc('M', 'C', 'L', 'V');   // one MIP level, coarsest first
 constexpr uint8_t kVersion = 1;
 constexpr uint8_t kModePaper = 0;
 constexpr uint8_t kModeVds = 1;
 constexpr size_t kHeaderFixedBytes = 12;
+
+// --- Vertex colours with their vertices (MCVX) --------------------------------
+// After the base mesh and after each split level, the colours of the
+// vertices it added, so that a coarse mesh is drawn in its colours before
+// the faces' samples arrive (its vertices are the final mesh's, at their
+// final positions):
+//   u32 first vertex (the vertices coloured so far), u32 count (those the
+//   mesh has beyond them), then arithmetic coded, vertices in order, Y', Cb,
+//   Cr each as a signed difference from fan_prediction (VertexContexts).
+constexpr size_t kVertexChunkHeadBytes = 8;
+// Vertex v's prediction from its neighbours in `mesh` numbered below it
+// (their values in `plane`): the rounded mean, else vertex v - 1's value,
+// else 128. The fan is walked in the corner table (at most 1023 faces).
+int32_t fan_prediction(const MeshState& mesh, const uint8_t* plane, uint32_t v);
+// Decodes an MCVX payload into the planes (vertex v's Y', Cb, Cr at
+// y[v], cb[v], cr[v]); `first` must be the vertices coloured so far and the
+// chunk must colour exactly the mesh's vertices beyond them (malformed
+// otherwise; truncated if it ends early). `coloured` is updated.
+Status decode_vertex_colours(const uint8_t* data, size_t size, const MeshState& mesh, const Planes& out,
+                             uint32_t* coloured);
 
 // --- A level's chunks (MCLV) -------------------------------------------------
 //   u8 level (0 .. max_res_log2 - 1), u32 first element, u32 elements

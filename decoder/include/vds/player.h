@@ -192,8 +192,10 @@ class Player {
   // Workspace a model's mesh colors need beyond its mesh and view (MCLH's
   // counts) to show a level of `samples` samples.
   static size_t model_colors_workspace_bytes(uint32_t faces, uint32_t vertices, uint32_t samples);
-  // A model's colours as the player shows them (nullptr before MCLH or when
-  // they cannot be shown), and the MIP level shown (-1: none).
+  // A model's colours as the player draws them (nullptr: none, drawn
+  // shaded), and what they are: -1 none, kModelVertexColours the colours
+  // that came with the vertices (MCVX), else the mesh colors level shown.
+  static constexpr int kModelVertexColours = 16;
   const MeshColorsSurface* model_colors() const;
   int model_colors_level() const;
 
@@ -285,6 +287,7 @@ class Player {
   ModelFrames model_frames;
   bool model_started = false;
   struct ModelColors* colors = nullptr;  // decoder/src/player/mode_model.cpp
+  struct VertexColours* vertex_colours = nullptr;  // the same
   WalkGeometry walk_geometry;
   WalkFrameDecoder walk_frames;
   struct WalkPlay* walk = nullptr;  // decoder/src/player/mode_walk.cpp

@@ -25,7 +25,27 @@ struct ModelColors {
   int shown = 0;   // the level in the planes (max_res_log2: vertex samples only)
 };
 
+// Colours of the vertices, arriving with them (MCVX) before MCLH: drawn
+// as faces of resolution 1 (each face its corners' colours, blended).
+struct VertexColours {
+  mc::Planes planes;
+  uint32_t capacity = 0;
+  uint32_t coloured = 0;
+  bool valid = true;  // false once the single-rate tail has renumbered the vertices
+  const MeshState* mesh = nullptr;
+  MeshColorsSurface surface;
+};
+
 namespace {
+
+bool vertex_lattice_of(const void* ctx, uint32_t t, LatticeFace* out) {
+  const auto* c = static_cast<const VertexColours*>(ctx);
+  const uint16_t* tri = c->mesh->triangles16();
+  if (tri == nullptr || t >= c->mesh->triangle_count()) return false;
+  *out = LatticeFace{};
+  for (int k = 0; k < 3; ++k) out->vertex[k] = tri[3 * t + k];
+  return true;
+}
 
 bool lattice_of(const void* ctx, uint32_t t, LatticeFace* out) {
   const auto* c = static_cast<const ModelColors*>(ctx);
@@ -41,6 +61,7 @@ bool start(Player& p, const StreamHeader&) {
   }
   p.model_started = false;
   p.colors = nullptr;
+  p.vertex_colours = nullptr;
   p.level_mark = 0;
   p.model_frames = ModelFrames{};
   return true;  // the decoder and the view are set up when MSHH arrives
@@ -85,7 +106,7 @@ ChunkResult draw_frame(Player& p) {
   if (!p.begin_frame()) return ChunkResult::abort;
   const uint64_t display_before = p.display_total();
   const uint64_t d0 = p.work_clock();
-  const MeshColorsSurface* surface = p.colors != nullptr ? &p.colors->surface : nullptr;
+  const MeshColorsSurface* surface = p.model_colors();
   const Status d = p.view.draw(p.mesh.mesh(), p.model_frames.angle(), detail::render_band_to_player, &p, surface);
   p.model_frames.mark_drawn(p.mesh);
   // Drawing counts as display: the bands have added their part, add the renderer's.
@@ -184,6 +205,49 @@ ChunkResult colors_level(Player& p, const uint8_t* payload, uint32_t size, bool*
   return ChunkResult::consumed;
 }
 
+// MCVX: the colours of the vertices the last level added.
+ChunkResult vertex_colours(Player& p, const uint8_t* payload, uint32_t size, bool* drawn) {
+  *drawn = false;
+  const MeshState& m = p.mesh.mesh();
+  if (p.colors != nullptr || !p.mesh.drawable() || m.triangles16() == nullptr) {
+    p.fail(Status::malformed, "vertex colours without a mesh to colour");
+    return ChunkResult::abort;
+  }
+  VertexColours* c = p.vertex_colours;
+  if (c == nullptr) {
+    const uint32_t cap = p.plan().vertices;
+    c = p.arena().alloc_array<VertexColours>(1);
+    uint8_t* planes = c != nullptr ? p.arena().alloc_array<uint8_t>(size_t{3} * cap) : nullptr;
+    if (planes == nullptr) {
+      p.fail(Status::workspace_too_small, "no room for the vertex colours");
+      return ChunkResult::abort;
+    }
+    *c = VertexColours{};
+    c->planes = mc::Planes{planes, planes + cap, planes + 2 * size_t{cap}};
+    c->capacity = cap;
+    c->mesh = &m;
+    c->surface.y = c->planes.y;
+    c->surface.cb = c->planes.cb;
+    c->surface.cr = c->planes.cr;
+    c->surface.face = vertex_lattice_of;
+    c->surface.ctx = c;
+    p.vertex_colours = c;
+  }
+  if (!c->valid) return ChunkResult::consumed;  // keyed to vertices the tail renumbered
+  if (m.vertex_count() > c->capacity) {
+    p.fail(Status::malformed, "vertex colours beyond the mesh's capacity");
+    return ChunkResult::abort;
+  }
+  const Status s = mc::decode_vertex_colours(payload, size, m, c->planes, &c->coloured);
+  if (s != Status::ok) {
+    p.fail(s, "the vertex colours were refused");
+    return ChunkResult::abort;
+  }
+  c->surface.samples = c->coloured;
+  *drawn = true;
+  return ChunkResult::consumed;
+}
+
 ChunkResult on_colors_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size) {
   if (!p.model_started) {
     p.fail(Status::malformed, "mesh colors before the mesh");
@@ -192,7 +256,9 @@ ChunkResult on_colors_chunk(Player& p, uint32_t type, const uint8_t* payload, ui
   const uint64_t t0 = p.enter_chunk();
   ChunkResult r;
   bool draw = false;
-  if (type == mc::kChunkHeader) {
+  if (type == mc::kChunkVertices) {
+    r = vertex_colours(p, payload, size, &draw);
+  } else if (type == mc::kChunkHeader) {
     if (p.colors != nullptr) {
       p.fail(Status::malformed, "a second mesh colors header");
       r = ChunkResult::abort;
@@ -210,7 +276,8 @@ ChunkResult on_colors_chunk(Player& p, uint32_t type, const uint8_t* payload, ui
 }
 
 ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size) {
-  if (type == mc::kChunkHeader || type == mc::kChunkLevel) return on_colors_chunk(p, type, payload, size);
+  if (type == mc::kChunkHeader || type == mc::kChunkLevel || type == mc::kChunkVertices)
+    return on_colors_chunk(p, type, payload, size);
   if (!MeshDecoder::handles(type)) return ChunkResult::unknown;
   if (!p.model_started) {
     if (type != chunk::kMeshHeader) {
@@ -245,7 +312,13 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
   }
   // The level a chunk completed is drawn even when the decoder knows at once
   // that the next one will not fit (a version-2 stream's tail).
-  if (result == ChunkResult::consumed && p.model_frames.due(p.mesh)) result = draw_frame(p);
+  // A model whose vertices come with their colours is drawn when their
+  // colours are in (the MCVX after each level); after the single-rate tail,
+  // which numbers the vertices anew, when MCLH brings them all again.
+  VertexColours* vc = p.vertex_colours;
+  if (vc != nullptr && vc->valid && p.mesh.header().tail() && p.mesh.complete()) vc->valid = false;
+  const bool colour_follows = vc != nullptr && p.colors == nullptr;
+  if (result == ChunkResult::consumed && p.model_frames.due(p.mesh) && !colour_follows) result = draw_frame(p);
   p.leave_chunk();
   return result;
 }
@@ -261,8 +334,14 @@ size_t Player::model_colors_workspace_bytes(uint32_t faces, uint32_t vertices, u
          64;
 }
 
-const MeshColorsSurface* Player::model_colors() const { return colors != nullptr ? &colors->surface : nullptr; }
-int Player::model_colors_level() const { return colors != nullptr ? colors->shown : -1; }
+const MeshColorsSurface* Player::model_colors() const {
+  if (colors != nullptr) return &colors->surface;
+  return vertex_colours != nullptr && vertex_colours->valid ? &vertex_colours->surface : nullptr;
+}
+int Player::model_colors_level() const {
+  if (colors != nullptr) return colors->shown;
+  return vertex_colours != nullptr && vertex_colours->valid ? kModelVertexColours : -1;
+}
 
 namespace detail {
 extern const PlayerMode kModelMode;

@@ -33,11 +33,16 @@ struct ModelStreamOptions {
   // > 0: the finest quality (of a ladder from 1/8 to 64) whose whole stream
   // takes at most this many bytes; the quality above is then ignored.
   size_t max_bytes = 0;
+  // Vertex colours with their vertices (MCVX after the base and each split
+  // level), so the coarse mesh is drawn in colour.
+  bool vertex_colours = true;
 };
 
 // Where the stream's bytes go (chunk framing included).
 struct ModelStreamParts {
   size_t geometry = 0;             // preamble, HEAD, mesh chunks, END
+  size_t vertex_colours = 0;       // MCVX chunks' bytes
+  size_t vertex_chunks = 0;        // and their number
   size_t colors_header = 0;        // MCLH
   std::vector<size_t> level_bytes; // MCLV chunks per level (0 the finest)
   std::vector<size_t> level_end;   // stream offset where each level's last chunk ends
