@@ -21,7 +21,7 @@ struct EncodeModelOptions {
   std::string output;
   double quality = 1;
   size_t bytes = 0;
-  int bits = 12;
+  int bits = enc::ModelStreamOptions{}.mesh.bits;
   int max_res = 8;
   double density = 0;
   std::string up = "+y";
@@ -32,6 +32,7 @@ struct EncodeModelOptions {
   int views = 8;
   std::string anchors;
   double tail = -1;
+  double samples_per_pixel = enc::ModelStreamOptions{}.samples_per_pixel;
 };
 
 // The stream as it arrives (enc::model_timeline) and, with anchors, each
@@ -65,6 +66,7 @@ void run_encode_model(const EncodeModelOptions& o) {
   e.mesh.bits = o.bits;
   e.mesh.max_chunk_payload = o.max_chunk;
   if (o.tail >= 0) e.mesh.tail_fraction = o.tail;
+  e.samples_per_pixel = o.samples_per_pixel;
   if (!enc::mesh_up_from_name(o.up, &e.mesh.up))
     throw Failure(kExitUsage, "--up must be +y, +z, +x, -y, -z or -x (or y, z, x), not '" + o.up + "'");
   e.colors.max_res_log2 = o.max_res;
@@ -94,9 +96,17 @@ void run_encode_model(const EncodeModelOptions& o) {
               static_cast<unsigned>(r.decoded.positions.size()), faces, r.quality, o.paper ? "paper" : "vds");
   std::printf("  geometry %zu bytes (%zu levels), colour header %zu bytes (vertex samples, face resolutions)\n",
               r.parts.geometry, r.mesh.levels.size(), r.parts.colors_header);
-  for (size_t m = r.parts.level_bytes.size(); m-- > 0;)
-    std::printf("  colour level %zu: %u samples, %zu bytes in %zu chunks\n", m, r.colors.samples(static_cast<int>(m)),
-                r.parts.level_bytes[m], r.coded.levels[m].size());
+  for (size_t m = r.parts.level_bytes.size(); m-- > 0;) {
+    const double psnr = m < r.level_psnr.size() ? r.level_psnr[m] : 0;
+    if (r.sent[m])
+      std::printf("  colour level %zu: %u samples, %zu bytes in %zu chunks", m, r.colors.samples(static_cast<int>(m)),
+                  r.parts.level_bytes[m], r.coded.levels[m].size());
+    else
+      std::printf("  colour level %zu: %u samples, not sent (%zu bytes, no better than a coarser one)", m,
+                  r.colors.samples(static_cast<int>(m)), r.coded.level_bytes(static_cast<int>(m)));
+    if (psnr > 0) std::printf(" (%.2f dB as the client shows it)", psnr);
+    std::printf("\n");
+  }
   std::printf("client: %u B workspace + %u B chunk buffer\n", r.header.workspace_bytes, r.header.max_chunk_payload);
 }
 
@@ -125,8 +135,13 @@ void add_encode_model(CLI::App& app) {
       ->capture_default_str();
   sub->add_option("--tail", o->tail,
                   "Send the whole mesh single-rate after the split levels that reach this fraction of the vertices "
-                  "(0: splits all the way; default as vds encode-mesh)")
+                  "(0: splits all the way; default 0.3)")
       ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--samples-per-pixel", o->samples_per_pixel,
+                  "Cap each face's resolution at this many samples per client pixel along its longest edge, seen as "
+                  "near as the client's model view sees it (0: no cap)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 64.0));
   sub->add_flag("--paper", o->paper, "Code the colours as the thesis does (for comparison)");
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes (the client's chunk buffer)")
       ->capture_default_str()

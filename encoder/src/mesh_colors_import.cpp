@@ -402,6 +402,14 @@ MeshColorsModel to_mesh_colors(const TexturedModel& model, const MeshColorsOptio
     for (uint32_t f = 0; f < F; ++f)
       if (boost[f] && out.face_res[f] < max_allowed) out.max_res = std::max<int>(out.max_res, ++out.face_res[f]);
   }
+  if (!o.face_max_res.empty()) {
+    if (o.face_max_res.size() != F) throw std::invalid_argument("mesh colors: a resolution cap per face is needed");
+    out.max_res = 0;
+    for (uint32_t f = 0; f < F; ++f) {
+      out.face_res[f] = std::min(out.face_res[f], o.face_max_res[f]);
+      out.max_res = std::max<int>(out.max_res, out.face_res[f]);
+    }
+  }
   if (layout.set(out.face_res.data(), nullptr, 256) != Status::ok) throw std::logic_error("mesh colors: layout set-up failed");
 
   auto to_planes = [](const Accum& a, uint32_t from, uint32_t to, std::array<std::vector<uint8_t>, 3>& planes) {

@@ -169,11 +169,85 @@ std::map<size_t, std::vector<uint8_t>> vertex_colour_chunks(std::span<const uint
   return out;
 }
 
+size_t framed(size_t payload) { return kChunkHeadBytes + payload + kChunkTailBytes; }
+
+// The stream: the mesh's chunks, each level's vertex colours after it,
+// MCLH, then the levels r.sent says, coarsest first.
+void assemble(ModelStreamResult& r, const std::map<size_t, std::vector<uint8_t>>& vertex_chunks, size_t max_chunk) {
+  StreamWriter w(r.header);
+  r.parts = ModelStreamParts{};
+  const std::vector<Chunk> mesh_chunks = body_chunks(r.mesh.stream);
+  for (size_t i = 0; i < mesh_chunks.size(); ++i) {
+    w.add_chunk(mesh_chunks[i].type, mesh_chunks[i].payload);
+    const auto vc = vertex_chunks.find(i);
+    if (vc == vertex_chunks.end()) continue;
+    if (vc->second.size() > max_chunk) throw std::invalid_argument("a level's vertex colours take more than a chunk");
+    w.add_chunk(mc::kChunkVertices, vc->second);
+    r.parts.vertex_colours += framed(vc->second.size());
+    ++r.parts.vertex_chunks;
+  }
+  r.parts.geometry_end = w.size();
+  w.add_chunk(mc::kChunkHeader, r.coded.header);
+  r.parts.colors_header_end = w.size();
+  r.parts.colors_header = framed(r.coded.header.size());
+  r.parts.level_bytes.assign(r.coded.levels.size(), 0);
+  r.parts.level_end.assign(r.coded.levels.size(), 0);
+  for (size_t m = r.coded.levels.size(); m-- > 0;) {
+    if (!r.sent[m]) continue;
+    for (const auto& ch : r.coded.levels[m]) {
+      w.add_chunk(mc::kChunkLevel, ch);
+      r.parts.level_bytes[m] += framed(ch.size());
+    }
+    r.parts.level_end[m] = w.size();
+  }
+  r.stream = w.finish();
+  r.parts.geometry = r.stream.size() - r.parts.colors_header - r.parts.vertex_colours;
+  for (size_t b : r.parts.level_bytes) r.parts.geometry -= b;
+}
+
 struct Colours {
   double quality;
   MeshColorsModel mc;
   MccEncoded coded;
 };
+
+// The largest exponent each face of `dm` needs on a client (see
+// ModelStreamOptions::samples_per_pixel): its longest edge in pixels when
+// nearest the client's camera, times the samples per pixel, to the next
+// power of two.
+std::vector<uint8_t> display_caps(const TexturedModel& dm, const Quantisation& q, const std::vector<std::array<uint16_t, 3>>& grid,
+                                  const StreamHeader& h, double samples_per_pixel) {
+  // World units (the model view's): 2^bits grid steps span 2 units, centred on the bounds.
+  std::array<double, 3> lo{1e30, 1e30, 1e30}, hi{-1e30, -1e30, -1e30};
+  for (const auto& g : grid)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min<double>(lo[a], g[a]);
+      hi[a] = std::max<double>(hi[a], g[a]);
+    }
+  const double unit = 2.0 / std::ldexp(1.0, q.bits);  // world units per grid step
+  double radius = 0;
+  for (const auto& g : grid) {
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) d2 += std::pow((g[a] - (lo[a] + hi[a]) / 2) * unit, 2);
+    radius = std::max(radius, std::sqrt(d2));
+  }
+  const double nearest = std::max(0.25, 3.2 - radius);
+  const double px_per_unit = h.height / nearest;
+  std::vector<uint8_t> caps(dm.triangles.size());
+  for (size_t f = 0; f < dm.triangles.size(); ++f) {
+    double longest = 0;
+    for (int k = 0; k < 3; ++k) {
+      const auto& a = grid[dm.triangles[f][k]];
+      const auto& b = grid[dm.triangles[f][(k + 1) % 3]];
+      double d2 = 0;
+      for (int c = 0; c < 3; ++c) d2 += std::pow((double(a[c]) - b[c]) * unit, 2);
+      longest = std::max(longest, std::sqrt(d2));
+    }
+    const double samples = std::max(1.0, longest * px_per_unit * samples_per_pixel);
+    caps[f] = static_cast<uint8_t>(std::clamp(static_cast<int>(std::ceil(std::log2(samples) - 1e-9)), 0, mc::kMaxResLog2));
+  }
+  return caps;
+}
 
 Colours colours_at(const TexturedModel& dm, const ModelStreamOptions& o, double quality, size_t max_chunk) {
   MeshColorsOptions co = o.colors;
@@ -185,7 +259,6 @@ Colours colours_at(const TexturedModel& dm, const ModelStreamOptions& o, double 
   return c;
 }
 
-size_t framed(size_t payload) { return kChunkHeadBytes + payload + kChunkTailBytes; }
 
 size_t stream_bytes(const MeshEncodeResult& mesh, const MccEncoded& coded) {
   size_t n = mesh.stream.size() + framed(coded.header.size());
@@ -208,12 +281,15 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
   const std::vector<uint32_t> tri = client_triangles(r.mesh.stream, &vertices, &grid);
   if (vertices != r.mesh.vertex_order.size()) throw std::logic_error("model stream: the client's vertex count differs");
   r.decoded = in_client_order(model, repaired, r.mesh.vertex_order, tri);
+  ModelStreamOptions oc = o;
+  if (o.samples_per_pixel > 0)
+    oc.colors.face_max_res = display_caps(r.decoded, r.mesh.quantisation, grid, r.mesh.stream_header, o.samples_per_pixel);
 
   const size_t max_chunk = r.mesh.stream_header.max_chunk_payload;
   Colours c;
   std::map<size_t, std::vector<uint8_t>> vertex_chunks;
   auto colour = [&](double q) {
-    c = colours_at(r.decoded, o, q, max_chunk);
+    c = colours_at(r.decoded, oc, q, max_chunk);
     vertex_chunks.clear();
     if (o.vertex_colours) vertex_chunks = vertex_colour_chunks(r.mesh.stream, grid, c.mc.vertex_ycc);
     size_t n = stream_bytes(r.mesh, c.coded);
@@ -242,34 +318,28 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
   const size_t extra = Player::model_colors_workspace_bytes(faces, vertices, r.colors.samples(0));
   if (h.workspace_bytes + extra > 0xFFFFFFFFu) throw std::invalid_argument("model too large for a client workspace");
   h.workspace_bytes = static_cast<uint32_t>(h.workspace_bytes + extra);
-  StreamWriter w(h);
-  const std::vector<Chunk> mesh_chunks = body_chunks(r.mesh.stream);
-  for (size_t i = 0; i < mesh_chunks.size(); ++i) {
-    w.add_chunk(mesh_chunks[i].type, mesh_chunks[i].payload);
-    const auto vc = vertex_chunks.find(i);
-    if (vc == vertex_chunks.end()) continue;
-    if (vc->second.size() > max_chunk) throw std::invalid_argument("a level's vertex colours take more than a chunk");
-    w.add_chunk(mc::kChunkVertices, vc->second);
-    r.parts.vertex_colours += framed(vc->second.size());
-    ++r.parts.vertex_chunks;
-  }
-  r.parts.geometry_end = w.size();
-  w.add_chunk(mc::kChunkHeader, r.coded.header);
-  r.parts.colors_header_end = w.size();
-  r.parts.colors_header = framed(r.coded.header.size());
-  r.parts.level_bytes.assign(r.coded.levels.size(), 0);
-  r.parts.level_end.assign(r.coded.levels.size(), 0);
-  for (size_t m = r.coded.levels.size(); m-- > 0;) {
-    for (const auto& ch : r.coded.levels[m]) {
-      w.add_chunk(mc::kChunkLevel, ch);
-      r.parts.level_bytes[m] += framed(ch.size());
-    }
-    r.parts.level_end[m] = w.size();
-  }
-  r.stream = w.finish();
   r.header = h;
-  r.parts.geometry = r.stream.size() - r.parts.colors_header - r.parts.vertex_colours;
-  for (size_t b : r.parts.level_bytes) r.parts.geometry -= b;
+  r.sent.assign(r.coded.levels.size(), true);
+  assemble(r, vertex_chunks, max_chunk);
+  if (o.schedule_views > 0 && !r.coded.levels.empty()) {
+    // The rate schedule: each level as the client shows it, measured; a
+    // level no better than the best coarser one by 0.05 dB is not sent.
+    TimelineOptions t;
+    t.views = o.schedule_views;
+    t.supersample = 2;
+    t.colours_only = true;
+    double best = -1;
+    std::vector<double> psnr(r.coded.levels.size() + 1, -1);
+    for (const TimelinePoint& p : model_timeline(model, r, t))
+      if (p.colour_level >= 0 && p.colour_level <= r.colors.max_res) psnr[static_cast<size_t>(p.colour_level)] = p.psnr;
+    best = psnr.back();  // the vertex samples alone (MCLH)
+    for (size_t m = r.coded.levels.size(); m-- > 0;) {
+      r.sent[m] = psnr[m] > best + 0.05;
+      if (r.sent[m]) best = psnr[m];
+    }
+    r.level_psnr = psnr;
+    assemble(r, vertex_chunks, max_chunk);
+  }
   return r;
 }
 

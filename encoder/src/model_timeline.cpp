@@ -148,6 +148,8 @@ std::vector<TimelinePoint> model_timeline(const TexturedModel& model, const Mode
     if (is_error(st)) throw std::logic_error(std::string("model timeline: the client refused the stream: ") + status_name(st));
     at = end;
     if (frames == before) continue;
+    if (o.colours_only && player->model_colors_level() < 0) continue;
+    if (o.colours_only && player->model_colors_level() == Player::kModelVertexColours) continue;
     const MeshState& mesh = player->mesh.mesh();
     const MeshColorsSurface* colours = player->model_colors();
     TimelinePoint p;

@@ -230,6 +230,8 @@ TEST(Player, ATexturedModelShowsEveryColourLevelItsWorkspaceHolds) {
   const char* box = "/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf";
   vds::enc::ModelStreamOptions o;
   o.colors.max_res_log2 = 6;
+  o.samples_per_pixel = 0;  // every level, each sent
+  o.schedule_views = 0;
   o.codec.max_chunk = 1024;
   o.mesh.max_chunk_payload = 1024;
   const vds::enc::ModelStreamResult r = vds::enc::encode_model_stream(vds::enc::load_textured_model(box), o);

@@ -70,6 +70,9 @@ struct MeshColorsOptions {
   int max_res_log2 = 10;  // R <= 1024
   int min_res_log2 = 0;   // for textured faces
   bool seam_boost = true;  // faces on a seam whose sides' colours differ get twice the resolution
+  // Optional, one per face: the largest exponent each face may have (after
+  // the rules above), e.g. what a display can show of it.
+  std::vector<uint8_t> face_max_res;
 };
 
 // A model's mesh colors on the host.
