@@ -28,13 +28,7 @@ mkdir -p "$WORK"
 # An OpenArena player's torso (openarena-data's pak2-players.pk3), taken out
 # of the archive with its skin and textures.
 PLAYER=${PLAYER:-major}
-/usr/bin/python3 - "$WORK/oa" "$PLAYER" <<'PY'
-import sys, zipfile
-z = zipfile.ZipFile("/usr/share/games/openarena/baseoa/pak2-players.pk3")
-for n in z.namelist():
-    if n.startswith("models/players/%s/" % sys.argv[2]):
-        z.extract(n, sys.argv[1])
-PY
+/usr/bin/python3 "$ROOT/bench/extract_oa_player.py" "$WORK/oa" "$PLAYER"
 MODELS=${MODELS:-"duck:$A/Collada/duck_triangulate.dae truck:$A/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf mrfixit:$A/IQM/mrfixit.iqm $PLAYER:$WORK/oa/models/players/$PLAYER/upper.md3"}
 # Models whose up axis is +z (Quake III's); assimp gives the others +y.
 Z_UP=${Z_UP:-$PLAYER}

@@ -4,6 +4,7 @@
 // first (vds/enc/model_stream.h). Prints where the bytes go and what a
 // client needs.
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -32,6 +33,8 @@ struct EncodeModelOptions {
   int views = 8;
   std::string anchors;
   double tail = -1;
+  std::string dump_obj;
+  std::string timeline_images;
   double samples_per_pixel = enc::ModelStreamOptions{}.samples_per_pixel;
 };
 
@@ -41,6 +44,8 @@ struct EncodeModelOptions {
 void write_timeline(const EncodeModelOptions& o, const enc::TexturedModel& model, const enc::ModelStreamResult& r) {
   enc::TimelineOptions t;
   t.views = o.views;
+  t.images_dir = o.timeline_images;
+  if (!t.images_dir.empty()) std::filesystem::create_directories(t.images_dir);
   std::vector<Anchor> anchors;
   if (!o.anchors.empty()) anchors = read_anchors(o.anchors, model.textures.size());
   std::FILE* f = std::fopen(o.timeline.c_str(), "w");
@@ -52,11 +57,27 @@ void write_timeline(const EncodeModelOptions& o, const enc::TexturedModel& model
       std::printf("  at %7zu bytes: %5u vertices, colour level %2d: %.2f dB\n", p.bytes, p.vertices, p.colour_level, p.psnr);
   }
   for (const Anchor& a : anchors) {
+    t.label = a.codec;
     const double psnr = enc::model_views_psnr(model, a.textures, r, t);
     std::fprintf(f, "%s,%s,%zu,%zu,-1,%.3f\n", a.codec.c_str(), a.param.c_str(), a.bytes, model.positions.size(), psnr);
     if (!o.quiet) std::printf("  %s %s: %zu bytes of texture: %.2f dB\n", a.codec.c_str(), a.param.c_str(), a.bytes, psnr);
   }
   std::fclose(f);
+}
+
+// The model as an OBJ with its texture coordinates (for other encoders:
+// the benchmark's Draco anchor), positions and corners as imported.
+void write_obj(const std::string& path, const enc::TexturedModel& m) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) throw Failure(kExitBadInput, path + ": cannot write");
+  for (const auto& p : m.positions) std::fprintf(f, "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+  for (const auto& face : m.uv)
+    for (const auto& t : face) std::fprintf(f, "vt %.9g %.9g\n", t[0], t[1]);
+  for (size_t i = 0; i < m.triangles.size(); ++i) {
+    const auto& t = m.triangles[i];
+    std::fprintf(f, "f %u/%zu %u/%zu %u/%zu\n", t[0] + 1, 3 * i + 1, t[1] + 1, 3 * i + 2, t[2] + 1, 3 * i + 3);
+  }
+  if (std::fclose(f) != 0) throw Failure(kExitBadInput, path + ": cannot write");
 }
 
 void run_encode_model(const EncodeModelOptions& o) {
@@ -81,6 +102,7 @@ void run_encode_model(const EncodeModelOptions& o) {
   } catch (const std::runtime_error& err) {
     throw Failure(kExitBadInput, err.what());
   }
+  if (!o.dump_obj.empty()) write_obj(o.dump_obj, model);
   enc::ModelStreamResult r;
   try {
     r = enc::encode_model_stream(model, e);
@@ -153,6 +175,10 @@ void add_encode_model(CLI::App& app) {
   sub->add_option("--anchors", o->anchors,
                   "With --timeline: the model's textures coded by other codecs (CSV codec,parameter,bytes,files), "
                   "each measured on the whole model at the same cameras");
+  sub->add_option("--timeline-images", o->timeline_images,
+                  "With --timeline: write each view's reference and the client's last picture (and each anchor's) "
+                  "as PNG into this directory");
+  sub->add_option("--dump-obj", o->dump_obj, "Also write the model as imported as an OBJ with its texture coordinates");
   sub->add_flag("-q,--quiet", o->quiet, "Print nothing");
   sub->callback([o] { run_encode_model(*o); });
 }

@@ -19,18 +19,22 @@ struct Options {
   std::string png_dir;
   size_t workspace = 0;
   size_t player_from = 0;
+  bool notices = false;
 };
 
 void run(const Options& o) {
   const std::vector<uint8_t> stream = enc::read_file(o.file);
   std::vector<enc::Image> frames;
   std::vector<uint32_t> crcs;
+  std::vector<std::string> notices;
   try {
     const enc::ClientArena board{o.workspace, o.player_from};
-    crcs = enc::client_frame_crcs(stream, o.png_dir.empty() ? nullptr : &frames, o.workspace ? &board : nullptr);
+    crcs = enc::client_frame_crcs(stream, o.png_dir.empty() ? nullptr : &frames, o.workspace ? &board : nullptr,
+                                  o.notices ? &notices : nullptr);
   } catch (const std::runtime_error& e) {
     throw Failure(kExitBadInput, o.file + ": " + e.what());
   }
+  for (const std::string& n : notices) std::fprintf(stderr, "%s\n", n.c_str());
   if (!o.png_dir.empty()) std::filesystem::create_directories(o.png_dir);
   for (size_t i = 0; i < crcs.size(); ++i) {
     std::printf("%08x\n", crcs[i]);
@@ -54,6 +58,7 @@ void add_frames(CLI::App& app) {
                 ->check(CLI::Range(size_t{1024}, size_t{1} << 30));
   sub->add_option("--player-from", o->player_from, "With --workspace: where the board's player starts in it (U)")
       ->needs(w);
+  sub->add_flag("--notices", o->notices, "Print what the player decided about a model (on stderr)");
   sub->callback([o] { run(*o); });
 }
 

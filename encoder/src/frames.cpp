@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <string>
 
 #include "vds/bytes.h"
 #include "vds/container.h"
@@ -79,7 +80,28 @@ namespace {
 struct Replay {
   std::vector<uint32_t> crcs;
   std::vector<Image>* frames = nullptr;
+  std::vector<std::string>* notices = nullptr;
 };
+
+std::string notice_text(PlayerNotice what, uint32_t a, uint32_t b, uint32_t c) {
+  switch (what) {
+    case PlayerNotice::model_partial:
+      return "model: the workspace holds " + std::to_string(a) + " of its " + std::to_string(b) +
+             " vertices; later levels are skipped";
+    case PlayerNotice::model_full:
+      return "model: workspace full after level " + std::to_string(a) + " of " + std::to_string(b) + " (" +
+             std::to_string(c) + " vertices)";
+    case PlayerNotice::model_base_too_big:
+      return "model: the base mesh needs " + std::to_string(a) + " bytes of workspace, " + std::to_string(b) +
+             " are left";
+    case PlayerNotice::model_colors_level:
+      return "model: colours down to MIP level " + std::to_string(a) + " of " + std::to_string(b) + " fit the workspace";
+    case PlayerNotice::model_no_colors:
+      return a == 1 ? "model: the mesh is not whole: drawn without its colours"
+                    : "model: no room for the colours: drawn without them";
+  }
+  return "model: notice " + std::to_string(static_cast<int>(what));
+}
 
 bool replay_band(void* ctx, const PixelRect& r) {
   auto* rp = static_cast<Replay*>(ctx);
@@ -99,10 +121,11 @@ bool replay_band(void* ctx, const PixelRect& r) {
 // The client's own player with the boards' configuration: only its chunk
 // buffer is sized to the stream (it changes no pixel).
 std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames,
-                                        const ClientArena* board) {
+                                        const ClientArena* board, std::vector<std::string>* notices) {
   auto player = std::make_unique<Player>();
   Replay rp;
   rp.frames = frames;
+  rp.notices = notices;
   PlayerConfig cfg = kClientPlayerConfig;
   std::vector<uint8_t> ws;
   if (board != nullptr) {
@@ -126,6 +149,10 @@ std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::ve
   };
   cb.band = replay_band;
   cb.frame_shown = [](void* ctx, const PlayedFrame& f) { static_cast<Replay*>(ctx)->crcs.push_back(f.crc); };
+  cb.notice = [](void* ctx, PlayerNotice what, uint32_t a, uint32_t b, uint32_t c) {
+    auto* r = static_cast<Replay*>(ctx);
+    if (r->notices != nullptr) r->notices->push_back(notice_text(what, a, b, c));
+  };
   if (player->init(arena, cfg, cb) != Status::ok) throw std::runtime_error("client player: cannot initialise");
   Status s = player->feed(stream.data(), stream.size());
   if (s == Status::more_input) s = player->finish();

@@ -212,9 +212,9 @@ struct Colours {
 };
 
 // The largest exponent each face of `dm` needs on a client (see
-// ModelStreamOptions::samples_per_pixel): its longest edge in pixels when
-// nearest the client's camera, times the samples per pixel, to the next
-// power of two.
+// ModelStreamOptions::samples_per_pixel): as the texture rule, R for
+// R^2 / 2 samples over the face's area in pixels when nearest the
+// client's camera, times the samples per pixel, to the next power of two.
 std::vector<uint8_t> display_caps(const TexturedModel& dm, const Quantisation& q, const std::vector<std::array<uint16_t, 3>>& grid,
                                   const StreamHeader& h, double samples_per_pixel) {
   // World units (the model view's): 2^bits grid steps span 2 units, centred on the bounds.
@@ -235,15 +235,15 @@ std::vector<uint8_t> display_caps(const TexturedModel& dm, const Quantisation& q
   const double px_per_unit = h.height / nearest;
   std::vector<uint8_t> caps(dm.triangles.size());
   for (size_t f = 0; f < dm.triangles.size(); ++f) {
-    double longest = 0;
-    for (int k = 0; k < 3; ++k) {
-      const auto& a = grid[dm.triangles[f][k]];
-      const auto& b = grid[dm.triangles[f][(k + 1) % 3]];
-      double d2 = 0;
-      for (int c = 0; c < 3; ++c) d2 += std::pow((double(a[c]) - b[c]) * unit, 2);
-      longest = std::max(longest, std::sqrt(d2));
-    }
-    const double samples = std::max(1.0, longest * px_per_unit * samples_per_pixel);
+    // The face's area in pixels (a lattice of resolution R holds about R^2 / 2 samples).
+    double e[2][3];
+    for (int k = 0; k < 2; ++k)
+      for (int c = 0; c < 3; ++c)
+        e[k][c] = (double(grid[dm.triangles[f][k + 1]][c]) - grid[dm.triangles[f][0]][c]) * unit * px_per_unit;
+    const double cx = e[0][1] * e[1][2] - e[0][2] * e[1][1], cy = e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                 cz = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+    const double area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+    const double samples = std::max(1.0, samples_per_pixel * std::sqrt(2 * area));
     caps[f] = static_cast<uint8_t>(std::clamp(static_cast<int>(std::ceil(std::log2(samples) - 1e-9)), 0, mc::kMaxResLog2));
   }
   return caps;

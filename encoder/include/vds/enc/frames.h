@@ -47,7 +47,9 @@ struct ClientArena {
   size_t budget = 0;
   size_t player_from = 0;
 };
+// `notices`, when given, receives what the player decided about a model
+// (PlayerNotice), one line each, worded as the firmware logs them.
 std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames = nullptr,
-                                        const ClientArena* arena = nullptr);
+                                        const ClientArena* arena = nullptr, std::vector<std::string>* notices = nullptr);
 
 }  // namespace vds::enc

@@ -42,10 +42,11 @@ struct ModelStreamOptions {
   // Vertex colours with their vertices (MCVX after the base and each split
   // level), so the coarse mesh is drawn in colour.
   bool vertex_colours = true;
-  // Samples per client pixel a face may have along its longest edge, seen
-  // as near as the client's model view ever sees it (its orbit at 3.2 units
-  // from the centre, the model within its bounding sphere, a focal length
-  // of the frame height): faces get no finer lattice than that (0: no cap).
+  // Samples per client pixel side a face may have, seen as near as the
+  // client's model view ever sees it (its orbit at 3.2 units from the
+  // centre, the model within its bounding sphere, a focal length of the
+  // frame height): a face's R at most the power of two at or above
+  // samples_per_pixel x sqrt(2 x its area in pixels) (0: no cap).
   double samples_per_pixel = 1;
   // The rate schedule: geometry with its vertex colours, then the vertex
   // samples (MCLH), then the MIP levels coarsest first — each only if, as
@@ -96,6 +97,10 @@ struct TimelineOptions {
   int views = 8;
   int supersample = 3;
   bool colours_only = false;  // only the frames from MCLH on
+  // When set: each view's reference and client picture of the last frame
+  // measured (DIR/view<k>_reference.png, DIR/view<k>_<label>.png).
+  std::string images_dir;
+  std::string label = "vds";
 };
 struct TimelinePoint {
   size_t bytes = 0;          // stream bytes received when the frame is drawn
@@ -107,8 +112,11 @@ std::vector<TimelinePoint> model_timeline(const TexturedModel& model, const Mode
                                           const TimelineOptions& o = TimelineOptions{});
 
 // The same measure of the model with `textures` in place of its own, on its
-// own geometry, at the cameras of the whole mesh: what a download of the
-// model with its texture coded by another codec shows once it is complete.
+// own geometry, at the cameras of the whole mesh, drawn as a client draws a
+// textured mesh (the client library's renderer, RGB565, bilinear): what a
+// download of the model with its texture coded by another codec shows once
+// it is complete. With the model's own textures: the client renderer's
+// ceiling.
 double model_views_psnr(const TexturedModel& model, const std::vector<Image>& textures, const ModelStreamResult& r,
                         const TimelineOptions& o = TimelineOptions{});
 
