@@ -63,9 +63,17 @@ for name in sys.argv[4:]:
     for i, dec, disp in frames:
         p = pix[i] if i < len(pix) else 0
         out.append(f"| {i} | {dec:,} | {disp:,} | {p:,} | {disp / p:.0f} |" if p else f"| {i} | {dec:,} | {disp:,} | - | - |")
-    # The last frames are the levels sent, finest last: decode per sample.
-    sent = [m for m in sorted(samples, reverse=True)]
-    tail = frames[-len(sent):] if len(frames) >= len(sent) else []
+    # The last frames are the levels the board showed (those sent, no finer
+    # than its workspace holds), finest last: decode per sample.
+    logs = q + "".join(open(f).read() for f in glob.glob(os.path.join(d, "qemu", "*.log")))
+    held = re.search(r"colours down to MIP level (\d+)", logs)
+    finest = int(held.group(1)) if held else 0
+    sent = [m for m in sorted(samples, reverse=True) if m >= finest]
+    if "no room for the colours" in logs:
+        sent = []
+    tail = frames[-len(sent):] if sent and len(frames) >= len(sent) else []
+    if held:
+        out.append(f"The board's workspace holds MIP level {finest} and coarser; finer levels are skipped.")
     if tail:
         out += ["", "| mesh colors level | samples | decode (instructions) | per sample |", "|---:|---:|---:|---:|"]
         for m, (_, dec, _) in zip(sent, tail):

@@ -158,6 +158,15 @@ void make_steps(uint16_t quality_q8, uint8_t mode, Steps* out) {
 
 void inverse_dct(const int32_t* in, int n, int32_t* out, int in_stride, int out_stride) {
   if (n < 1 || n > 8) return;
+  // Most rows and columns of a coded block hold no AC coefficient: their
+  // samples are the DC (what the sums below give, without them).
+  bool ac = false;
+  for (int k = 1; k < n && !ac; ++k) ac = in[k * in_stride] != 0;
+  if (!ac) {
+    const int32_t v = clamp32(in[0], kSampleLimit);
+    for (int i = 0; i < n; ++i) out[i * out_stride] = v;
+    return;
+  }
   const int16_t* t = kCos + kCosStart[n];
   for (int i = 0; i < n; ++i) {
     int64_t acc = 0;
