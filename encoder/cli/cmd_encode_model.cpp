@@ -22,6 +22,7 @@ struct EncodeModelOptions {
   std::string output;
   double quality = 1;
   size_t bytes = 0;
+  double psnr = 0;
   int bits = enc::ModelStreamOptions{}.mesh.bits;
   int max_res = 8;
   double density = 0;
@@ -81,9 +82,11 @@ void write_obj(const std::string& path, const enc::TexturedModel& m) {
 }
 
 void run_encode_model(const EncodeModelOptions& o) {
+  if (o.bytes > 0 && o.psnr > 0) throw Failure(kExitUsage, "--bytes and --psnr exclude each other");
   enc::ModelStreamOptions e;
   e.quality = o.quality;
   e.max_bytes = o.bytes;
+  e.min_psnr = o.psnr;
   e.mesh.bits = o.bits;
   e.mesh.max_chunk_payload = o.max_chunk;
   if (o.tail >= 0) e.mesh.tail_fraction = o.tail;
@@ -146,6 +149,11 @@ void add_encode_model(CLI::App& app) {
                 ->check(CLI::Range(1.0 / 256, 255.0));
   sub->add_option("--bytes", o->bytes, "Instead of --quality: the finest quality whose whole stream fits this many bytes")
       ->check(CLI::Range(size_t{1}, size_t{1} << 32))
+      ->excludes(q);
+  sub->add_option("--psnr", o->psnr,
+                  "Instead of --quality: the coarsest quality whose finest picture, as the client shows it (the rate "
+                  "schedule's measure), reaches this PSNR")
+      ->check(CLI::Range(1.0, 99.0))
       ->excludes(q);
   sub->add_option("--bits", o->bits, "Geometry quantisation bits per axis")->capture_default_str()->check(CLI::Range(2, 16));
   sub->add_option("--max-res", o->max_res, "Largest face resolution exponent (R = 2^r)")

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <array>
 #include <map>
 #include <memory>
@@ -286,59 +287,93 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
     oc.colors.face_max_res = display_caps(r.decoded, r.mesh.quantisation, grid, r.mesh.stream_header, o.samples_per_pixel);
 
   const size_t max_chunk = r.mesh.stream_header.max_chunk_payload;
-  Colours c;
   std::map<size_t, std::vector<uint8_t>> vertex_chunks;
+  // The colours at quality q, coded (without the schedule: the bytes of every level).
   auto colour = [&](double q) {
-    c = colours_at(r.decoded, oc, q, max_chunk);
+    Colours c = colours_at(r.decoded, oc, q, max_chunk);
     vertex_chunks.clear();
     if (o.vertex_colours) vertex_chunks = vertex_colour_chunks(r.mesh.stream, grid, c.mc.vertex_ycc);
-    size_t n = stream_bytes(r.mesh, c.coded);
+    if (c.coded.header.size() > max_chunk)
+      throw std::invalid_argument("the mesh colors header takes " + std::to_string(c.coded.header.size()) +
+                                  " bytes, more than a chunk (" + std::to_string(max_chunk) + "): raise the chunk size");
+    r.quality = c.quality;
+    r.colors = std::move(c.mc);
+    r.coded = std::move(c.coded);
+    size_t n = stream_bytes(r.mesh, r.coded);
     for (const auto& [at, payload] : vertex_chunks) n += framed(payload.size());
     return n;
   };
-  if (o.max_bytes > 0) {
-    bool found = false;
-    size_t bytes = 0;
-    for (double q = 0.125; q <= 64 && !found; q *= std::sqrt(2.0)) found = (bytes = colour(q)) <= o.max_bytes;
-    if (!found)
-      throw std::invalid_argument("no quality fits " + std::to_string(o.max_bytes) + " bytes (at quality 64: " +
-                                  std::to_string(bytes) + ")");
-  } else {
-    colour(o.quality);
-  }
-  if (c.coded.header.size() > max_chunk)
-    throw std::invalid_argument("the mesh colors header takes " + std::to_string(c.coded.header.size()) +
-                                " bytes, more than a chunk (" + std::to_string(max_chunk) + "): raise the chunk size");
-  r.quality = c.quality;
-  r.colors = std::move(c.mc);
-  r.coded = std::move(c.coded);
-
-  StreamHeader h = r.mesh.stream_header;
-  const uint32_t faces = static_cast<uint32_t>(r.colors.face_res.size());
-  const size_t extra = Player::model_colors_workspace_bytes(faces, vertices, r.colors.samples(0));
-  if (h.workspace_bytes + extra > 0xFFFFFFFFu) throw std::invalid_argument("model too large for a client workspace");
-  h.workspace_bytes = static_cast<uint32_t>(h.workspace_bytes + extra);
-  r.header = h;
-  r.sent.assign(r.coded.levels.size(), true);
-  assemble(r, vertex_chunks, max_chunk);
-  if (o.schedule_views > 0 && !r.coded.levels.empty()) {
+  // The stream of the colours last coded, the rate schedule applied; the
+  // PSNR of its finest picture as the schedule measured it (0 without).
+  auto finish = [&]() {
+    StreamHeader h = r.mesh.stream_header;
+    const uint32_t faces = static_cast<uint32_t>(r.colors.face_res.size());
+    const size_t extra = Player::model_colors_workspace_bytes(faces, vertices, r.colors.samples(0));
+    if (h.workspace_bytes + extra > 0xFFFFFFFFu) throw std::invalid_argument("model too large for a client workspace");
+    h.workspace_bytes = static_cast<uint32_t>(h.workspace_bytes + extra);
+    r.header = h;
+    r.sent.assign(r.coded.levels.size(), true);
+    r.level_psnr.clear();
+    assemble(r, vertex_chunks, max_chunk);
+    if (o.schedule_views <= 0 || r.coded.levels.empty()) return 0.0;
     // The rate schedule: each level as the client shows it, measured; a
     // level no better than the best coarser one by 0.05 dB is not sent.
     TimelineOptions t;
     t.views = o.schedule_views;
     t.supersample = 2;
     t.colours_only = true;
-    double best = -1;
     std::vector<double> psnr(r.coded.levels.size() + 1, -1);
     for (const TimelinePoint& p : model_timeline(model, r, t))
       if (p.colour_level >= 0 && p.colour_level <= r.colors.max_res) psnr[static_cast<size_t>(p.colour_level)] = p.psnr;
-    best = psnr.back();  // the vertex samples alone (MCLH)
+    double best = psnr.back();  // the vertex samples alone (MCLH)
     for (size_t m = r.coded.levels.size(); m-- > 0;) {
       r.sent[m] = psnr[m] > best + 0.05;
       if (r.sent[m]) best = psnr[m];
     }
     r.level_psnr = psnr;
     assemble(r, vertex_chunks, max_chunk);
+    return best;
+  };
+  // The quality ladder of --bytes and --psnr: 1/8 to 64 in steps of sqrt(2).
+  std::vector<double> ladder;
+  for (int i = 0; i <= 18; ++i) ladder.push_back(0.125 * std::pow(2.0, i / 2.0));
+  if (o.max_bytes > 0) {
+    bool found = false;
+    size_t bytes = 0;
+    for (size_t i = 0; i < ladder.size() && !found; ++i) found = (bytes = colour(ladder[i])) <= o.max_bytes;
+    if (!found)
+      throw std::invalid_argument("no quality fits " + std::to_string(o.max_bytes) + " bytes (at quality 64: " +
+                                  std::to_string(bytes) + ")");
+    finish();
+  } else if (o.min_psnr > 0) {
+    if (o.schedule_views <= 0) throw std::invalid_argument("a PSNR target needs the rate schedule's measure");
+    // The coarsest quality whose finest picture reaches the target: the
+    // ladder bisected (finer qualities never measured worse on the test models).
+    size_t lo = 0, hi = ladder.size();  // [lo, hi): candidates; ladder[lo] finest
+    colour(ladder[0]);
+    const double finest = finish();
+    if (finest < o.min_psnr)
+    {
+      char msg[160];
+      std::snprintf(msg, sizeof msg, "no quality reaches %.2f dB (at quality 1/8: %.2f dB)", o.min_psnr, finest);
+      throw std::invalid_argument(msg);
+    }
+    size_t good = 0;
+    while (hi - lo > 1) {
+      const size_t mid = (lo + hi) / 2;
+      colour(ladder[mid]);
+      if (finish() >= o.min_psnr) {
+        good = mid;
+        lo = mid;
+      } else {
+        hi = mid;
+      }
+    }
+    colour(ladder[good]);
+    finish();
+  } else {
+    colour(o.quality);
+    finish();
   }
   return r;
 }

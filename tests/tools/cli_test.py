@@ -140,6 +140,12 @@ code, out, err = run("encode-model", obj, "-o", textured + ".x", "--bytes", "50"
 check(code == 1 and "no quality fits 50 bytes" in err and not os.path.exists(textured + ".x"),
       "encode-model: a byte budget no quality meets is refused, nothing written")
 
+code, out, err = run("encode-model", obj, "-o", textured + ".x", "--bytes", "5000", "--psnr", "30")
+check(code == 2 and not os.path.exists(textured + ".x"), "encode-model: --bytes with --psnr is a usage error")
+code, out, err = run("encode-model", obj, "-o", textured + ".x", "--psnr", "30")
+check(code == 1 and "no quality reaches" in err and not os.path.exists(textured + ".x"),
+      "encode-model: a PSNR no quality reaches is refused, nothing written")
+
 # vds play and encode-walk: options checked before anything runs.
 code, out, err = run("play", stream, "--board", "fpga")
 check(code == 2 and "--board" in err, "vds play refuses a board it does not have")

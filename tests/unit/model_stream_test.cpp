@@ -5,7 +5,9 @@
 // exactly the levels it measured as no better than a coarser one.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
+#include <stdexcept>
 
 #include "vds/enc/frames.h"
 #include "vds/enc/model_stream.h"
@@ -45,6 +47,28 @@ TEST(ModelStream, TheDuckArrivesInItsColoursAndEndsSharp) {
   // The stream plays on the client's own player to the same end.
   const std::vector<uint32_t> crcs = client_frame_crcs(r.stream);
   EXPECT_EQ(crcs.size(), tl.size());
+}
+
+// --psnr: the coarsest quality whose finest picture reaches the target.
+TEST(ModelStream, APsnrTargetIsReachedWithTheFewestBytesOfTheLadder) {
+  ASSERT_TRUE(std::ifstream(kDuck).good()) << kDuck << " not installed: scripts/fetch-data.sh installs assimp-testmodels";
+  const TexturedModel duck = load_textured_model(kDuck);
+  ModelStreamOptions o;
+  o.min_psnr = 37;
+  const ModelStreamResult r = encode_model_stream(duck, o);
+  double best = 0;
+  for (double p : r.level_psnr) best = std::max(best, p);
+  EXPECT_GE(best, 37.0);
+  // One ladder step coarser misses it (measured: quality 5.66 reaches 37.2 dB, 8 does not).
+  ModelStreamOptions coarser;
+  coarser.quality = r.quality * std::sqrt(2.0);
+  const ModelStreamResult c = encode_model_stream(duck, coarser);
+  double cbest = 0;
+  for (double p : c.level_psnr) cbest = std::max(cbest, p);
+  EXPECT_LT(cbest, 37.0);
+  EXPECT_LT(c.stream.size(), r.stream.size());
+  o.min_psnr = 60;
+  EXPECT_THROW(encode_model_stream(duck, o), std::invalid_argument);
 }
 
 }  // namespace

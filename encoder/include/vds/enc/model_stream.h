@@ -39,6 +39,9 @@ struct ModelStreamOptions {
   // > 0: the finest quality (of a ladder from 1/8 to 64) whose whole stream
   // takes at most this many bytes; the quality above is then ignored.
   size_t max_bytes = 0;
+  // > 0 (and no max_bytes): the coarsest quality of that ladder whose
+  // finest picture, as the rate schedule measures it, reaches this PSNR.
+  double min_psnr = 0;
   // Vertex colours with their vertices (MCVX after the base and each split
   // level), so the coarse mesh is drawn in colour.
   bool vertex_colours = true;
