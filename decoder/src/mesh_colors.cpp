@@ -425,7 +425,7 @@ Status MeshColors::init(Arena& arena, const uint16_t* tri, uint32_t faces, uint3
   return Status::ok;
 }
 
-Status MeshColors::read_header(const uint8_t* data, size_t size) {
+Status MeshColors::read_header(const uint8_t* data, size_t size, const Planes* vertex_colours) {
   header_ = false;
   layout_m_ = -1;
   if (face_res_ == nullptr) return Status::invalid_argument;
@@ -438,11 +438,19 @@ Status MeshColors::read_header(const uint8_t* data, size_t size) {
   const uint32_t vertices = static_cast<uint32_t>(data[6] | (data[7] << 8));
   const uint32_t faces = static_cast<uint32_t>(data[8]) | (static_cast<uint32_t>(data[9]) << 8) |
                          (static_cast<uint32_t>(data[10]) << 16) | (static_cast<uint32_t>(data[11]) << 24);
-  if (max_res > kMaxResLog2 || data[3] != 0 || q8 == 0 || vertices != topo_.vertices || faces != topo_.faces)
+  if (max_res > kMaxResLog2 || (data[3] & ~kFlagVertexColours) != 0 || q8 == 0 || vertices != topo_.vertices ||
+      faces != topo_.faces)
     return Status::malformed;
   const bool paper = data[1] == kModePaper;
+  // The vertex samples: the colours that came with the vertices, or in here.
+  const bool outside = (data[3] & kFlagVertexColours) != 0;
+  if (outside) {
+    if (vertex_colours == nullptr) return Status::malformed;  // no colours came with the vertices
+    for (uint32_t v = 0; v < vertices; ++v)
+      for (int c = 0; c < 3; ++c) vertex_ycc_[3 * v + c] = vertex_colours->plane(c)[v];
+  }
   // The paper mode carries the vertex samples raw, before the coded part.
-  const size_t vbytes = paper ? 3 * static_cast<size_t>(vertices) : 0;
+  const size_t vbytes = paper && !outside ? 3 * static_cast<size_t>(vertices) : 0;
   if (size - kHeaderFixedBytes < vbytes) return Status::truncated;
   for (size_t i = 0; i < vbytes; ++i) vertex_ycc_[i] = data[kHeaderFixedBytes + i];
   ArithDecoder dec;
@@ -458,7 +466,7 @@ Status MeshColors::read_header(const uint8_t* data, size_t size) {
     prev = static_cast<int>(r);
     if (prev > top) top = prev;
   }
-  if (!paper) {
+  if (!paper && !outside) {
     // The vds mode codes each vertex sample as its difference from the
     // prediction of the vertices before it (vertex_prediction).
     const size_t mark = arena_->mark();

@@ -385,11 +385,13 @@ MccEncoded encode_mesh_colors(const MeshColorsModel& model, double quality, cons
   const uint32_t V = static_cast<uint32_t>(model.positions.size());
   MccEncoded out;
   std::vector<uint8_t>& h = out.header;
-  h = {mc::kVersion, mode, static_cast<uint8_t>(model.max_res), 0, static_cast<uint8_t>(q8 & 0xFF),
+  const bool outside = o.vertex_colours_outside;
+  h = {mc::kVersion, mode, static_cast<uint8_t>(model.max_res), outside ? mc::kFlagVertexColours : uint8_t{0},
+       static_cast<uint8_t>(q8 & 0xFF),
        static_cast<uint8_t>(q8 >> 8), static_cast<uint8_t>(V & 0xFF), static_cast<uint8_t>(V >> 8),
        static_cast<uint8_t>(F & 0xFF), static_cast<uint8_t>((F >> 8) & 0xFF), static_cast<uint8_t>((F >> 16) & 0xFF),
        static_cast<uint8_t>(F >> 24)};
-  if (o.paper) h.insert(h.end(), model.vertex_ycc.begin(), model.vertex_ycc.end());
+  if (o.paper && !outside) h.insert(h.end(), model.vertex_ycc.begin(), model.vertex_ycc.end());
   ArithEncoder enc;
   ArithContext ctx[mc::kMaxResLog2 + 1][mc::kMaxResLog2];
   arith_init_contexts(&ctx[0][0], (mc::kMaxResLog2 + 1) * mc::kMaxResLog2);
@@ -399,7 +401,7 @@ MccEncoded encode_mesh_colors(const MeshColorsModel& model, double quality, cons
       enc.encode_unary(ctx[prev], mc::kMaxResLog2, model.face_res[f], static_cast<uint32_t>(model.max_res));
       prev = model.face_res[f];
     }
-  if (!o.paper) {
+  if (!o.paper && !outside) {
     const mc::Topology& topo = l.mc.topology();
     std::vector<uint8_t> scratch(mc::adjacency_bytes(topo.vertices, topo.edges));
     Arena arena(scratch.data(), scratch.size());
@@ -426,7 +428,15 @@ MccEncoded encode_mesh_colors(const MeshColorsModel& model, double quality, cons
 std::array<std::vector<uint8_t>, 3> decode_mesh_colors_level(const MeshColorsModel& model, const MccEncoded& enc, int m) {
   Layout l;
   set_up(model, 256, mc::kModePaper, l);
-  Status s = l.mc.read_header(enc.header.data(), enc.header.size());
+  // The vertex colours a client has when they came with the vertices.
+  const size_t V = model.positions.size();
+  std::array<std::vector<uint8_t>, 3> vc;
+  for (int c = 0; c < 3; ++c) {
+    vc[c].resize(V);
+    for (size_t v = 0; v < V; ++v) vc[c][v] = model.vertex_ycc[3 * v + c];
+  }
+  const mc::Planes vertex_colours{vc[0].data(), vc[1].data(), vc[2].data()};
+  Status s = l.mc.read_header(enc.header.data(), enc.header.size(), &vertex_colours);
   if (s != Status::ok) throw std::runtime_error(std::string("mesh colors header refused: ") + status_name(s));
   const uint32_t total = l.mc.layout_level(m);
   std::array<std::vector<uint8_t>, 3> planes{std::vector<uint8_t>(total), std::vector<uint8_t>(total),

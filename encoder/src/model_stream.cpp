@@ -135,12 +135,14 @@ std::map<size_t, std::vector<uint8_t>> vertex_colour_chunks(std::span<const uint
     if (is_error(st)) throw std::logic_error("model stream: the client refused the geometry");
     const MeshState& m = p.mesh.mesh();
     const uint32_t nv = m.vertex_count();
-    // The base, and each split level, once complete (the tail numbers the vertices anew).
+    // The base, and each split level, once complete; the single-rate tail
+    // numbers the vertices anew, so after it every vertex again.
     const bool done = (!base && p.mesh.drawable()) || (base && p.mesh.levels_done() != levels);
     base = p.mesh.drawable();
     levels = p.mesh.levels_done();
-    if (!done || nv == coloured) continue;
-    if (p.mesh.header().tail() && p.mesh.levels_done() == p.mesh.header().levels) break;
+    if (!done) continue;
+    if (p.mesh.header().tail() && p.mesh.levels_done() == p.mesh.header().levels) coloured = 0;
+    if (nv == coloured) continue;
     if (nv > grid.size()) throw std::logic_error("model stream: a level has more vertices than the mesh");
     ArithEncoder enc;
     mc::VertexContexts vx;
@@ -256,6 +258,7 @@ Colours colours_at(const TexturedModel& dm, const ModelStreamOptions& o, double 
   Colours c{quality, to_mesh_colors(dm, co), {}};
   MccOptions mo = o.codec;
   mo.max_chunk = max_chunk;
+  mo.vertex_colours_outside = o.vertex_colours;  // every vertex's colour came with it (MCVX)
   c.coded = encode_mesh_colors(c.mc, quality, mo);
   return c;
 }

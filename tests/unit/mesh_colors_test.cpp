@@ -417,6 +417,34 @@ TEST_P(MeshColorsModes, LevelsInChunksDecodeAlikeAndOnlyInOrder) {
   EXPECT_EQ(h.mc.decoding_level(), 1);
 }
 
+// kFlagVertexColours: the vertex samples are not in MCLH but the colours
+// that came with the vertices; a header that says so is refused without them.
+TEST_P(MeshColorsModes, VertexSamplesFromTheVertexColours) {
+  const enc::MeshColorsModel m = test_colors();
+  enc::MccOptions o;
+  o.paper = GetParam();
+  const enc::MccEncoded inside = enc::encode_mesh_colors(m, 1, o);
+  o.vertex_colours_outside = true;
+  const enc::MccEncoded outside = enc::encode_mesh_colors(m, 1, o);
+  EXPECT_EQ(outside.header[3], mc::kFlagVertexColours);
+  EXPECT_LT(outside.header.size(), inside.header.size());
+  const size_t V = m.positions.size();
+  std::array<std::vector<uint8_t>, 3> vc;
+  for (int c = 0; c < 3; ++c)
+    for (size_t v = 0; v < V; ++v) vc[c].push_back(m.vertex_ycc[3 * v + c]);
+  const mc::Planes planes{vc[0].data(), vc[1].data(), vc[2].data()};
+  Held h;
+  ASSERT_EQ(h.init(m.triangles, static_cast<uint32_t>(V)), Status::ok);
+  EXPECT_EQ(h.mc.read_header(outside.header.data(), outside.header.size()), Status::malformed);
+  ASSERT_EQ(h.mc.read_header(outside.header.data(), outside.header.size(), &planes), Status::ok);
+  for (size_t i = 0; i < 3 * V; ++i) ASSERT_EQ(h.mc.vertex_samples()[i], m.vertex_ycc[i]);
+  // The same samples at every level as with the vertex samples inside.
+  for (int level = 0; level < m.max_res; ++level)
+    EXPECT_EQ(enc::decode_mesh_colors_level(m, outside, level), enc::decode_mesh_colors_level(m, inside, level)) << level;
+  for (size_t n = 0; n < outside.header.size(); ++n)
+    EXPECT_TRUE(is_error(h.mc.read_header(outside.header.data(), n, &planes))) << "prefix " << n;
+}
+
 INSTANTIATE_TEST_SUITE_P(PaperAndVds, MeshColorsModes, ::testing::Values(true, false),
                          [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "paper" : "vds"; });
 

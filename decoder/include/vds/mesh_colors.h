@@ -209,17 +209,20 @@ constexpr uint32_t kNzCutoff = 6;
 constexpr int kNzOrder = 1;
 
 // --- The header chunk (MCLH) ------------------------------------------------
-//   u8 version (1), u8 mode (0 = paper, 1 = vds), u8 max_res_log2 (0..10), u8 flags (0),
+//   u8 version (1), u8 mode (0 = paper, 1 = vds), u8 max_res_log2 (0..10), u8 flags (kFlagVertexColours or 0),
 //   u16 quality factor x 256 (>= 1), u16 vertices, u32 faces,
-//   paper mode: vertices x 3 bytes, every vertex's Y', Cb, Cr;
+//   paper mode, unless kFlagVertexColours: vertices x 3 bytes, every vertex's Y', Cb, Cr;
 //   arithmetic coded: the faces' resolution exponents, face f's as a
 //   truncated unary code (max max_res_log2) in the contexts of face f - 1's;
-//   vds mode: then every vertex's Y', Cb, Cr as signed differences from
-//   vertex_prediction (vertices in order).
+//   vds mode, unless kFlagVertexColours: then every vertex's Y', Cb, Cr as
+//   signed differences from vertex_prediction (vertices in order).
 constexpr uint32_t kChunkVertices = fourcc('M', 'C', 'V', 'X');  // after the base and each split level
 constexpr uint32_t kChunkHeader = fourcc('M', 'C', 'L', 'H');  // after the mesh's last level
 constexpr uint32_t kChunkLevel = fourcc('M', 'C', 'L', 'V');   // one MIP level, coarsest first
 constexpr uint8_t kVersion = 1;
+// MCLH flags: the vertex samples are the colours that came with the
+// vertices (MCVX, the last one after the single-rate tail), not in MCLH.
+constexpr uint8_t kFlagVertexColours = 1;
 constexpr uint8_t kModePaper = 0;
 constexpr uint8_t kModeVds = 1;
 constexpr size_t kHeaderFixedBytes = 12;
@@ -228,7 +231,8 @@ constexpr size_t kHeaderFixedBytes = 12;
 // After the base mesh and after each split level, the colours of the
 // vertices it added, so that a coarse mesh is drawn in its colours before
 // the faces' samples arrive (its vertices are the final mesh's, at their
-// final positions):
+// final positions); after the single-rate tail, which numbers the vertices
+// anew, the colours of every vertex again (first 0):
 //   u32 first vertex (the vertices coloured so far), u32 count (those the
 //   mesh has beyond them), then arithmetic coded, vertices in order, Y', Cb,
 //   Cr each as a signed difference from fan_prediction (VertexContexts).
@@ -269,8 +273,10 @@ class MeshColors {
   static size_t init_bytes(uint32_t faces, uint32_t vertices);
 
   // The MCLH payload. malformed for a version, mode, count or value this
-  // mesh or this decoder cannot take (unsupported_version for a newer version).
-  Status read_header(const uint8_t* data, size_t size);
+  // mesh or this decoder cannot take (unsupported_version for a newer
+  // version). With kFlagVertexColours set the vertex samples are
+  // `vertex_colours` (the planes the MCVX chunks filled; malformed without).
+  Status read_header(const uint8_t* data, size_t size, const Planes* vertex_colours = nullptr);
   // What read_header sets, from the encoder's side: every face's resolution
   // exponent (0..kMaxResLog2), the vertex samples (3 per vertex; null
   // leaves them) and the quality factor. invalid_argument for a value out

@@ -12,6 +12,7 @@
 // the one shown. The planes are carved at MCLH for the finest level the
 // workspace holds; finer levels are skipped, so a small client shows the
 // colour it can rather than none.
+#include "vds/bytes.h"
 #include "vds/mesh_colors.h"
 #include "vds/player.h"
 
@@ -134,7 +135,10 @@ ChunkResult start_colors(Player& p, const uint8_t* payload, uint32_t size) {
     *c = ModelColors{};
     s = c->mc.init(a, m.triangles16(), m.triangle_count(), m.vertex_count());
   }
-  if (s == Status::ok) s = c->mc.read_header(payload, size);
+  // The vertex samples may be the colours that came with the vertices.
+  const VertexColours* vc = p.vertex_colours;
+  const bool whole = vc != nullptr && vc->valid && vc->coloured == m.vertex_count();
+  if (s == Status::ok) s = c->mc.read_header(payload, size, whole ? &vc->planes : nullptr);
   if (s != Status::ok && s != Status::workspace_too_small) {
     p.fail(s, "the mesh colors header was refused");
     return ChunkResult::abort;
@@ -233,7 +237,12 @@ ChunkResult vertex_colours(Player& p, const uint8_t* payload, uint32_t size, boo
     c->surface.ctx = c;
     p.vertex_colours = c;
   }
-  if (!c->valid) return ChunkResult::consumed;  // keyed to vertices the tail renumbered
+  if (!c->valid) {
+    // After the single-rate tail: every vertex's colour again, from the first.
+    if (size < mc::kVertexChunkHeadBytes || load_le32(payload) != 0) return ChunkResult::consumed;
+    c->valid = true;
+    c->coloured = 0;
+  }
   if (m.vertex_count() > c->capacity) {
     p.fail(Status::malformed, "vertex colours beyond the mesh's capacity");
     return ChunkResult::abort;

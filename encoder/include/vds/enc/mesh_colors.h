@@ -124,6 +124,9 @@ struct MccOptions {
   double deadzone = 0.35;
   // The largest MCLV payload (a client's chunk buffer); 0: a level in one chunk.
   size_t max_chunk = 0;
+  // The vertex samples travel with the vertices (MCVX), not in MCLH
+  // (vds::mc::kFlagVertexColours).
+  bool vertex_colours_outside = false;
 };
 
 // Every level of `mc` at quality factor `quality` (the JPEG tables'
