@@ -31,7 +31,7 @@ for entry in $MODELS; do
   dir="$WORK/$name"
   rm -rf "$dir"; mkdir -p "$dir"
   echo "run_model_client: $name: encode, then both boards"
-  "$VDS" encode-model "$model" -o "$dir/model.vds" ${args//=/ } > "$dir/encode.txt"
+  "$VDS" encode-model "$model" -o "$dir/model.vds" --orbit 0 ${args//=/ } > "$dir/encode.txt"
   "$VDS" play "$dir/model.vds" --board qemu --firmware "$ELF" --out "$dir/qemu" > "$dir/qemu.txt" 2>&1
   "$VDS" play "$dir/model.vds" --board host --firmware "$HOSTFW" --out "$dir/host" > "$dir/host.txt" 2>&1
 done

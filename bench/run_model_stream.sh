@@ -80,7 +80,7 @@ for entry in $MODELS; do
     echo "run_model_stream: $name: vds encode-model --quality $q, as it arrives"
     extra=()
     if [ "$q" = "$mid" ]; then extra=(--anchors "$dir/anchors.csv" --timeline-images "$dir/img"); fi
-    "$VDS" encode-model "$model" -o "$dir/q$q.vds" --up $up --quality $q --timeline "$dir/q$q.csv" --views "$VIEWS" \
+    "$VDS" encode-model "$model" -o "$dir/q$q.vds" --up $up --quality $q --orbit 0 --timeline "$dir/q$q.csv" --views "$VIEWS" \
       "${extra[@]}" > "$dir/q$q.txt"
   done
   rm -rf "$dir/frames"

@@ -34,6 +34,7 @@ struct EncodeModelOptions {
   int views = 8;
   std::string anchors;
   double tail = -1;
+  uint32_t orbit = 64;
   std::string dump_obj;
   std::string timeline_images;
   double samples_per_pixel = enc::ModelStreamOptions{}.samples_per_pixel;
@@ -91,6 +92,7 @@ void run_encode_model(const EncodeModelOptions& o) {
   e.mesh.max_chunk_payload = o.max_chunk;
   if (o.tail >= 0) e.mesh.tail_fraction = o.tail;
   e.samples_per_pixel = o.samples_per_pixel;
+  e.orbit_frames = o.orbit;
   if (!enc::mesh_up_from_name(o.up, &e.mesh.up))
     throw Failure(kExitUsage, "--up must be +y, +z, +x, -y, -z or -x (or y, z, x), not '" + o.up + "'");
   e.colors.max_res_log2 = o.max_res;
@@ -172,6 +174,9 @@ void add_encode_model(CLI::App& app) {
                   "near as the client's model view sees it (0: no cap)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 64.0));
+  sub->add_option("--orbit", o->orbit, "At the end, a turn of the finished model in this many frames (0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0u, 4096u));
   sub->add_flag("--paper", o->paper, "Code the colours as the thesis does (for comparison)");
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes (the client's chunk buffer)")
       ->capture_default_str()

@@ -15,6 +15,7 @@
 #include "vds/enc/arith_encoder.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/mesh_colors.h"
+#include "vds/model_view.h"
 #include "vds/player.h"
 
 namespace vds::enc {
@@ -203,6 +204,12 @@ void assemble(ModelStreamResult& r, const std::map<size_t, std::vector<uint8_t>>
     }
     r.parts.level_end[m] = w.size();
   }
+  // The orbit script: a turn in orbit_frames frames, from angle 0.
+  for (uint32_t i = 0; i < r.orbit_frames; ++i) {
+    const uint32_t angle = static_cast<uint32_t>((uint64_t{i} * 65536) / r.orbit_frames);
+    const uint8_t a[2] = {static_cast<uint8_t>(angle & 0xFF), static_cast<uint8_t>(angle >> 8)};
+    w.add_chunk(kModelOrbitChunk, a);
+  }
   r.stream = w.finish();
   r.parts.geometry = r.stream.size() - r.parts.colors_header - r.parts.vertex_colours;
   for (size_t b : r.parts.level_bytes) r.parts.geometry -= b;
@@ -285,6 +292,8 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
   const std::vector<uint32_t> tri = client_triangles(r.mesh.stream, &vertices, &grid);
   if (vertices != r.mesh.vertex_order.size()) throw std::logic_error("model stream: the client's vertex count differs");
   r.decoded = in_client_order(model, repaired, r.mesh.vertex_order, tri);
+  if (o.orbit_frames > kModelOrbitMaxFrames) throw std::invalid_argument("an orbit of more than 4096 frames");
+  r.orbit_frames = o.orbit_frames;
   ModelStreamOptions oc = o;
   if (o.samples_per_pixel > 0)
     oc.colors.face_max_res = display_caps(r.decoded, r.mesh.quantisation, grid, r.mesh.stream_header, o.samples_per_pixel);

@@ -253,10 +253,12 @@ std::vector<TimelinePoint> model_timeline(const TexturedModel& model, const Mode
   while (at < s.size()) {
     const size_t end = at == 0 ? kPreambleBytes : at + kChunkHeadBytes + load_le32(s.data() + at + 4) + kChunkTailBytes;
     const uint32_t before = frames;
+    const size_t at_start = at;
     const Status st = player->feed(s.data() + at, end - at);
     if (is_error(st)) throw std::logic_error(std::string("model timeline: the client refused the stream: ") + status_name(st));
     at = end;
     if (frames == before) continue;
+    if (at_start != 0 && load_le32(s.data() + at_start) == kModelOrbitChunk) continue;  // the same model, turning
     if (o.colours_only && player->model_colors_level() < 0) continue;
     if (o.colours_only && player->model_colors_level() == Player::kModelVertexColours) continue;
     const MeshState& mesh = player->mesh.mesh();

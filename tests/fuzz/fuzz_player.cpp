@@ -47,14 +47,15 @@ std::vector<uint8_t> container(vds::StreamMode mode, const uint8_t* data, size_t
   vds::enc::StreamWriter w(h);
   const uint32_t images[] = {vds::chunk::kImageHeader, vds::chunk::kImageData, vds::chunk::kJpeg};
   const uint32_t meshes[] = {vds::chunk::kMeshHeader, vds::chunk::kMeshBase, vds::chunk::kMeshLevel,
-                             vds::chunk::kMeshTail, vds::mc::kChunkHeader, vds::mc::kChunkLevel};
+                             vds::chunk::kMeshTail, vds::mc::kChunkHeader, vds::mc::kChunkLevel,
+                             vds::mc::kChunkVertices, vds::kModelOrbitChunk};
   size_t at = 0;
   while (at + 2 <= size) {
     const uint8_t pick = data[at];
     const size_t len = data[at + 1] * 8u % 600;
     at += 2;
     const size_t n = len < size - at ? len : size - at;
-    const uint32_t type = mode == vds::StreamMode::images ? images[pick % 3] : meshes[pick % 6];
+    const uint32_t type = mode == vds::StreamMode::images ? images[pick % 3] : meshes[pick % 8];
     w.add_chunk(type, std::vector<uint8_t>(data + at, data + at + n));
     at += n;
   }
@@ -150,6 +151,7 @@ const std::vector<uint8_t>& valid_model() {
     vds::enc::ModelStreamOptions o;
     o.colors.max_res_log2 = 4;
     o.mesh.max_chunk_payload = 512;
+    o.orbit_frames = 3;
     return vds::enc::encode_model_stream(m, o).stream;
   }();
   return s;

@@ -248,6 +248,16 @@ TEST(Player, ATexturedModelShowsEveryColourLevelItsWorkspaceHolds) {
     EXPECT_EQ(seen.crcs, want) << piece;
     EXPECT_TRUE(seen.notices.empty());
   }
+  // An orbit script: that many more frames of the finished model, turning.
+  {
+    vds::enc::ModelStreamOptions oo = o;
+    oo.orbit_frames = 5;
+    const vds::enc::ModelStreamResult ro = vds::enc::encode_model_stream(vds::enc::load_textured_model(box), oo);
+    const std::vector<uint32_t> turned = vds::enc::client_frame_crcs(ro.stream);
+    ASSERT_EQ(turned.size(), want.size() + 5);
+    EXPECT_EQ(std::vector<uint32_t>(turned.begin(), turned.begin() + static_cast<std::ptrdiff_t>(want.size())), want);
+    EXPECT_NE(turned[want.size()], turned[want.size() + 1]) << "each frame a further step round";
+  }
   // Smaller workspaces: fewer colour levels, then none.
   bool coarser = false, none = false;
   size_t lo = 1024, hi = 1u << 20;  // the least workspace that plays the mesh

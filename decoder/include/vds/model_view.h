@@ -17,6 +17,7 @@
 #include <cstdint>
 
 #include "vds/arena.h"
+#include "vds/container.h"
 #include "vds/mesh.h"
 #include "vds/render.h"
 #include "vds/status.h"
@@ -114,6 +115,13 @@ Status start_model(Arena& arena, const uint8_t* mshh, uint32_t size, const Model
 // after every level completed since the previous frame, with the camera a
 // further kModelOrbitStep round the model each frame.
 constexpr uint16_t kModelOrbitStep = 65536 / 64;  // 1/64 turn
+
+// A model stream's orbit script: MORB chunks anywhere after the base mesh,
+// each a u16 angle (2^-16 turn round the up axis): one frame of the model
+// as the client holds it, seen from there. (One frame a chunk, as every
+// model chunk: a client's back-pressure counts on it.)
+constexpr uint32_t kModelOrbitChunk = fourcc('M', 'O', 'R', 'B');
+constexpr uint32_t kModelOrbitMaxFrames = 4096;  // what vds encode-model --orbit writes at most
 
 struct ModelFrames {
   uint32_t drawn = 0;   // frames drawn so far

@@ -102,13 +102,15 @@ bool start_mesh(Player& p, const uint8_t* mshh, uint32_t size) {
   return true;
 }
 
-// Draws the current mesh (with its colours once they are in) as the next frame.
-ChunkResult draw_frame(Player& p) {
+// Draws the current mesh (with its colours once they are in) as the next
+// frame, from `angle` (2^-16 turn), or the orbit's next one when negative.
+ChunkResult draw_frame(Player& p, int32_t angle = -1) {
   if (!p.begin_frame()) return ChunkResult::abort;
   const uint64_t display_before = p.display_total();
   const uint64_t d0 = p.work_clock();
   const MeshColorsSurface* surface = p.model_colors();
-  const Status d = p.view.draw(p.mesh.mesh(), p.model_frames.angle(), detail::render_band_to_player, &p, surface);
+  const uint16_t at = angle >= 0 ? static_cast<uint16_t>(angle) : p.model_frames.angle();
+  const Status d = p.view.draw(p.mesh.mesh(), at, detail::render_band_to_player, &p, surface);
   p.model_frames.mark_drawn(p.mesh);
   // Drawing counts as display: the bands have added their part, add the renderer's.
   p.add_display((p.work_clock() - d0) - (p.display_total() - display_before));
@@ -284,7 +286,24 @@ ChunkResult on_colors_chunk(Player& p, uint32_t type, const uint8_t* payload, ui
   return r;
 }
 
+// MORB: one frame of the model as it is held, from the script's angle.
+ChunkResult orbit(Player& p, const uint8_t* payload, uint32_t size) {
+  if (!p.model_started || !p.mesh.drawable()) {
+    p.fail(Status::malformed, "an orbit before the base mesh");
+    return ChunkResult::abort;
+  }
+  if (size != 2) {
+    p.fail(Status::malformed, "an orbit chunk is one u16 angle");
+    return ChunkResult::abort;
+  }
+  (void)p.enter_chunk();
+  const ChunkResult r = draw_frame(p, static_cast<int32_t>(load_le16(payload)));
+  p.leave_chunk();
+  return r;
+}
+
 ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size) {
+  if (type == kModelOrbitChunk) return orbit(p, payload, size);
   if (type == mc::kChunkHeader || type == mc::kChunkLevel || type == mc::kChunkVertices)
     return on_colors_chunk(p, type, payload, size);
   if (!MeshDecoder::handles(type)) return ChunkResult::unknown;

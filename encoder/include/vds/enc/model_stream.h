@@ -56,6 +56,9 @@ struct ModelStreamOptions {
   // the client shows it from this many orbit angles, it is better than the
   // best coarser one (0: every level is sent).
   int schedule_views = 4;
+  // The orbit script at the end (MORB chunks): a turn of the finished model
+  // in this many frames (0: none).
+  uint32_t orbit_frames = 0;
 };
 
 // Where the stream's bytes go (chunk framing included).
@@ -81,6 +84,7 @@ struct ModelStreamResult {
   MccEncoded coded;           // and coded
   std::vector<bool> sent;     // per level: in the stream (the rate schedule)
   std::vector<double> level_psnr;  // per level (max_res: vertex samples) as the schedule measured it
+  uint32_t orbit_frames = 0;       // MORB's
   ModelStreamParts parts;
 };
 
