@@ -222,6 +222,13 @@ write(os.path.join("textured", "huge.png"), png(65535, 65535, b"\0" * 1000))
 write(os.path.join("textured", "huge.mtl"), "newmtl t\nmap_Kd huge.png\n")
 huge_obj = write(os.path.join("textured", "huge.obj"), tex_obj.replace("m.mtl", "huge.mtl"))
 run("textured_obj_texture_claims_65535", ["mesh-colors", huge_obj], huge_obj, 1, "declares a 65535x65535 image")
+# The same files through the model stream's encoder (vds encode-model).
+model_out = os.path.join(TMP, "model_out.vds")
+run("encode_model_textured_obj_valid", ["encode-model", ok_obj, "-o", model_out], ok_obj, 0, output=model_out)
+run("encode_model_iqm_claims_1e9_vertices", ["encode-model", os.path.join(TMP, "huge.iqm"), "-o", model_out],
+    os.path.join(TMP, "huge.iqm"), 1, "do not fit the file")
+run("encode_model_texture_claims_65535", ["encode-model", huge_obj, "-o", model_out], huge_obj, 1,
+    "declares a 65535x65535 image")
 
 
 img_out = os.path.join(TMP, "out_img.vds")
