@@ -338,17 +338,37 @@ struct LatticeLinearSampler : LatticeSampler {
     }
     uint32_t k0, k1, k2;
     int32_t w0, w1, w2;
-    if (fu + fv <= kOne) {  // the cell (i0, j0), (i0 + 1, j0), (i0, j0 + 1)
+    const bool lower = fu + fv <= kOne;
+    if (i0 >= 1 && j0 >= 1 && i0 + j0 + 2 < R) {
+      // Every point of the cell is the face's own: rows j0 and j0 + 1 of
+      // its samples (row j holds i = 1 .. R - 1 - j, lattice_index's layout).
+      const int32_t r = j0 - 1;
+      const uint32_t row = t.face.face_base + static_cast<uint32_t>(r * (R - 1) - ((r * (r + 1)) >> 1) - 1);
+      const uint32_t next = row + static_cast<uint32_t>(R - 1 - j0);
+      const uint32_t a = row + static_cast<uint32_t>(i0), b = next + static_cast<uint32_t>(i0);
+      if (lower) {  // (i0, j0), (i0 + 1, j0), (i0, j0 + 1)
+        k0 = a;
+        k1 = a + 1;
+        k2 = b;
+      } else {  // (i0 + 1, j0 + 1), (i0, j0 + 1), (i0 + 1, j0)
+        k0 = b + 1;
+        k1 = b;
+        k2 = a + 1;
+      }
+    } else if (lower) {
       k0 = lattice_index(t.face, R, i0, j0);
       k1 = lattice_index(t.face, R, i0 + 1, j0);
       k2 = lattice_index(t.face, R, i0, j0 + 1);
-      w0 = kOne - fu - fv;
-      w1 = fu;
-      w2 = fv;
-    } else {  // the cell (i0 + 1, j0 + 1), (i0, j0 + 1), (i0 + 1, j0)
+    } else {
       k0 = lattice_index(t.face, R, i0 + 1, j0 + 1);
       k1 = lattice_index(t.face, R, i0, j0 + 1);
       k2 = lattice_index(t.face, R, i0 + 1, j0);
+    }
+    if (lower) {
+      w0 = kOne - fu - fv;
+      w1 = fu;
+      w2 = fv;
+    } else {
       w0 = fu + fv - kOne;
       w1 = kOne - fu;
       w2 = kOne - fv;

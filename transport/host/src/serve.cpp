@@ -230,6 +230,8 @@ ServeReport serve(Server& srv, const ServeOptions& o, const std::function<void(c
     const uint32_t t0 = monotonic_ms();
     uint32_t acked_at = 0;
     uint32_t owed_at = 0;  // last time the client's stats showed frame records still to come
+    uint32_t record_at = 0;  // last time a frame record arrived
+    size_t records_seen = 0;
     std::optional<uint32_t> receipt_at, goodbye_at;  // when the report had arrived, when the Goodbye went
     constexpr uint32_t kRecordWaitMs = 5000;   // frame records missing after this are reported missing
     constexpr uint32_t kGoodbyeWaitMs = 10000;  // a client that does not acknowledge the Goodbye by then has gone (a loaded machine may hold an emulated client back for seconds)
@@ -273,10 +275,17 @@ ServeReport serve(Server& srv, const ServeOptions& o, const std::function<void(c
       // All acknowledged: wait briefly for the report (a client may not send
       // one), counted from when the client stopped owing frame records: one
       // whose stats show more frames than have arrived is still sending, and
-      // its report follows its records.
+      // its report follows its records; so is one whose records still
+      // arrive (frames drawn from bytes it already holds, e.g. a model's
+      // orbit).
       const bool records_owed = srv.have_stats && srv.stats.frames_shown > srv.frames.size();
       if (records_owed) owed_at = now;
-      const uint32_t quiet_from = owed_at > acked_at ? owed_at : acked_at;
+      if (srv.frames.size() != records_seen) {
+        records_seen = srv.frames.size();
+        record_at = now;
+      }
+      uint32_t quiet_from = owed_at > acked_at ? owed_at : acked_at;
+      if (record_at > quiet_from) quiet_from = record_at;
       if (!srv.receipt && acked_at != 0 && !records_owed && now - quiet_from > 2000) break;
       if (o.timeout_s != 0 && now - t0 > o.timeout_s * 1000u)
         throw std::runtime_error(std::string(host.established() ? "the transfer did not finish" : "no client answered") +
