@@ -121,8 +121,9 @@ void run_encode_model(const EncodeModelOptions& o) {
   const uint32_t faces = static_cast<uint32_t>(r.colors.face_res.size());
   std::printf("%s: %zu bytes: %u vertices, %u faces, quality %.3g, %s codec\n", o.output.c_str(), r.stream.size(),
               static_cast<unsigned>(r.decoded.positions.size()), faces, r.quality, o.paper ? "paper" : "vds");
-  std::printf("  geometry %zu bytes (%zu levels), colour header %zu bytes (vertex samples, face resolutions)\n",
-              r.parts.geometry, r.mesh.levels.size(), r.parts.colors_header);
+  std::printf("  geometry %zu bytes (%zu levels), vertex colours with them %zu bytes (%zu chunks), colour header %zu bytes\n",
+              r.parts.geometry, r.mesh.levels.size(), r.parts.vertex_colours, r.parts.vertex_chunks,
+              r.parts.colors_header);
   for (size_t m = r.parts.level_bytes.size(); m-- > 0;) {
     const double psnr = m < r.level_psnr.size() ? r.level_psnr[m] : 0;
     if (r.sent[m])
