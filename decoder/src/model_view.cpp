@@ -14,7 +14,6 @@ constexpr uint32_t kMaxPositions = 65535;
 // Faces summed into a vertex normal (a bound on the walk, far above any
 // real fan; 2^10 - 1 keeps the sum of 2^21-bounded terms within int32).
 constexpr uint32_t kMaxFanFaces = 1023;
-constexpr int64_t kCameraDistanceQ16 = 3 * 65536 + 13107;  // 3.2 world units
 constexpr uint32_t kElevation = 238609294u;                // 20 degrees in 2^-32 turn
 // Direction to the light in camera space (x right, y down, z forward), Q15:
 // to the left, above and toward the viewer; about unit length.
@@ -128,9 +127,9 @@ Status ModelView::camera(const MeshState& mesh, uint16_t angle, Camera* out, uin
     for (int j = 0; j < 3; ++j) cam.rotation.m[i][j] = Q2_30::from_raw(rows[i][j]);
   // The centre of projection: D units back along the forward axis.
   // (Q2.30 x Q16.16 -> Q16.16: drop the rotation's fraction bits.)
-  cam.position.x = Q16_16::from_raw(static_cast<int32_t>((-rows[2][0] * kCameraDistanceQ16) >> kQ30));
-  cam.position.y = Q16_16::from_raw(static_cast<int32_t>((-rows[2][1] * kCameraDistanceQ16) >> kQ30));
-  cam.position.z = Q16_16::from_raw(static_cast<int32_t>((-rows[2][2] * kCameraDistanceQ16) >> kQ30));
+  cam.position.x = Q16_16::from_raw(static_cast<int32_t>((-rows[2][0] * int64_t{kModelViewDistanceQ16}) >> kQ30));
+  cam.position.y = Q16_16::from_raw(static_cast<int32_t>((-rows[2][1] * int64_t{kModelViewDistanceQ16}) >> kQ30));
+  cam.position.z = Q16_16::from_raw(static_cast<int32_t>((-rows[2][2] * int64_t{kModelViewDistanceQ16}) >> kQ30));
   // Focal length one frame height: a point 1 unit from the centre, on the
   // near side, lands within 0.46 frame heights of the middle.
   const int32_t focal = int32_t{cfg_.height} * 65536;

@@ -17,6 +17,7 @@
 #include "vds/mesh_colors.h"
 #include "vds/model_view.h"
 #include "vds/player.h"
+#include "vds/render_camera.h"
 
 namespace vds::enc {
 namespace {
@@ -209,9 +210,10 @@ void assemble(ModelStreamResult& r, const std::map<size_t, std::vector<uint8_t>>
     const uint32_t angle = static_cast<uint32_t>((uint64_t{i} * 65536) / r.orbit_frames);
     const uint8_t a[2] = {static_cast<uint8_t>(angle & 0xFF), static_cast<uint8_t>(angle >> 8)};
     w.add_chunk(kModelOrbitChunk, a);
+    r.parts.orbit += framed(sizeof a);
   }
   r.stream = w.finish();
-  r.parts.geometry = r.stream.size() - r.parts.colors_header - r.parts.vertex_colours;
+  r.parts.geometry = r.stream.size() - r.parts.colors_header - r.parts.vertex_colours - r.parts.orbit;
   for (size_t b : r.parts.level_bytes) r.parts.geometry -= b;
 }
 
@@ -241,8 +243,8 @@ std::vector<uint8_t> display_caps(const TexturedModel& dm, const Quantisation& q
     for (int a = 0; a < 3; ++a) d2 += std::pow((g[a] - (lo[a] + hi[a]) / 2) * unit, 2);
     radius = std::max(radius, std::sqrt(d2));
   }
-  const double nearest = std::max(0.25, 3.2 - radius);
-  const double px_per_unit = h.height / nearest;
+  const double nearest = std::max(0.25, kModelViewDistanceQ16 / 65536.0 - radius);
+  const double px_per_unit = std::max<int32_t>(h.height, kCameraMinFocalPx) / nearest;
   std::vector<uint8_t> caps(dm.triangles.size());
   for (size_t f = 0; f < dm.triangles.size(); ++f) {
     // The face's area in pixels (a lattice of resolution R holds about R^2 / 2 samples).
@@ -361,28 +363,28 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
     if (o.schedule_views <= 0) throw std::invalid_argument("a PSNR target needs the rate schedule's measure");
     // The coarsest quality whose finest picture reaches the target: the
     // ladder bisected (finer qualities never measured worse on the test models).
-    size_t lo = 0, hi = ladder.size();  // [lo, hi): candidates; ladder[lo] finest
+    // lo: the coarsest known to reach it; hi: the finest known not to (or the end).
+    size_t lo = 0, hi = ladder.size(), last = 0;
     colour(ladder[0]);
     const double finest = finish();
-    if (finest < o.min_psnr)
-    {
+    if (finest < o.min_psnr) {
       char msg[160];
       std::snprintf(msg, sizeof msg, "no quality reaches %.2f dB (at quality 1/8: %.2f dB)", o.min_psnr, finest);
       throw std::invalid_argument(msg);
     }
-    size_t good = 0;
     while (hi - lo > 1) {
       const size_t mid = (lo + hi) / 2;
       colour(ladder[mid]);
-      if (finish() >= o.min_psnr) {
-        good = mid;
+      last = mid;
+      if (finish() >= o.min_psnr)
         lo = mid;
-      } else {
+      else
         hi = mid;
-      }
     }
-    colour(ladder[good]);
-    finish();
+    if (last != lo) {  // the stream in hand is another quality's
+      colour(ladder[lo]);
+      finish();
+    }
   } else {
     colour(o.quality);
     finish();

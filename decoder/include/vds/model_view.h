@@ -24,6 +24,10 @@
 
 namespace vds {
 
+// The camera's distance from the grid's centre, Q16.16 world units (3.2;
+// its focal length is the frame height in pixels).
+constexpr int32_t kModelViewDistanceQ16 = 3 * 65536 + 13107;
+
 struct ModelViewConfig {
   uint16_t width = 0;   // frame size, pixels (1..2048)
   uint16_t height = 0;

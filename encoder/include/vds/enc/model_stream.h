@@ -66,6 +66,7 @@ struct ModelStreamParts {
   size_t geometry = 0;             // preamble, HEAD, mesh chunks, END
   size_t vertex_colours = 0;       // MCVX chunks' bytes
   size_t vertex_chunks = 0;        // and their number
+  size_t orbit = 0;                // MORB chunks
   size_t colors_header = 0;        // MCLH
   std::vector<size_t> level_bytes; // MCLV chunks per level (0 the finest)
   std::vector<size_t> level_end;   // stream offset where each level's last chunk ends
