@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "host_player.h"
+#include "stream_chunks.h"
 #include "vds/bytes.h"
 #include "vds/container.h"
 #include "vds/enc/arith_encoder.h"
@@ -22,24 +23,11 @@
 namespace vds::enc {
 namespace {
 
-struct Chunk {
-  uint32_t type;
-  std::span<const uint8_t> payload;
-  size_t end;  // stream offset after it
-};
-
-// The chunks of a stream this encoder wrote, HEAD and END left out.
-std::vector<Chunk> body_chunks(std::span<const uint8_t> s) {
-  std::vector<Chunk> out;
-  size_t at = kPreambleBytes;
-  while (at + kChunkHeadBytes + kChunkTailBytes <= s.size()) {
-    const uint32_t type = load_le32(s.data() + at), n = load_le32(s.data() + at + 4);
-    if (at + kChunkHeadBytes + n + kChunkTailBytes > s.size()) break;
-    if (type != chunk::kHeader && type != chunk::kEnd)
-      out.push_back({type, s.subspan(at + kChunkHeadBytes, n), at + kChunkHeadBytes + n + kChunkTailBytes});
-    at += kChunkHeadBytes + n + kChunkTailBytes;
-  }
-  if (at != s.size()) throw std::logic_error("model stream: the mesh stream does not parse");
+// The mesh stream's chunks, HEAD and END left out.
+std::vector<StreamChunk> body_chunks(std::span<const uint8_t> s) {
+  std::vector<StreamChunk> out;
+  for (const StreamChunk& c : stream_chunks(s))
+    if (c.type != chunk::kHeader && c.type != chunk::kEnd) out.push_back(c);
   return out;
 }
 
@@ -124,7 +112,7 @@ std::map<size_t, std::vector<uint8_t>> vertex_colour_chunks(std::span<const uint
   for (uint32_t v = 0; v < grid.size(); ++v) at.emplace(grid[v], v);
   HostPlayer host;
   Player& p = *host.player;
-  const std::vector<Chunk> chunks = body_chunks(stream);
+  const std::vector<StreamChunk> chunks = body_chunks(stream);
   std::map<size_t, std::vector<uint8_t>> out;
   std::array<std::vector<uint8_t>, 3> planes;
   for (auto& pl : planes) pl.assign(grid.size() + 1, 0);
@@ -181,7 +169,7 @@ size_t framed(size_t payload) { return kChunkHeadBytes + payload + kChunkTailByt
 void assemble(ModelStreamResult& r, const std::map<size_t, std::vector<uint8_t>>& vertex_chunks, size_t max_chunk) {
   StreamWriter w(r.header);
   r.parts = ModelStreamParts{};
-  const std::vector<Chunk> mesh_chunks = body_chunks(r.mesh.stream);
+  const std::vector<StreamChunk> mesh_chunks = body_chunks(r.mesh.stream);
   for (size_t i = 0; i < mesh_chunks.size(); ++i) {
     w.add_chunk(mesh_chunks[i].type, mesh_chunks[i].payload);
     const auto vc = vertex_chunks.find(i);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "host_player.h"
+#include "stream_chunks.h"
 #include "vds/bytes.h"
 #include "vds/container.h"
 #include "vds/enc/model_render.h"
@@ -183,18 +184,19 @@ struct ClientViews {
     return v;
   }
 
-  ModelFrame reference(const ref::CameraD& cam, const std::vector<Image>& textures, bool cache) {
+  // The model with its own textures from `cam`, its silhouette eroded;
+  // drawn once per camera (the colour levels of one mesh share them).
+  const ModelFrame& reference(const ref::CameraD& cam) {
     char key[256];
     std::snprintf(key, sizeof key, "%.9g %.9g %.9g %.9g %.9g %.9g", cam.position.x, cam.position.y, cam.position.z,
                   cam.rotation.m[0][0], cam.rotation.m[0][2], cam.rotation.m[2][1]);
-    if (cache) {
-      auto it = refs.find(key);
-      if (it != refs.end()) return it->second;
+    auto it = refs.find(key);
+    if (it == refs.end()) {
+      ModelFrame f = render_textured(model, model.textures, cam, views());
+      f.mask = interior(f.mask);
+      it = refs.emplace(key, std::move(f)).first;
     }
-    ModelFrame f = render_textured(model, textures, cam, views());
-    f.mask = interior(f.mask);
-    if (cache) refs.emplace(key, f);
-    return f;
+    return it->second;
   }
 
   // Mean over the views of the squared error of `draw(angle, cam)` against the reference.
@@ -248,17 +250,14 @@ std::vector<TimelinePoint> model_timeline(const TexturedModel& model, const Mode
   HostPlayer host(cb);
   Player* player = host.player.get();
   std::vector<TimelinePoint> out;
-  size_t at = 0;
-  const std::span<const uint8_t> s = r.stream;
-  while (at < s.size()) {
-    const size_t end = at == 0 ? kPreambleBytes : at + kChunkHeadBytes + load_le32(s.data() + at + 4) + kChunkTailBytes;
+  size_t at = 0;  // fed so far: the preamble with the first chunk, then chunk by chunk
+  for (const StreamChunk& c : stream_chunks(r.stream)) {
     const uint32_t before = frames;
-    const size_t at_start = at;
-    const Status st = player->feed(s.data() + at, end - at);
+    const Status st = player->feed(r.stream.data() + at, c.end - at);
     if (is_error(st)) throw std::logic_error(std::string("model timeline: the client refused the stream: ") + status_name(st));
-    at = end;
+    at = c.end;
     if (frames == before) continue;
-    if (at_start != 0 && load_le32(s.data() + at_start) == kModelOrbitChunk) continue;  // the same model, turning
+    if (c.type == kModelOrbitChunk) continue;  // the same model, turning
     if (o.colours_only && player->model_colors_level() < 0) continue;
     if (o.colours_only && player->model_colors_level() == Player::kModelVertexColours) continue;
     const MeshState& mesh = player->mesh.mesh();
@@ -268,7 +267,7 @@ std::vector<TimelinePoint> model_timeline(const TexturedModel& model, const Mode
     p.vertices = mesh.vertex_count();
     p.colour_level = player->model_colors_level();
     p.psnr = cv.psnr(mesh, [&](ModelView& view, uint16_t angle, const ref::CameraD& cam, const ClientCamera&) {
-      const ModelFrame ref = cv.reference(cam, model.textures, true);
+      const ModelFrame& ref = cv.reference(cam);
       const ModelFrame test{client_picture(view, r.header.width, r.header.height, mesh, angle, colours), Image()};
       cv.keep(ref, test.rgb);
       return masked_mse(ref, test);
@@ -284,7 +283,7 @@ double model_views_psnr(const TexturedModel& model, const std::vector<Image>& te
   HostPlayer host;
   if (host.play(r.stream) != Status::ok) throw std::logic_error("model timeline: the client refused the stream");
   return cv.psnr(host.player->mesh.mesh(), [&](ModelView&, uint16_t, const ref::CameraD& cam, const ClientCamera& cc) {
-    const ModelFrame ref = cv.reference(cam, model.textures, true);
+    const ModelFrame& ref = cv.reference(cam);
     const ModelFrame test{client_textured_picture(model, textures, cc, r.mesh.quantisation, r.header.width, r.header.height),
                           Image()};
     cv.keep(ref, test.rgb);
