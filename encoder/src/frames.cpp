@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "host_player.h"
 #include "vds/bytes.h"
 #include "vds/container.h"
 #include "vds/enc/stream_writer.h"
@@ -122,24 +123,9 @@ bool replay_band(void* ctx, const PixelRect& r) {
 // buffer is sized to the stream (it changes no pixel).
 std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::vector<Image>* frames,
                                         const ClientArena* board, std::vector<std::string>* notices) {
-  auto player = std::make_unique<Player>();
   Replay rp;
   rp.frames = frames;
   rp.notices = notices;
-  PlayerConfig cfg = kClientPlayerConfig;
-  std::vector<uint8_t> ws;
-  if (board != nullptr) {
-    if (board->player_from >= board->budget || board->budget > (size_t{1} << 30))
-      throw std::runtime_error("client player: a board workspace of " + std::to_string(board->budget) +
-                               " bytes with the player from byte " + std::to_string(board->player_from));
-    ws.resize(board->budget);  // (aligned as the board's: the offsets below are the same modulo 8)
-  } else {
-    // The chunk buffer, then what the header declares, as on a client.
-    ws.resize((1u << 24) + ImageDecoder::kWorkspaceBytes + (1u << 25));  // or a model of <= 65,536 vertices
-    cfg.max_chunk_bytes = 1u << 24;
-  }
-  Arena arena(ws.data(), ws.size());
-  if (board != nullptr) arena.alloc(board->player_from, 1);
   PlayerCallbacks cb;
   cb.ctx = &rp;
   cb.begin_frame = [](void* ctx, uint16_t w, uint16_t h) {
@@ -153,9 +139,9 @@ std::vector<uint32_t> client_frame_crcs(std::span<const uint8_t> stream, std::ve
     auto* r = static_cast<Replay*>(ctx);
     if (r->notices != nullptr) r->notices->push_back(notice_text(what, a, b, c));
   };
-  if (player->init(arena, cfg, cb) != Status::ok) throw std::runtime_error("client player: cannot initialise");
-  Status s = player->feed(stream.data(), stream.size());
-  if (s == Status::more_input) s = player->finish();
+  HostPlayer host(cb, board);
+  const Status s = host.play(stream);
+  const Player* player = host.player.get();
   if (s != Status::ok) {
     throw std::runtime_error(std::string("client decode failed: ") + status_name(s) + " at byte " +
                              std::to_string(player->error_offset()) + " (" + player->error_detail() + ")");
