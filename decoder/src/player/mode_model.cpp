@@ -6,12 +6,15 @@
 // says at once when it holds no more.
 //
 // A textured model's colour follows its geometry as mesh colors
-// (vds/mesh_colors.h): MCLH, once the mesh is whole, carries every face's
-// resolution and the vertex samples (the model is drawn with them at
-// once), then MCLV chunks its MIP levels coarsest first, each replacing
-// the one shown. The planes are carved at MCLH for the finest level the
-// workspace holds; finer levels are skipped, so a small client shows the
-// colour it can rather than none.
+// (vds/mesh_colors.h): an MCVX after each level colours the vertices it
+// added (the level is drawn then, in those colours; after the single-rate
+// tail, which numbers the vertices anew, every vertex again); MCLH, once
+// the mesh is whole, carries every face's resolution (and the vertex
+// samples, unless they are those colours), then MCLV chunks its MIP
+// levels coarsest first, each replacing the one shown. The planes are
+// carved at MCLH for the finest level the workspace holds; finer levels
+// are skipped, so a small client shows the colour it can rather than none.
+// MORB chunks draw the model as held from a given angle (the orbit script).
 #include "vds/bytes.h"
 #include "vds/mesh_colors.h"
 #include "vds/player.h"
@@ -341,8 +344,8 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
   // The level a chunk completed is drawn even when the decoder knows at once
   // that the next one will not fit (a version-2 stream's tail).
   // A model whose vertices come with their colours is drawn when their
-  // colours are in (the MCVX after each level); after the single-rate tail,
-  // which numbers the vertices anew, when MCLH brings them all again.
+  // colours are in (the MCVX after each level; after the single-rate tail,
+  // which numbers the vertices anew, the MCVX that colours them all again).
   VertexColours* vc = p.vertex_colours;
   if (vc != nullptr && vc->valid && p.mesh.header().tail() && p.mesh.complete()) vc->valid = false;
   const bool colour_follows = vc != nullptr && p.colors == nullptr;
