@@ -42,6 +42,7 @@ WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& vi
   // Free slots, lowest first.
   std::vector<uint32_t> free_slots;
   for (uint32_t s = slots; s-- > 0;) free_slots.push_back(s);
+  uint32_t cursor = slots - 1;  // the last send's slot, as the geometry record codes it
   // Held polygons by (next hot frame, slot), farthest last.
   std::map<std::pair<uint32_t, uint32_t>, uint32_t> by_next;
   const auto next_frame = [&](uint32_t id) {
@@ -64,22 +65,31 @@ WalkGeometryPlan plan_walk_geometry(const std::vector<std::vector<uint32_t>>& vi
         s = free_slots.back();
         free_slots.pop_back();
       } else {
-        // Farthest next use; a polygon hot at f has its next use after f only
-        // if it is hot again later, but it must stay: skip those.
-        auto victim = by_next.end();
-        for (auto it = by_next.rbegin(); it != by_next.rend(); ++it) {
-          if (!std::binary_search(hot[f].begin(), hot[f].end(), it->second)) {
-            victim = std::prev(it.base());
-            break;
+        // Polygons never hot again are equally good victims: the first
+        // such slot after the last send's goes (the cheapest slot to name:
+        // the geometry record codes "the slot after the last" in one bin).
+        // Else the farthest next use; a polygon hot at f has its next use
+        // after f only if it is hot again later, but it must stay: skip those.
+        s = kEmpty;
+        for (uint32_t k = 1; k <= slots && s == kEmpty; ++k) {
+          const uint32_t c = (cursor + k) % slots;
+          if (next_frame(slot_id[c]) == kEmpty && !std::binary_search(hot[f].begin(), hot[f].end(), slot_id[c])) s = c;
+        }
+        if (s == kEmpty) {
+          for (auto it = by_next.rbegin(); it != by_next.rend(); ++it) {
+            if (!std::binary_search(hot[f].begin(), hot[f].end(), it->second)) {
+              s = it->first.second;
+              break;
+            }
           }
         }
-        if (victim == by_next.end()) throw std::logic_error("plan_walk_geometry: no slot to evict");
-        s = victim->first.second;
-        slot_of.erase(victim->second);
-        by_next.erase(victim);
+        if (s == kEmpty) throw std::logic_error("plan_walk_geometry: no slot to evict");
+        by_next.erase({next_frame(slot_id[s]), s});
+        slot_of.erase(slot_id[s]);
       }
       slot_id[s] = id;
       slot_of[id] = s;
+      cursor = s;
       by_next[{next_frame(id), s}] = id;
       plan.sends[f].push_back({id, s});
       if (sent_before[id]) ++plan.resends;
@@ -159,9 +169,30 @@ void WalkGeometryEncoder::encode(ArithEncoder& e, const std::vector<Send>& sends
     last_slot_ = s.slot;
     e.encode_bit(ctx_.hot_now, s.hot_now);
     if (s.hot_now) sent_hot[s.slot] = true;
+    // The triangle on the grid, turned (its winding kept) so that an edge
+    // it shares with the triangle before it comes first: its third vertex
+    // is then predicted across that edge.
+    int32_t tri[3][3];
+    for (int c = 0; c < 3; ++c)
+      for (int a = 0; a < 3; ++a) tri[c][a] = static_cast<int32_t>(std::lround(s.vertices[static_cast<size_t>(c)][static_cast<size_t>(a)] / q));
+    const auto in_prev = [&](const int32_t* v) {
+      for (int j = 0; j < 3; ++j)
+        if (prev_[j][0] == v[0] && prev_[j][1] == v[1] && prev_[j][2] == v[2]) return true;
+      return false;
+    };
+    for (int turn = 0; turn < 3; ++turn) {
+      const int k0 = turn, k1 = (turn + 1) % 3;
+      if (in_prev(tri[k0]) && in_prev(tri[k1]) && (tri[k0][0] != tri[k1][0] || tri[k0][1] != tri[k1][1] || tri[k0][2] != tri[k1][2])) {
+        int32_t t[3][3];
+        for (int c = 0; c < 3; ++c)
+          for (int a = 0; a < 3; ++a) t[c][a] = tri[(c + turn) % 3][a];
+        std::copy(&t[0][0], &t[0][0] + 9, &tri[0][0]);
+        break;
+      }
+    }
     for (int c = 0; c < 3; ++c) {
       int32_t g[3];
-      for (int a = 0; a < 3; ++a) g[a] = static_cast<int32_t>(std::lround(s.vertices[static_cast<size_t>(c)][static_cast<size_t>(a)] / q));
+      for (int a = 0; a < 3; ++a) g[a] = tri[c][a];
       // The newest copy in the ring, if any.
       uint32_t found = kWalkVertexRing;
       for (uint32_t i = 0; i < ring_.size; ++i) {

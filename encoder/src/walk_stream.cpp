@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
+#include <queue>
 #include <stdexcept>
 
 #include "vds/enc/arith_encoder.h"
@@ -461,20 +463,41 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       progress("rate control", static_cast<size_t>(7 - std::log2(hi - lo)), 7);
     }
     std::fill(q.begin(), q.end(), std::max(lo, 0));
-    // ... then each view in turn a step higher while the pre-roll stays
-    // within it: the views where the link has room rise.
-    if (timed) {
-      constexpr int kStep = 2;
-      for (bool rose = true; rose;) {
-        rose = false;
-        for (size_t u = 0; u < updates; ++u) {
-          if (q[u] + kStep > 100) continue;
-          q[u] += kStep;
-          if (fits(q)) rose = true;
-          else q[u] -= kStep;
+    // ... then, a step at a time, the view whose next step buys the most
+    // (its lower error over the pixels it serves, per byte) while the
+    // stream still fits: views serving many pixels for long rise, and
+    // where the link has room (long holds) the views there rise, those
+    // where updates crowd staying where they are.
+    std::vector<double> served(updates, 0);  // pixel-frames each update's view serves
+    {
+      std::vector<int64_t> current(static_cast<size_t>(o.views), -1);
+      for (size_t f = 0; f < n; ++f) {
+        for (size_t k = 0; k < vp.updates[f].size(); ++k) current[vp.updates[f][k].slot] = static_cast<int64_t>(update_of[f][k]);
+        for (size_t i = 0; i < visible[f].size(); ++i) {
+          const int8_t c = vp.choice[f][i];
+          if (c >= 0 && current[static_cast<size_t>(c)] >= 0) served[static_cast<size_t>(current[static_cast<size_t>(c)])] += visible[f][i].second;
         }
-        progress("rate control: the views' mean quality", static_cast<size_t>(std::accumulate(q.begin(), q.end(), 0) / updates), 100);
       }
+    }
+    constexpr int kStep = 2;
+    const auto mse = [&](size_t u, int qq) { return std::pow(10.0, -intra(update_camera[u], qq).psnr / 10); };
+    std::priority_queue<std::pair<double, size_t>> next;  // (error removed per byte, update)
+    const auto offer = [&](size_t u) {
+      if (q[u] + kStep > 100) return;
+      const double gain = served[u] * (mse(u, q[u]) - mse(u, q[u] + kStep));
+      const double cost = static_cast<double>(intra(update_camera[u], q[u] + kStep).coded_bytes()) -
+                          static_cast<double>(intra(update_camera[u], q[u]).coded_bytes());
+      next.push({cost > 0 ? gain / cost : std::numeric_limits<double>::max(), u});
+    };
+    for (size_t u = 0; u < updates; ++u) offer(u);
+    for (size_t tried = 0; !next.empty(); ++tried) {
+      const size_t u = next.top().second;
+      next.pop();
+      q[u] += kStep;
+      if (fits(q)) offer(u);
+      else q[u] -= kStep;  // what rises later only takes more room: this view stays
+      if (tried % 16 == 0)
+        progress("rate control: the views' mean quality", static_cast<size_t>(std::accumulate(q.begin(), q.end(), 0) / updates), 100);
     }
   }
   // The stream, stating the pre-roll it needs as written (the model's

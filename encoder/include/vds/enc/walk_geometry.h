@@ -8,7 +8,8 @@
 // at f; one not held is sent (with the slot it goes into) by f. The encoder
 // knows the whole path, so when a slot is needed and all are full it
 // evicts the held polygon whose next hot frame is farthest away (never one
-// hot at f; ties: the highest slot) — the choice that resends the fewest
+// hot at f; among those never hot again, the first slot after the last
+// send's, which the record names in one bin) — the choice that resends the fewest
 // polygons. The client never chooses: it stores what the stream puts in a
 // slot, so its cache mirrors this plan by construction.
 #pragma once
