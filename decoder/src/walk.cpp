@@ -101,7 +101,7 @@ void walk_view_to_bytes(const WalkViewUpdate& u, uint8_t out[kWalkViewBytes]) {
 void WalkFrameState::reset() {
   arith_init_contexts(&zero[0], 5);
   arith_init_contexts(&mag[0][0], 5 * 6);
-  arith_init_contexts(&same_view, 1);
+  arith_init_contexts(&same_view[0], 6);
   arith_init_contexts(&record_frames[0], kWalkMaxFramesPerRecord - 1);
   for (auto& r : prev)
     for (int32_t& v : r) v = 0;
@@ -147,15 +147,15 @@ uint32_t WalkFrameDecoder::read_count(ArithDecoder& d, uint8_t max_frames) {
 }
 
 Status WalkFrameDecoder::consume(const uint8_t* payload, uint32_t size, const uint16_t* hot, uint32_t hot_count,
-                                 uint8_t* view_of, uint8_t views, WalkPose* pose) {
+                                 uint8_t* view_of, uint16_t* stamp, const bool* fresh, uint8_t views, WalkPose* pose) {
   ArithDecoder d;
   Status s = d.init(payload, size);
-  if (s == Status::ok) s = decode(d, hot, hot_count, view_of, views, pose);
+  if (s == Status::ok) s = decode(d, hot, hot_count, view_of, stamp, fresh, views, pose);
   return s == Status::ok ? d.finish() : s;
 }
 
-Status WalkFrameDecoder::decode(ArithDecoder& d, const uint16_t* hot, uint32_t hot_count, uint8_t* view_of, uint8_t views,
-                                WalkPose* pose) {
+Status WalkFrameDecoder::decode(ArithDecoder& d, const uint16_t* hot, uint32_t hot_count, uint8_t* view_of, uint16_t* stamp,
+                                const bool* fresh, uint8_t views, WalkPose* pose) {
   if (views == 0 || views > kWalkMaxViews) return Status::invalid_argument;
   int32_t pred[5], steps[5];
   state_.predict(pred);
@@ -171,14 +171,19 @@ Status WalkFrameDecoder::decode(ArithDecoder& d, const uint16_t* hot, uint32_t h
   }
   if (!d.ok()) return d.status();
   const int other_bits = walk_other_view_bits(views);
-  for (uint32_t i = 0; i < hot_count; ++i) {
+  const uint16_t now = walk_frame_stamp(state_.frames);
+  for (uint32_t i = 0, kept = 1; i < hot_count; ++i) {
     uint8_t& v = view_of[hot[i]];
     if (v >= views) v = 0;
-    if (views > 1 && !d.decode_bit(state_.same_view)) {
-      const uint32_t k = d.decode_bits_bypass(other_bits);
-      if (k >= static_cast<uint32_t>(views - 1)) return d.ok() ? Status::malformed : d.status();
-      v = static_cast<uint8_t>(k >= v ? k + 1 : k);
+    if (views > 1) {
+      kept = static_cast<uint32_t>(d.decode_bit(state_.same_view[walk_view_context(stamp[hot[i]], state_.frames, fresh[v], static_cast<int>(kept))]));
+      if (!kept) {
+        const uint32_t k = d.decode_bits_bypass(other_bits);
+        if (k >= static_cast<uint32_t>(views - 1)) return d.ok() ? Status::malformed : d.status();
+        v = static_cast<uint8_t>(k >= v ? k + 1 : k);
+      }
     }
+    stamp[hot[i]] = now;
   }
   if (!d.ok()) return d.status();
   state_.push(steps);

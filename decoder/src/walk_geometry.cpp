@@ -11,7 +11,7 @@ void WalkGeometryContexts::reset() {
   arith_init_contexts(&count[0], sizeof(*this) / sizeof(ArithContext));
 }
 
-void walk_predict(const WalkVertexRing& ring, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]) {
+bool walk_predict(const WalkVertexRing& ring, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]) {
   // The third vertex of a triangle sharing an edge with the one before it:
   // the parallelogram across that edge (exact for the second half of a
   // rectangle).
@@ -26,17 +26,22 @@ void walk_predict(const WalkVertexRing& ring, const int32_t prev[3][3], const in
         const int64_t p = static_cast<int64_t>(cur[0][a]) + cur[1][a] - prev[other][a];
         out[a] = p < -(int64_t{1} << 30) ? -(1 << 30) : p > (int64_t{1} << 30) ? (1 << 30) : static_cast<int32_t>(p);
       }
-      return;
+      return true;
     }
   }
   for (int a = 0; a < 3; ++a) out[a] = ring.size > 0 ? ring.at(0)[a] : 0;
+  return false;
+}
+
+uint32_t walk_get_place(ArithDecoder& d, ArithContext* bucket, uint32_t bits) {
+  const uint32_t b = d.decode_unary(bucket, static_cast<int>(bits + 1), bits);
+  if (!d.ok()) return 1u << bits;
+  if (b <= 1) return b;
+  return (1u << (b - 1)) | d.decode_bits_bypass(static_cast<int>(b - 1));
 }
 
 uint32_t walk_get_ring_index(ArithDecoder& d, ArithContext* ring_bucket) {
-  const uint32_t b = d.decode_unary(ring_bucket, static_cast<int>(kWalkRingBits + 1), kWalkRingBits);
-  if (!d.ok()) return kWalkVertexRing;
-  if (b <= 1) return b;
-  return (1u << (b - 1)) | d.decode_bits_bypass(static_cast<int>(b - 1));
+  return walk_get_place(d, ring_bucket, kWalkRingBits);
 }
 
 size_t WalkGeometry::workspace_bytes(uint32_t slots) {
@@ -63,6 +68,7 @@ Status WalkGeometry::init(Arena& arena, uint32_t slots, int32_t quantum_raw) {
   frames_ = 0;
   ctx_.reset();
   ring_.reset(ring);
+  axes_.reset();
   for (int c = 0; c < 3; ++c)
     for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a] = INT32_MIN;
   return Status::ok;
@@ -102,8 +108,14 @@ Status WalkGeometry::decode(ArithDecoder& d) {
         for (int a = 0; a < 3; ++a) g[a] = ring_.at(i)[a];
       } else {
         int32_t pred[3];
-        walk_predict(ring_, prev_, cur_, c, pred);
+        const bool across = walk_predict(ring_, prev_, cur_, c, pred);
         for (int a = 0; a < 3; ++a) {
+          if (!across && d.decode_bit(ctx_.axis_seen[a])) {
+            const uint32_t i = walk_get_place(d, ctx_.axis_bucket[a], kWalkAxisBits);
+            if (i >= axes_.size[a]) return d.ok() ? Status::malformed : d.status();
+            g[a] = axes_.v[a][i];
+            continue;
+          }
           const int32_t base = pred[a];
           // Whole map units, then the fraction in grid steps.
           const int64_t whole = d.decode_signed(ctx_.delta_zero[a], ctx_.delta_mag[a], 6, 6, 3);
@@ -115,6 +127,7 @@ Status WalkGeometry::decode(ArithDecoder& d) {
         }
       }
       ring_.push(g);
+      axes_.touch(g);
       for (int a = 0; a < 3; ++a) cur_[c][a] = g[a];
       for (int a = 0; a < 3; ++a) {
         const int64_t raw = static_cast<int64_t>(g[a]) * quantum_;
@@ -129,8 +142,10 @@ Status WalkGeometry::decode(ArithDecoder& d) {
     if (hot_now) mark_[slot] = 1;
   }
   // Slots hot before that stay hot.
-  for (uint32_t i = 0; i < hot_count_; ++i)
-    if (d.decode_bit(ctx_.stays)) mark_[hot_[i]] = 1;
+  for (uint32_t i = 0, stayed = 1; i < hot_count_; ++i) {
+    stayed = static_cast<uint32_t>(d.decode_bit(ctx_.stays[stayed]));
+    if (stayed) mark_[hot_[i]] = 1;
+  }
   // Slots turning hot again without a send.
   const uint32_t again = d.decode_ueg(ctx_.again_count, 4, 8, 2);
   if (!d.ok()) return d.status();

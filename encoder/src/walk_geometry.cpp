@@ -143,9 +143,22 @@ WalkGeometryEncoder::WalkGeometryEncoder(uint32_t slots, int32_t quantum_raw)
     throw std::invalid_argument("WalkGeometryEncoder: slots or quantum out of range");
   ctx_.reset();
   ring_.reset(reinterpret_cast<int32_t(*)[3]>(ring_storage_.data()));
+  axes_.reset();
   for (int c = 0; c < 3; ++c)
     for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a] = INT32_MIN;
 }
+
+namespace {
+
+// A place in a list of 2^bits entries, as walk_get_place reads it.
+void put_place(ArithEncoder& e, ArithContext* bucket, uint32_t bits, uint32_t place) {
+  uint32_t b = 0;
+  while ((place >> b) != 0) ++b;
+  e.encode_unary(bucket, static_cast<int>(bits + 1), b, bits);
+  if (b >= 2) e.encode_bits_bypass(place & ((1u << (b - 1)) - 1u), static_cast<int>(b - 1));
+}
+
+}  // namespace
 
 std::vector<uint8_t> WalkGeometryEncoder::encode(const std::vector<Send>& sends, const std::vector<uint32_t>& hot) {
   ArithEncoder e;
@@ -204,15 +217,20 @@ void WalkGeometryEncoder::encode(ArithEncoder& e, const std::vector<Send>& sends
       }
       if (ring_.size > 0) e.encode_bit(ctx_.cached[c], found < kWalkVertexRing);
       if (found < kWalkVertexRing) {
-        uint32_t b = 0;
-        while ((found >> b) != 0) ++b;
-        e.encode_unary(ctx_.ring_bucket, static_cast<int>(kWalkRingBits + 1), b, kWalkRingBits);
-        if (b >= 2) e.encode_bits_bypass(found & ((1u << (b - 1)) - 1u), static_cast<int>(b - 1));
+        put_place(e, ctx_.ring_bucket, kWalkRingBits, found);
       } else {
         const int fb = walk_fraction_bits(quantum_);
         int32_t pred[3];
-        walk_predict(ring_, prev_, cur_, c, pred);
+        const bool across = walk_predict(ring_, prev_, cur_, c, pred);
         for (int a = 0; a < 3; ++a) {
+          if (!across) {
+            const uint32_t i = axes_.find(a, g[a]);
+            e.encode_bit(ctx_.axis_seen[a], i < kWalkAxisValues);
+            if (i < kWalkAxisValues) {
+              put_place(e, ctx_.axis_bucket[a], kWalkAxisBits, i);
+              continue;
+            }
+          }
           const int32_t base = pred[a];
           const int64_t delta = static_cast<int64_t>(g[a]) - base;
           const int64_t whole = delta >> fb;  // floor: the fraction is never negative
@@ -222,12 +240,18 @@ void WalkGeometryEncoder::encode(ArithEncoder& e, const std::vector<Send>& sends
         }
       }
       ring_.push(g);
+      axes_.touch(g);
       for (int a = 0; a < 3; ++a) cur_[c][a] = g[a];
     }
     for (int c = 0; c < 3; ++c)
       for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a];
   }
-  for (uint32_t s : prev_hot_) e.encode_bit(ctx_.stays, std::binary_search(hot.begin(), hot.end(), s));
+  uint32_t stayed = 1;
+  for (uint32_t s : prev_hot_) {
+    const int now = std::binary_search(hot.begin(), hot.end(), s) ? 1 : 0;
+    e.encode_bit(ctx_.stays[stayed], now);
+    stayed = static_cast<uint32_t>(now);
+  }
   std::vector<uint32_t> again;
   for (uint32_t s : hot)
     if (!sent_hot[s] && !std::binary_search(prev_hot_.begin(), prev_hot_.end(), s)) again.push_back(s);

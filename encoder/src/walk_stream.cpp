@@ -32,9 +32,11 @@ class WalkFrameEncoder {
   void encode_count(ArithEncoder& e, uint32_t frames, uint8_t max_frames) {
     e.encode_unary(state_.record_frames, kWalkMaxFramesPerRecord - 1, frames - 1, max_frames - 1u);
   }
-  // `view_of` holds each slot's last view (in) and is set to `views_now` for the hot slots (out).
+  // `view_of` holds each slot's last view (in) and is set to `views_now`
+  // for the hot slots (out); `fresh`: the view slots updated since the
+  // frame before.
   void encode(ArithEncoder& e, const WalkPose& pose, const std::vector<uint32_t>& hot, const std::vector<uint8_t>& views_now,
-              std::vector<uint8_t>& view_of, uint8_t views) {
+              std::vector<uint8_t>& view_of, const std::vector<bool>& fresh, uint8_t views) {
     int32_t pred[5], steps[5];
     state_.predict(pred);
     walk_pose_to_steps(pose, steps);
@@ -44,21 +46,28 @@ class WalkFrameEncoder {
       e.encode_signed(state_.zero[k], state_.mag[k], 6, r, 6, 3);
     }
     const int other_bits = walk_other_view_bits(views);
+    if (stamp_.size() < view_of.size()) stamp_.resize(view_of.size(), 0);
+    const uint16_t now = walk_frame_stamp(state_.frames);
+    int kept = 1;
     for (size_t i = 0; i < hot.size(); ++i) {
       uint8_t& v = view_of[hot[i]];
       if (v >= views) v = 0;
       const uint8_t want = views_now[i];
       if (views > 1) {
-        e.encode_bit(state_.same_view, want == v);
+        const int ctx = walk_view_context(stamp_[hot[i]], state_.frames, fresh[v], kept);
+        kept = want == v ? 1 : 0;
+        e.encode_bit(state_.same_view[ctx], kept);
         if (want != v) e.encode_bits_bypass(want > v ? want - 1u : want, other_bits);
       }
       v = want;
+      stamp_[hot[i]] = now;
     }
     state_.push(steps);
   }
 
  private:
   WalkFrameState state_{};
+  std::vector<uint16_t> stamp_;  // per slot, as the client keeps them
 };
 
 // The client, fed the stream as it is written: what its view slots hold
@@ -295,7 +304,10 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
         now.push_back(it != choice.end() && it->second >= 0 ? static_cast<uint8_t>(it->second) : slot_view[slot]);
         slot_view[slot] = now.back();
       }
-      fe.encode(e, poses[f], geo.hot[f], now, view_of, wp.views);
+      std::vector<bool> fresh(wp.views, false);  // the WVUPs the client reads before this frame
+      for (const auto& u : vp.updates[f]) fresh[u.slot] = true;
+      for (const Refine& rf : refines[f]) fresh[rf.slot] = true;
+      fe.encode(e, poses[f], geo.hot[f], now, view_of, fresh, wp.views);
       progress("geometry", f + 1, n);
     }
     wfrm[r] = e.finish();
@@ -445,9 +457,14 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     for (const WalkPiece& x : p) b += x.bytes;
     return b;
   };
-  // A target even the lowest quality cannot meet becomes the least pre-roll there is.
+  // A target even the lowest quality cannot meet becomes the least
+  // pre-roll there is plus the target: at the least there is, the views
+  // where updates crowd could not rise above the lowest quality.
   uint32_t target = o.preroll_ms;
-  if (timed && o.quality < 0 && updates > 0) target = std::max(target, preroll_of(pieces_at(q)));
+  if (timed && o.quality < 0 && updates > 0) {
+    const uint32_t least = preroll_of(pieces_at(q));
+    if (least > target) target = std::min(kWalkMaxPrerollMs, least + target);
+  }
   // Whether views at qualities `qq` keep the stream in time with the target
   // pre-roll (untimed: within the rate on average).
   const auto fits = [&](const std::vector<int>& qq) {

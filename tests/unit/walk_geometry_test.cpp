@@ -287,6 +287,49 @@ TEST(WalkGeometryRecord, PrefixesAndGarbageAreRefused) {
   }
 }
 
+TEST(WalkGeometryRecord, ACornerMadeOfCoordinatesNamedBeforeCostsLessThanANewOne) {
+  // Axis-aligned rooms repeat a few coordinates on each axis: a vertex
+  // that is new as a point but whose x, y and z were each named lately
+  // (among the last kWalkAxisValues distinct values of their axis) is
+  // named by three short places, and arrives exactly where it was.
+  constexpr int32_t kQ = 65536 / 8;
+  const double xs[] = {0, 64.5, 192, 320.125}, ys[] = {-256, 0, 128}, zs[] = {0, 96, 200.25};
+  std::vector<vds::enc::WalkGeometryEncoder::Send> base;
+  vds::test::Xorshift32 rng;
+  for (uint32_t i = 0; i < 12; ++i) {
+    vds::enc::WalkGeometryEncoder::Send snd{i, true, {}};
+    for (auto& v : snd.vertices) v = {xs[rng.next() % 4], ys[rng.next() % 3], zs[rng.next() % 3]};
+    base.push_back(snd);
+  }
+  const auto cost = [&](const std::array<double, 3>& corner) {
+    auto sends = base;
+    vds::enc::WalkGeometryEncoder::Send last{12, true, {}};
+    last.vertices = {{{1000, 1000, 1000}, {1016, 1000, 1000}, corner}};
+    sends.push_back(last);
+    std::vector<uint32_t> hot(13);
+    for (uint32_t i = 0; i < 13; ++i) hot[i] = i;
+    const auto head = vds::enc::WalkGeometryEncoder(13, kQ).encode(base, std::vector<uint32_t>(hot.begin(), hot.end() - 1));
+    const auto all = vds::enc::WalkGeometryEncoder(13, kQ).encode(sends, hot);
+    std::vector<uint8_t> work(vds::WalkGeometry::workspace_bytes(13));
+    vds::Arena arena(work.data(), work.size());
+    vds::WalkGeometry client;
+    EXPECT_EQ(client.init(arena, 13, kQ), vds::Status::ok);
+    EXPECT_EQ(client.consume(all.data(), static_cast<uint32_t>(all.size())), vds::Status::ok);
+    const auto* t = client.triangle(12);
+    EXPECT_NE(t, nullptr);
+    if (t != nullptr) {
+      EXPECT_EQ(t[2].x.raw(), static_cast<int32_t>(std::lround(corner[0] * 65536)));
+      EXPECT_EQ(t[2].y.raw(), static_cast<int32_t>(std::lround(corner[1] * 65536)));
+      EXPECT_EQ(t[2].z.raw(), static_cast<int32_t>(std::lround(corner[2] * 65536)));
+    }
+    return static_cast<double>(all.size()) - static_cast<double>(head.size());
+  };
+  const double seen = cost({xs[3], ys[0], zs[2]});
+  const double fresh = cost({-1187.375, 733.625, -419.875});
+  std::printf("a corner of coordinates named before: %.0f bytes a triangle, of new ones: %.0f\n", seen, fresh);
+  EXPECT_LT(seen + 2, fresh);
+}
+
 TEST(WalkGeometryRecord, AVertexNamedAgainComesFromTheRingUpToItsSize) {
   // A frame of 400 triangles with distinct random vertices, then, a
   // triangle whose vertices are those of triangle k (sent 3 * (399 - k)

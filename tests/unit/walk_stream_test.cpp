@@ -296,8 +296,20 @@ TEST(WalkStream, RateControlBringsEveryFrameInTimeWithTheStatedPreroll) {
   EXPECT_GT(q90.preroll_ms, 400u);
   EXPECT_GT(late_frames(q90.stream, rate, 1 << 20, 0.4), 0u);
   EXPECT_EQ(late_frames(q90.stream, rate, 1 << 20, q90.preroll_ms / 1000.0), 0u);
-  std::printf("room, 60 frames at 12 kbit/s: pre-roll %u ms (views at quality %d to %d, PSNR %.2f dB); at quality 90 %u ms\n",
-              r.preroll_ms, *lo, *hi, r.psnr_rgb, q90.preroll_ms);
+  // A pre-roll no quality meets: the least there is plus the one asked
+  // for, so that the views can rise above the lowest quality; still every
+  // frame in time with the pre-roll stated.
+  o.quality = -1;
+  o.buffer_bytes = 1024;
+  o.preroll_ms = 1;
+  const auto tight = vds::enc::encode_walk(room, path, o);
+  ASSERT_NE(tight.rate_bytes, 0u);
+  EXPECT_GT(tight.preroll_ms, 1u);
+  EXPECT_EQ(late_frames(tight.stream, rate, 1024, tight.preroll_ms / 1000.0), 0u);
+  EXPECT_GT(*std::max_element(tight.view_quality.begin(), tight.view_quality.end()), 0);
+  std::printf("room, 60 frames at 12 kbit/s: pre-roll %u ms (views at quality %d to %d, PSNR %.2f dB); at quality 90 %u ms; "
+              "asked for 1 ms, %u ms\n",
+              r.preroll_ms, *lo, *hi, r.psnr_rgb, q90.preroll_ms, tight.preroll_ms);
 }
 
 TEST(WalkStream, DamagedStreamsAreRefusedNotCrashed) {
@@ -366,13 +378,15 @@ TEST(WalkStream, RecordsRoundTripAndRefuseBadFields) {
   vds::test::Xorshift32 rng;
   const uint16_t hot[4] = {0, 3, 5, 9};
   uint8_t view_of[10] = {};
+  uint16_t stamp[10] = {};
+  const bool fresh[3] = {false, true, false};
   for (int round = 0; round < 3000; ++round) {
     vds::WalkFrameDecoder d;
     d.reset();
     std::vector<uint8_t> junk(1 + rng.next() % 24);
     for (auto& x : junk) x = static_cast<uint8_t>(rng.next());
     vds::WalkPose pose;
-    if (d.consume(junk.data(), static_cast<uint32_t>(junk.size()), hot, 4, view_of, 3, &pose) == vds::Status::ok)
+    if (d.consume(junk.data(), static_cast<uint32_t>(junk.size()), hot, 4, view_of, stamp, fresh, 3, &pose) == vds::Status::ok)
       for (uint16_t h : hot) ASSERT_LT(view_of[h], 3);
   }
 }

@@ -105,7 +105,11 @@ constexpr int kWalkPoseShift = 12;  // raw Q16.16 per step: 2^12
 struct WalkFrameState {
   ArithContext zero[5];
   ArithContext mag[5][6];
-  ArithContext same_view;
+  // "Same view as last time", by the triangle's class — hot in the frame
+  // before and its view not updated since (0), hot before and its view
+  // updated (1), newly hot (2) — times 2, plus 1 if the triangle before
+  // it in the frame kept its view (walk_view_context).
+  ArithContext same_view[6];
   ArithContext record_frames[kWalkMaxFramesPerRecord - 1];  // a record's frame count - 1, truncated unary
   int32_t prev[2][5] = {};  // the last two poses as steps: x, y, z, yaw, pitch
   uint32_t frames = 0;
@@ -115,25 +119,41 @@ struct WalkFrameState {
   void push(const int32_t steps[5]);
 };
 
+// The context of a hot triangle's "same view" bin (WalkFrameState::
+// same_view): `stamp` is the slot's frame stamp (the frame, plus one,
+// modulo 2^16, it was last hot in; 0 never), `frame` the index of the
+// frame being read, `fresh` whether its view slot took a view update
+// since the frame before, `kept` whether the triangle before it in the
+// frame kept its view (1 for the first).
+inline int walk_view_context(uint16_t stamp, uint32_t frame, bool fresh, int kept) {
+  const bool was_hot = frame > 0 && stamp == static_cast<uint16_t>(frame);
+  return 2 * (was_hot ? (fresh ? 1 : 0) : 2) + kept;
+}
+inline uint16_t walk_frame_stamp(uint32_t frame) { return static_cast<uint16_t>(frame + 1u); }
+
 // WFRM payload, one arithmetic-coded stream: the number of frames it
 // holds less one (truncated unary, at most WLKP's frames-per-record - 1;
 // read_count), then per frame: its geometry (WalkGeometry::decode,
 // vds/walk_geometry.h), its pose as five signed ueg3 residuals against
 // WalkFrameState::predict (angles wrap at a turn), then per hot triangle
-// (ascending slot) a "same view as last time" bin and, when not, the view
-// among the others in ceil(log2(views - 1)) bypass bins.
+// (ascending slot) a "same view as last time" bin in the context
+// walk_view_context gives and, when not, the view among the others in
+// ceil(log2(views - 1)) bypass bins.
 class WalkFrameDecoder {
  public:
   void reset() { state_.reset(); }
   // A record's frame count (1..max_frames); 0 when the data is bad.
   uint32_t read_count(ArithDecoder& d, uint8_t max_frames);
   // Reads a record's pose and views: the pose, and `view_of[hot[i]]` for
-  // each hot slot (its last view in, its new view out; views < `views`).
-  // malformed for a view out of range; truncated.
-  Status decode(ArithDecoder& d, const uint16_t* hot, uint32_t hot_count, uint8_t* view_of, uint8_t views, WalkPose* pose);
+  // each hot slot (its last view in, its new view out; views < `views`),
+  // `stamp[hot[i]]` set to this frame's stamp (walk_frame_stamp); `fresh`
+  // per view slot: a view update since the frame before. malformed for a
+  // view out of range; truncated.
+  Status decode(ArithDecoder& d, const uint16_t* hot, uint32_t hot_count, uint8_t* view_of, uint16_t* stamp,
+                const bool* fresh, uint8_t views, WalkPose* pose);
   // The same from a payload of its own (then the coder's end check).
   Status consume(const uint8_t* payload, uint32_t size, const uint16_t* hot, uint32_t hot_count, uint8_t* view_of,
-                 uint8_t views, WalkPose* pose);
+                 uint16_t* stamp, const bool* fresh, uint8_t views, WalkPose* pose);
 
  private:
   WalkFrameState state_{};

@@ -13,11 +13,19 @@
 //             ceil(log2 slots) bypass bins), a "hot now" bin, three
 //             vertices — each a "cached" bin, then its place among the
 //             last kWalkVertexRing vertices named (walk_get_ring_index)
-//             or its offset from a prediction (walk_predict), per axis
-//             in whole map units (signed ueg3) and then the fraction in
-//             grid steps (one context bin per bit, most significant first:
-//             grid points on whole units cost almost nothing);
-//   hot set   per slot hot in the previous frame (ascending) a "stays" bin;
+//             or a new position: across the edge it shares with the
+//             triangle before it (walk_predict's parallelogram) its offset
+//             from that prediction, else per axis a "seen" bin and the
+//             value's place among the last kWalkAxisValues distinct values
+//             named on that axis (WalkAxisValues; bit length in context
+//             bins, then the bits below the leading one), or when not
+//             seen the offset from the most recent vertex. An offset is
+//             per axis in whole map units (signed ueg3) and then the
+//             fraction in grid steps (one context bin per bit, most
+//             significant first: grid points on whole units cost almost
+//             nothing);
+//   hot set   per slot hot in the previous frame (ascending) a "stays" bin,
+//             in a context by whether the one before it stayed;
 //             then ueg2 count of slots turning hot again without a send,
 //             each as ueg4 of its distance from the last one.
 // Vertices are integer multiples of the grid quantum (the encoder's
@@ -42,6 +50,12 @@ static_assert((kWalkVertexRing & (kWalkVertexRing - 1u)) == 0, "the ring's size 
 constexpr uint32_t kWalkRingBits = 10;  // log2(kWalkVertexRing): the longest bit length of a place
 static_assert((1u << kWalkRingBits) == kWalkVertexRing, "kWalkRingBits is the ring's log2");
 
+// Distinct coordinate values remembered per axis (Quake's walls, floors
+// and ceilings repeat a few planes' coordinates): 4 bytes each.
+constexpr uint32_t kWalkAxisValues = 32;
+constexpr uint32_t kWalkAxisBits = 5;  // log2(kWalkAxisValues): the longest bit length of a place
+static_assert((1u << kWalkAxisBits) == kWalkAxisValues, "kWalkAxisBits is the list's log2");
+
 // The contexts of the geometry coding, shared with the encoder.
 struct WalkGeometryContexts {
   ArithContext count[4];
@@ -52,7 +66,9 @@ struct WalkGeometryContexts {
   ArithContext delta_zero[3];  // by axis
   ArithContext delta_mag[3][6];
   ArithContext fraction[16];   // by bit of a vertex offset's fraction of a map unit
-  ArithContext stays;
+  ArithContext stays[2];  // by whether the slot before it stayed
+  ArithContext axis_seen[3];
+  ArithContext axis_bucket[3][kWalkAxisBits + 1];
   ArithContext again_count[4];
   ArithContext again_gap[4];
   void reset();
@@ -81,6 +97,34 @@ struct WalkVertexRing {
   }
 };
 
+// The last kWalkAxisValues distinct values named on each axis (grid
+// units), most recent first: every vertex a triangle names moves its
+// three coordinates to the front of their lists.
+struct WalkAxisValues {
+  int32_t v[3][kWalkAxisValues];
+  uint32_t size[3];
+  void reset() { size[0] = size[1] = size[2] = 0; }
+  // The place of `value` on `axis`, or kWalkAxisValues when not held.
+  uint32_t find(int axis, int32_t value) const {
+    for (uint32_t i = 0; i < size[axis]; ++i)
+      if (v[axis][i] == value) return i;
+    return kWalkAxisValues;
+  }
+  void touch(const int32_t p[3]) {
+    for (int a = 0; a < 3; ++a) {
+      uint32_t i = find(a, p[a]);
+      if (i == kWalkAxisValues) i = size[a] < kWalkAxisValues ? size[a]++ : kWalkAxisValues - 1;
+      for (; i > 0; --i) v[a][i] = v[a][i - 1];
+      v[a][0] = p[a];
+    }
+  }
+};
+
+// A place in a list of 2^bits entries: its bit length (0 for place 0, b
+// for 2^(b-1) .. 2^b - 1) as truncated unary in `bucket`'s bits + 1
+// contexts, then the bits below the leading one, bypass.
+uint32_t walk_get_place(ArithDecoder& d, ArithContext* bucket, uint32_t bits);
+
 // A place in the ring: its bit length (0 for place 0, b for 2^(b-1) ..
 // 2^b - 1) as truncated unary in ring_bucket's contexts, then the bits
 // below the leading one, bypass. Returns the place, or kWalkVertexRing
@@ -90,8 +134,9 @@ uint32_t walk_get_ring_index(ArithDecoder& d, ArithContext* ring_bucket);
 // The prediction of vertex c (0..2) of a triangle being sent, from what
 // both ends know: for the third vertex of a triangle that shares an edge
 // with the previous one sent, the parallelogram across that edge; else the
-// most recent vertex (or the origin). Shared with the encoder.
-void walk_predict(const WalkVertexRing& ring, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]);
+// most recent vertex (or the origin). True for the parallelogram. Shared
+// with the encoder.
+bool walk_predict(const WalkVertexRing& ring, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]);
 
 class WalkGeometry {
  public:
@@ -132,6 +177,7 @@ class WalkGeometry {
   uint32_t frames_ = 0;
   WalkGeometryContexts ctx_{};
   WalkVertexRing ring_{};
+  WalkAxisValues axes_{};
   int32_t prev_[3][3]{};  // the previous triangle sent (grid units)
   int32_t cur_[3][3]{};   // the one being read
 };

@@ -32,6 +32,8 @@ struct WalkPlay {
   Vec3<Q16_16>* positions = nullptr;
   uint16_t* indices = nullptr;
   uint8_t* view_of = nullptr;
+  uint16_t* hot_stamp = nullptr;     // per slot: walk_frame_stamp of the frame it was last hot in
+  bool fresh[kWalkMaxViews] = {};    // a view update since the last frame
 };
 
 namespace {
@@ -105,7 +107,9 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   wp->positions = p.arena().alloc_array<Vec3<Q16_16>>(3u * w.slots);
   wp->indices = p.arena().alloc_array<uint16_t>(3u * w.slots);
   wp->view_of = p.arena().alloc_array<uint8_t>(w.slots);
-  if (s == Status::ok && (!wp->meshes || !wp->positions || !wp->indices || !wp->view_of)) s = Status::workspace_too_small;
+  wp->hot_stamp = p.arena().alloc_array<uint16_t>(w.slots);
+  if (s == Status::ok && (!wp->meshes || !wp->positions || !wp->indices || !wp->view_of || !wp->hot_stamp))
+    s = Status::workspace_too_small;
   for (uint8_t v = 0; v < w.views && s == Status::ok; ++v) {
     uint8_t* planes = static_cast<uint8_t*>(p.arena().alloc(plane_bytes(w), 4));
     if (planes == nullptr) {
@@ -134,7 +138,7 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
     return false;
   }
   for (uint32_t i = 0; i < 3u * w.slots; ++i) wp->indices[i] = static_cast<uint16_t>(i);
-  for (uint32_t i = 0; i < w.slots; ++i) wp->view_of[i] = 0;
+  for (uint32_t i = 0; i < w.slots; ++i) wp->view_of[i] = 0, wp->hot_stamp[i] = 0;
   p.walk_frames.reset();
   p.walk = wp;
   return true;
@@ -300,6 +304,7 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
       refuse(Status::malformed, "WVUP's camera is not valid");
     else {
       w.pending = u.slot;
+      w.fresh[u.slot] = true;
       w.image_open = false;
       // The slot's own camera again: a refinement, added to what the slot
       // holds. Another camera: the slot is given the view's prediction
@@ -353,7 +358,9 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
       WalkPose pose;
       Status s = p.walk_geometry.decode(d);
       if (s == Status::ok)
-        s = p.walk_frames.decode(d, p.walk_geometry.hot(), p.walk_geometry.hot_count(), w.view_of, w.params.views, &pose);
+        s = p.walk_frames.decode(d, p.walk_geometry.hot(), p.walk_geometry.hot_count(), w.view_of, w.hot_stamp, w.fresh,
+                                 w.params.views, &pose);
+      for (bool& f : w.fresh) f = false;
       if (s == Status::ok && k + 1 == frames) s = d.finish();
       p.add_decode(p.work_clock() - f0);
       if (s != Status::ok) {
@@ -397,8 +404,8 @@ size_t Player::walk_workspace_bytes(const StreamHeader& h, const WalkParams& w, 
   // Each allocation of setup() with its worst alignment slack.
   return sizeof(WalkPlay) + alignof(WalkPlay) + WalkGeometry::workspace_bytes(w.slots) + ImageDecoder::kWorkspaceBytes +
          render_workspace_size(rc) + w.slots * sizeof(Mesh) + alignof(Mesh) + 3u * w.slots * sizeof(Vec3<Q16_16>) +
-         alignof(Vec3<Q16_16>) + 3u * w.slots * sizeof(uint16_t) + alignof(uint16_t) + w.slots +
-         w.views * (plane_bytes(w) + 4);
+         alignof(Vec3<Q16_16>) + 3u * w.slots * sizeof(uint16_t) + alignof(uint16_t) + w.slots + w.slots * sizeof(uint16_t) +
+         alignof(uint16_t) + w.views * (plane_bytes(w) + 4);
 }
 
 namespace detail {

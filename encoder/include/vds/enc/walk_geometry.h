@@ -76,6 +76,7 @@ class WalkGeometryEncoder {
   WalkGeometryContexts ctx_{};
   std::vector<std::array<int32_t, 3>> ring_storage_;
   WalkVertexRing ring_{};
+  WalkAxisValues axes_{};
   std::vector<uint32_t> prev_hot_;
   uint32_t last_slot_;
   int32_t prev_[3][3]{}, cur_[3][3]{};
