@@ -9,7 +9,10 @@
 #   client's PSNR over R, G, B pooled and its worst frame against the
 #   ground truth, next to each video codec's PSNR at the same rate; per
 #   map at 16 kbit/s a contact sheet (ground truth | vds | SVT-AV1 | x264,
-#   walkthrough_<map>_frames.jpg) and per-frame PSNR (walkthrough_<map>_psnr.png).
+#   walkthrough_<map>_frames.jpg) and per-frame PSNR and bits (walkthrough_<map>_psnr.png:
+#   vds's from `vds encode-walk --per-frame`, each frame's views and its part of its record; the
+#   video codecs' their packets' sizes in display order, from ffprobe).
+# The video encodes must be in WORK: run_walk_video.sh's rate-16 SVT-AV1 and x264 streams.
 #
 # Usage: bench/run_walkthrough.sh [BUILD_DIR]   (default build/host-release)
 #   MAPS="oa_dm4 oa_dm5 oa_rpg3dm2"; THRESHOLD=18; WORK (default BUILD_DIR/walk).
@@ -26,10 +29,11 @@ for map in ${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2}; do
   [ -f "$WORK/$map/tour.txt" ] || { echo "run_walkthrough: $WORK/$map/tour.txt missing (bench/run_walk_video.sh)" >&2; exit 1; }
   for rate in 8 16 32; do
     # REUSE=1: streams encoded by an earlier run are kept.
-    [ "${REUSE:-0}" = 1 ] && [ -s "$WORK/$map/walk_$rate.txt" ] && [ -s "$WORK/$map/walk_$rate.y4m" ] && continue
+    [ "${REUSE:-0}" = 1 ] && [ -s "$WORK/$map/walk_$rate.txt" ] && [ -s "$WORK/$map/walk_$rate.y4m" ] && [ -s "$WORK/$map/walk_$rate.csv" ] && continue
     echo "== $map at $rate kbit/s"
     "$VDS" encode-walk "$map" --path "$WORK/$map/tour.txt" --rate "$rate" --threshold "${THRESHOLD:-18}" \
-      -o "$WORK/$map/walk_$rate.vds" --y4m "$WORK/$map/walk_$rate.y4m" 2>/dev/null | tee "$WORK/$map/walk_$rate.txt"
+      -o "$WORK/$map/walk_$rate.vds" --y4m "$WORK/$map/walk_$rate.y4m" --per-frame "$WORK/$map/walk_$rate.csv" 2>/dev/null \
+      | tee "$WORK/$map/walk_$rate.txt"
   done
 done
 VDS="$VDS" BENCH_DIR="$ROOT/bench" $PY - "$WORK" "$RESULTS" "${THRESHOLD:-18}" ${MAPS:-oa_dm4 oa_dm5 oa_rpg3dm2} <<'PY'
@@ -152,6 +156,14 @@ def decoded(path, fmt):
                          check=True, stdout=subprocess.PIPE).stdout
     return np.frombuffer(raw, np.uint8).reshape(-1, H, W, 3)
 
+def packet_bits(path, fmt):
+    # Each frame's packet, in display order: kbit. An AV1 temporal unit shows exactly one frame, so its
+    # packets are in display order already; H.264's are reordered: the decoded frames' packet sizes.
+    entry = "packet=size" if fmt == "obu" else "frame=pkt_size"
+    out = subprocess.run(["ffprobe", "-hide_banner", "-loglevel", "error", "-f", fmt, "-i", path, "-select_streams", "v:0",
+                          "-show_entries", entry, "-of", "csv=p=0"], check=True, stdout=subprocess.PIPE, text=True).stdout
+    return np.array([int(x) for x in out.split() if x.strip().isdigit()]) * 8 / 1000
+
 def psnr(a, b):
     m = ((a.astype(np.float32) - b.astype(np.float32)) ** 2).mean(axis=(1, 2, 3))
     return 10 * np.log10(255 ** 2 / np.maximum(m, 1e-9))
@@ -178,11 +190,17 @@ for m in maps:
     enc.stdin.close()
     if enc.wait() != 0:
         raise SystemExit("run_walkthrough: ffmpeg could not write " + video)
-    fig, ax = plt.subplots(figsize=(9, 3.2))
+    fig, (ax, bx) = plt.subplots(2, 1, figsize=(9, 5.6), sharex=True)
     for name, frames in list(rows.items())[1:]:
         ax.plot(psnr(frames, gt), lw=0.8, label=name)
-    ax.set_xlabel("frame"); ax.set_ylabel("PSNR R,G,B (dB)"); ax.set_title(f"{m} at 16 kbit/s, frame by frame")
+    ax.set_ylabel("PSNR R,G,B (dB)"); ax.set_title(f"{m} at 16 kbit/s, frame by frame")
     ax.grid(True, lw=0.3); ax.legend(fontsize=7)
+    per_frame = np.loadtxt(os.path.join(d, "walk_16.csv"), delimiter=",", skiprows=1)
+    bits = {"vds walkthrough": per_frame[:, 1] * 8 / 1000, "SVT-AV1": packet_bits(os.path.join(d, "svt-av1_rate16.obu"), "obu"),
+            "x264": packet_bits(os.path.join(d, "x264_rate16.h264"), "h264")}
+    for name, kbit in bits.items():
+        bx.plot(kbit, lw=0.8, label=name)
+    bx.set_yscale("log"); bx.set_xlabel("frame"); bx.set_ylabel("kbit a frame"); bx.grid(True, lw=0.3); bx.legend(fontsize=7)
     fig.tight_layout(); fig.savefig(os.path.join(results, f"walkthrough_{m}_psnr.png"), dpi=100)
     L.append(f"## {m} at 16 kbit/s\n")
     L.append(f"Rows: ground truth, vds walkthrough, SVT-AV1, x264; columns: frames {', '.join(map(str, picks))}. The whole "

@@ -18,7 +18,7 @@ namespace vds::cli {
 namespace {
 
 struct EncodeWalkOptions {
-  std::string scene, path, out, y4m, size = "240x180";
+  std::string scene, path, out, y4m, per_frame, size = "240x180";
   double rate = 16, threshold = 18, widen = -1, view_scale = -1;
   int lookahead = -1, preroll = -1, window = -1, max_sends = -1;
   bool predict = false;
@@ -60,6 +60,12 @@ void run_encode_walk(const EncodeWalkOptions& o) {
     io::Y4mWriter y(o.y4m, static_cast<int>(std::lround(path.fps)));
     for (const io::Image& f : r.frames) y.write(f);
     y.close();
+  }
+  if (!o.per_frame.empty()) {
+    std::string csv = "frame,bytes,psnr_rgb\n";
+    for (size_t f = 0; f < r.bytes_by_frame.size(); ++f)
+      csv += std::to_string(f) + "," + std::to_string(r.bytes_by_frame[f]) + "," + std::to_string(r.frame_psnr[f]) + "\n";
+    enc::write_file(o.per_frame, std::vector<uint8_t>(csv.begin(), csv.end()));
   }
   const double secs = path.frames.size() / path.fps;
   int qmin = 100, qmax = 0;
@@ -115,6 +121,7 @@ void add_encode_walk(CLI::App& app) {
       ->check(CLI::Range(1.0, 4.0));
   sub->add_option("--view-scale", o->view_scale, "The views' size over the frame's, each side (default 2/3)")->check(CLI::Range(0.1, 1.0));
   sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");
+  sub->add_option("--per-frame", o->per_frame, "Also write each frame's stream bytes and PSNR R,G,B as CSV");
   sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 240x180)");
   sub->add_option("--refine-delta", o->refine_delta, "A refinement's image quality above the views' (0: none)")->check(CLI::Range(0, 100));
   sub->add_option("--refine-after", o->refine_after, "Frames after a view arrives that it is refined")->check(CLI::Range(1, 1000));

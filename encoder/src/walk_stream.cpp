@@ -274,6 +274,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   WalkFrameEncoder fe;
   std::vector<std::vector<uint8_t>> wfrm(record_start.size());  // by record
   std::vector<size_t> geometry_part(record_start.size());       // bytes of each record's geometry
+  std::vector<size_t> frame_share(n);  // each frame's part of its record (the first's with the frame count)
   std::vector<uint8_t> view_of(slots, 0);
   std::vector<uint8_t> slot_view(slots, 0);
   std::vector<uint32_t> id_of_slot(slots, 0);  // the triangle each slot holds, as the sends so far put them
@@ -307,7 +308,9 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       std::vector<bool> fresh(wp.views, false);  // the WVUPs the client reads before this frame
       for (const auto& u : vp.updates[f]) fresh[u.slot] = true;
       for (const Refine& rf : refines[f]) fresh[rf.slot] = true;
+      const size_t before = f == record_start[r] ? 0 : e.finished_size();
       fe.encode(e, poses[f], geo.hot[f], now, view_of, fresh, wp.views);
+      frame_share[f] = e.finished_size() - before;
       progress("geometry", f + 1, n);
     }
     wfrm[r] = e.finish();
@@ -379,6 +382,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     written.assign(1, WalkPiece{w.size(), 0, 0, false});
     res->view_bytes = res->geometry_bytes = res->frame_bytes = 0;
     res->view_updates = res->view_refinements = res->view_predicted = 0;
+    res->bytes_by_frame.assign(n, 0);
     // A view into a slot: WVUP with its camera's pose, then its image:
     // intra, or a residual against what the client then holds (its
     // prediction of the view, whichever is better; a refinement's base).
@@ -431,11 +435,19 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       w.add_chunk(chunk::kWalkFrame, wfrm[r]);
       client.feed(w);
       written.push_back({w.size() - before, f, last, true});
+      // Each frame's part; the record's framing and the views before it go with its first.
+      for (const WalkPiece& piece : written)
+        if (piece.first_frame == f && !piece.record) res->bytes_by_frame[f] += piece.bytes;
+      size_t shares = 0;
+      for (uint32_t g = f; g <= last; ++g) shares += frame_share[g], res->bytes_by_frame[g] += frame_share[g];
+      res->bytes_by_frame[f] += (w.size() - before) - std::min(shares, w.size() - before);
       // The record's geometry and the rest (its poses, views and the chunk's framing).
       res->geometry_bytes += std::min(geometry_part[r], wfrm[r].size());
       res->frame_bytes += w.size() - before - std::min(geometry_part[r], wfrm[r].size());
     }
     res->stream = w.finish();
+    // The stream's end goes with the last frame.
+    res->bytes_by_frame.back() += res->stream.size() - std::accumulate(res->bytes_by_frame.begin(), res->bytes_by_frame.end(), size_t{0});
     res->slots = slots;
     res->workspace_bytes = h.workspace_bytes;
     res->kbps = res->stream.size() * 8.0 / (n / path.fps) / 1000;

@@ -64,8 +64,13 @@ def main():
         for k in range(40):
             f.write("%d %.4f %.4f 1.5 %.3f %.3f\n" % (k, -2 + 0.1 * k, -1 + 0.05 * k, 30 + 3 * k, -5 + 0.25 * k))
     stream = os.path.join(work, "walk.vds")
+    per_frame = os.path.join(work, "walk.csv")
     subprocess.run([vds, "encode-walk", os.path.join(work, "room.obj"), "--path", os.path.join(work, "path.txt"),
-                    "--size", "64x48", "--rate", "64", "-o", stream], check=True)
+                    "--size", "64x48", "--rate", "64", "-o", stream, "--per-frame", per_frame], check=True)
+    # Each frame's bytes and PSNR: 40 rows whose bytes add up to the stream.
+    rows = [line.split(",") for line in open(per_frame).read().split("\n")[1:] if line]
+    if len(rows) != 40 or sum(int(r[1]) for r in rows) != os.path.getsize(stream) or not all(10 < float(r[2]) < 99 for r in rows):
+        sys.exit(f"walk_case: --per-frame wrote {len(rows)} rows, not 40 adding up to the stream's {os.path.getsize(stream)} bytes")
     if "--play" in args:
         sys.exit(play(vds, work, stream, args))
     rest = [a for i, a in enumerate(args) if a != "--vds" and (i == 0 or args[i - 1] != "--vds")]

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <numeric>
 #include <vector>
 
 #include "vds/enc/frames.h"
@@ -35,6 +36,13 @@ TEST(WalkStream, ARoomPlaysEndToEndWithinItsRate) {
   EXPECT_GT(r.psnr_rgb, 24.0) << "quality " << r.quality;
   // No frame more than 6 dB below the pooled PSNR.
   for (size_t f = 0; f < r.frame_psnr.size(); ++f) EXPECT_GT(r.frame_psnr[f], r.psnr_rgb - 6) << "frame " << f;
+  // Each frame's bytes add up to the stream; a frame with a view update
+  // brings at least that view's image.
+  ASSERT_EQ(r.bytes_by_frame.size(), 60u);
+  EXPECT_EQ(std::accumulate(r.bytes_by_frame.begin(), r.bytes_by_frame.end(), size_t{0}), r.stream.size());
+  size_t view_frames = 0;
+  for (size_t f = 0; f < 60; ++f) view_frames += r.bytes_by_frame[f] > 200;
+  EXPECT_GE(view_frames, r.view_updates > 1 ? 2u : 1u);
   // The same input makes the same stream, and the client shows the same frames.
   const auto again = vds::enc::encode_walk(room, path, o);
   EXPECT_EQ(again.stream, r.stream);

@@ -75,6 +75,7 @@ struct WalkEncodeResult {
   double kbps = 0;                  // the whole stream over the path's duration
   double psnr_rgb = 0;              // the client's frames against the ground truth, pooled
   std::vector<double> frame_psnr;   // per frame
+  std::vector<size_t> bytes_by_frame;  // per frame: the stream bytes it brings (its views and part of its record; the header with frame 0)
   std::vector<uint32_t> frame_crc;  // the CRC of each frame the client displays
   std::vector<io::Image> frames;    // what the client shows (when keep_frames)
 };
