@@ -176,6 +176,17 @@ void image_header_to_bytes(const ImageHeader& h, uint8_t out[kImageHeaderBytes])
 // `chroma` selects the chroma shape. Steps are 1..2047.
 void image_quant_table(int index, int slope, bool chroma, uint16_t out_zigzag[64]);
 
+// Smooths the edges between 8x8 blocks of a decoded planar image in
+// place, where a step across an edge is small enough to come from the
+// quantisation of its DC (under four times dc_step / 8) and both sides
+// are smooth: flat sides become a ramp over the eight samples, others move the
+// two samples next to the edge a quarter of the step together. What the
+// walkthrough's views get after their image (docs/walkthrough.md); integer
+// arithmetic, the same on every machine.
+void image_deblock_plane(uint8_t* plane, int width, int height, ptrdiff_t stride, int dc_step);
+// Each plane with its own DC step (the header's quantisers).
+void image_deblock(const ImageHeader& h, const ImageTarget& planes);
+
 // IMGD payload: u32 first MCU index, u16 number of MCUs, then the range
 // coder's bytes for exactly those MCUs.
 constexpr uint32_t kImageDataPrefixBytes = 6;

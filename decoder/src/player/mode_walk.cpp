@@ -338,6 +338,7 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
         if (is_error(s)) {
           refuse(s, "a view's image was refused");
         } else if (s == Status::ok && p.image.done()) {
+          image_deblock(p.image.header(), target);
           w.view_cam[w.pending] = w.pending_cam;
           w.view_ready[w.pending] = true;
           w.pending = -1;
