@@ -64,7 +64,8 @@ L = ["# Walkthrough mode against the video codecs\n",
      f"Produced by `bench/run_walkthrough.sh` (THRESHOLD={threshold}) on the tours and ground truth of "
      "`bench/run_walk_video.sh` (`walk_anchors.md`): 600 frames, 240x180, 20 frames/s. vds: `vds encode-walk MAP --path "
      "TOUR --rate R --threshold T` (two views; each view's image quality set by the rate control: every frame's data in "
-     "time with a pre-roll of at most 1 s on a link of rate R into the client's 4 KiB window); PSNR over R, G, B of "
+     "time with a pre-roll of at most 1 s on a link of rate R into the client's 4 KiB window, or where no quality "
+     "brings every frame in time within 1 s, the least pre-roll there is plus 1 s); PSNR over R, G, B of "
      "what the client library shows (RGB565, as the boards display it) against the ground truth. Video codecs: their "
      "PSNR at vds's rate, read off each codec's points in `walk_anchors.json` (linear in log-rate; '-' outside them).\n",
      "| map | target | vds kbit/s | views | geometry | frame records | header B | view updates | quality (mean) | pre-roll s | client workspace B | vds PSNR | worst frame | x264 | x265 | SVT-AV1 | libaom |",
