@@ -10,6 +10,7 @@
 #include "commands.h"
 #include "vds/enc/camera_path.h"
 #include "vds/enc/scene.h"
+#include "vds/enc/scene_shape.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/enc/walk_stream.h"
 #include "vds/io/y4m.h"
@@ -21,12 +22,21 @@ struct EncodeWalkOptions {
   std::string scene, path, out, y4m, per_frame, size = "240x180";
   double rate = 16, threshold = 18, widen = -1, view_scale = -1;
   int lookahead = -1, preroll = -1, window = -1, max_sends = -1;
-  bool predict = false;
+  bool predict = false, keep_triangles = false;
   int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
 };
 
 void run_encode_walk(const EncodeWalkOptions& o) {
   const enc::Scene scene = enc::load_scene(o.scene);
+  // What the client draws the views onto: the same shape in fewer
+  // triangles (docs/walkthrough.md, "Fewer triangles").
+  std::unique_ptr<enc::Scene> drawn;
+  if (!o.keep_triangles) {
+    enc::ShapeStats st;
+    drawn = std::make_unique<enc::Scene>(enc::simplify_shape(scene, enc::ShapeOptions{}, &st));
+    std::fprintf(stderr, "encode-walk: the client draws %zu triangles for the scene's %zu (%zu regions in one plane drawn as their outline)\n",
+                 st.triangles_out, scene.triangles(), st.merged);
+  }
   const std::vector<uint8_t> text = enc::read_file(o.path);
   const enc::CameraPath path = enc::read_camera_path(std::string(text.begin(), text.end()), o.path);
   if (path.frames.empty()) throw Failure(kExitBadInput, o.path + ": no frames");
@@ -54,7 +64,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
     if (done == total) std::fprintf(stderr, "\n");
     std::fflush(stderr);
   };
-  const enc::WalkEncodeResult r = enc::encode_walk(scene, path, wo, !o.y4m.empty());
+  const enc::WalkEncodeResult r = enc::encode_walk(scene, path, wo, !o.y4m.empty(), drawn.get());
   enc::write_file(o.out, r.stream);
   if (!o.y4m.empty()) {
     io::Y4mWriter y(o.y4m, static_cast<int>(std::lround(path.fps)));
@@ -93,6 +103,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   for (double p : r.frame_psnr) worst = std::min(worst, p);
   std::printf("  client: %u triangle slots, %d views, %zu bytes of workspace; PSNR R,G,B %.2f dB pooled, %.2f dB worst frame\n",
               r.slots, o.views, r.workspace_bytes, r.psnr_rgb, worst);
+  std::printf("  geometry: %zu polygon sends, %zu of them of a polygon evicted since it was sent before\n", r.polygons_sent, r.polygons_resent);
 }
 
 }  // namespace
@@ -120,6 +131,8 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--widen", o->widen, "tan(half the views' field of view) / tan(half the screen's) (default 1.5)")
       ->check(CLI::Range(1.0, 4.0));
   sub->add_option("--view-scale", o->view_scale, "The views' size over the frame's, each side (default 2/3)")->check(CLI::Range(0.1, 1.0));
+  sub->add_flag("--keep-triangles", o->keep_triangles,
+                "The client draws the views onto the scene's own triangles (default: neighbours in one plane merged)");
   sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");
   sub->add_option("--per-frame", o->per_frame, "Also write each frame's stream bytes and PSNR R,G,B as CSV");
   sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 240x180)");

@@ -134,7 +134,11 @@ CameraPose from_walk_pose(const WalkPose& w) {
   return p;
 }
 
-WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkEncodeOptions& o, bool keep_frames) {
+WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkEncodeOptions& o, bool keep_frames,
+                             const Scene* geometry) {
+  const Scene& drawn = geometry ? *geometry : s;  // what the client draws
+  if (drawn.textures.size() != s.textures.size())
+    throw std::invalid_argument("encode_walk: the geometry scene's textures are not the scene's");
   const size_t n = path.frames.size();
   if (n == 0) throw std::invalid_argument("encode_walk: an empty path");
   if (o.views < 1 || o.views > kWalkMaxViews) throw std::invalid_argument("encode_walk: 1 to 8 views");
@@ -158,8 +162,18 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> visible(n);
   render_path(renderer, path, o.threads, [&](size_t f, const SceneFrame& fr) {
     truth[f] = fr.rgb;
-    visible[f] = visible_triangles(fr);
+    if (!geometry) visible[f] = visible_triangles(fr);
   }, [&](size_t done) { progress("ground truth", done, n); });
+  RenderOptions vro = ro;
+  vro.supersample = 1;
+  vro.max_aniso = 1;
+  if (geometry) {
+    // What the client's triangles show, pixel by pixel (the alpha-tested
+    // ones cut out as the scene's are).
+    const SceneRenderer ids(drawn, images, vro);
+    render_path(ids, path, o.threads, [&](size_t f, const SceneFrame& fr) { visible[f] = visible_triangles(fr); },
+                [&](size_t done) { progress("visibility", done, n); });
+  }
   // 2. Geometry and views.
   std::vector<std::vector<uint32_t>> ids(n);
   for (size_t f = 0; f < n; ++f)
@@ -185,14 +199,11 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vo.view_height = view_h;
   CameraPath wide = path;
   wide.hfov_deg = view_hfov;
-  RenderOptions vro = ro;
-  vro.supersample = 1;
-  vro.max_aniso = 1;
-  const SceneRenderer view_vis(s, {}, vro);
+  const SceneRenderer view_vis(drawn, {}, vro);
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> view_visible(n);
   render_path(view_vis, wide, o.threads, [&](size_t f, const SceneFrame& fr) { view_visible[f] = visible_triangles(fr); },
               [&](size_t done) { progress("view visibility", done, n); });
-  const WalkViewPlan vp = plan_walk_views(s, path, visible, vo, &view_visible);
+  const WalkViewPlan vp = plan_walk_views(drawn, path, visible, vo, &view_visible);
   // 3. The views, rendered at the client's cameras.
   std::vector<WalkPose> poses(n);
   for (size_t f = 0; f < n; ++f) poses[f] = walk_pose(path.frames[f]);
@@ -225,7 +236,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   if (o.frames_per_record < 1 || o.frames_per_record > kWalkMaxFramesPerRecord)
     throw std::invalid_argument("encode_walk: 1 to 8 frames a record");
   wp.frames_per_record = static_cast<uint8_t>(o.frames_per_record);
-  wp.quantum_raw = choose_walk_quantum(s, 1.0 / 16);
+  wp.quantum_raw = choose_walk_quantum(drawn, 1.0 / 16);
   wp.view_focal_q16 = static_cast<int32_t>(std::lround(scene_camera(path.frames[0], view_hfov, view_w, view_h).focal * 65536));
   wp.view_width = static_cast<uint16_t>(view_w);
   wp.view_height = static_cast<uint16_t>(view_h);
@@ -289,7 +300,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
         for (int c = 0; c < 3; ++c)
           for (int a = 0; a < 3; ++a)
             gs.vertices[static_cast<size_t>(c)][static_cast<size_t>(a)] =
-                s.vertices[s.indices[3 * static_cast<size_t>(snd.id) + static_cast<size_t>(c)]].pos[static_cast<size_t>(a)];
+                drawn.vertices[drawn.indices[3 * static_cast<size_t>(snd.id) + static_cast<size_t>(c)]].pos[static_cast<size_t>(a)];
         sends.push_back(gs);
       }
       const size_t g0 = e.finished_size();
@@ -449,6 +460,8 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     // The stream's end goes with the last frame.
     res->bytes_by_frame.back() += res->stream.size() - std::accumulate(res->bytes_by_frame.begin(), res->bytes_by_frame.end(), size_t{0});
     res->slots = slots;
+    res->polygons_sent = geo.first_sends + geo.resends;
+    res->polygons_resent = geo.resends;
     res->workspace_bytes = h.workspace_bytes;
     res->kbps = res->stream.size() * 8.0 / (n / path.fps) / 1000;
     res->preroll_ms = preroll_ms;

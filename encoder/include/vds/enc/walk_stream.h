@@ -71,6 +71,7 @@ struct WalkEncodeResult {
   // records' geometry, and the rest of the records (pose, views, framing).
   size_t header_bytes = 0, view_bytes = 0, geometry_bytes = 0, frame_bytes = 0;
   uint32_t slots = 0;
+  size_t polygons_sent = 0, polygons_resent = 0;  // the geometry: polygon sends, and those of a polygon sent before (evicted since)
   size_t workspace_bytes = 0;       // what the client needs beyond its chunk buffer
   double kbps = 0;                  // the whole stream over the path's duration
   double psnr_rgb = 0;              // the client's frames against the ground truth, pooled
@@ -85,6 +86,11 @@ WalkPose walk_pose(const CameraPose& p);
 // Back to a path pose (what the client's camera is).
 CameraPose from_walk_pose(const WalkPose& p);
 
-WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkEncodeOptions& o, bool keep_frames = false);
+// `s` is what the camera sees: the ground truth and the views are drawn
+// from it. `geometry`, if given, is what the client draws them onto: a
+// scene of the same shape in fewer triangles (walk_geometry_scene), whose
+// textures are s's; the visibility the plans work from is its own.
+WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkEncodeOptions& o, bool keep_frames = false,
+                             const Scene* geometry = nullptr);
 
 }  // namespace vds::enc
