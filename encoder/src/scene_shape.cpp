@@ -398,22 +398,18 @@ Scene simplify_shape(const Scene& s, const ShapeOptions& o, ShapeStats* stats) {
           if (p.x < m.x) continue;
           const double d = (p.x - m.x) * (p.x - m.x) + (p.y - m.y) * (p.y - m.y);
           if (d >= best) continue;
-          bool seen_clear = true;
-          for (size_t e = 0; e < outline.size() && seen_clear; ++e) {
-            const uint32_t ea = outline[e], eb = outline[(e + 1) % outline.size()];
-            if (ea == outline[j] || eb == outline[j]) continue;
-            const P2 a = at[ea], b = at[eb];
-            const double d1 = cross2(m, p, a), d2 = cross2(m, p, b), d3 = cross2(a, b, m), d4 = cross2(a, b, p);
-            if (((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0))) seen_clear = false;
-          }
-          for (size_t e = 0; e < h.size() && seen_clear; ++e) {
-            const uint32_t ea = h[e], eb = h[(e + 1) % h.size()];
-            if (ea == h[hi] || eb == h[hi]) continue;
-            const P2 a = at[ea], b = at[eb];
-            const double d1 = cross2(m, p, a), d2 = cross2(m, p, b), d3 = cross2(a, b, m), d4 = cross2(a, b, p);
-            if (((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0))) seen_clear = false;
-          }
-          if (seen_clear) {
+          // No edge of `l` but those ending at `end` crosses m-p.
+          const auto clear_of = [&](const std::vector<uint32_t>& l, uint32_t end) {
+            for (size_t e = 0; e < l.size(); ++e) {
+              const uint32_t ea = l[e], eb = l[(e + 1) % l.size()];
+              if (ea == end || eb == end) continue;
+              const P2 a = at[ea], b = at[eb];
+              const double d1 = cross2(m, p, a), d2 = cross2(m, p, b), d3 = cross2(a, b, m), d4 = cross2(a, b, p);
+              if (((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0))) return false;
+            }
+            return true;
+          };
+          if (clear_of(outline, outline[j]) && clear_of(h, h[hi])) {
             best = d;
             bj = j;
           }
