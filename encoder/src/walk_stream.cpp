@@ -186,6 +186,8 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vo.threshold = o.threshold;
   vo.lookahead = o.lookahead;
   vo.tolerance_px = static_cast<size_t>(o.tolerance * o.width * o.height);
+  vo.occlusion_margin = o.occlusion_margin;
+  vo.occlusion_updates = o.occlusion_updates;
   vo.width = o.width;
   vo.height = o.height;
   // Views see wider than the screen (a pan stays inside a view longer):

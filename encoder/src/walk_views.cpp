@@ -7,7 +7,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <unordered_set>
+#include <unordered_map>
 
 #include "vds/enc/scene_render.h"
 #include "vds/homography.h"
@@ -59,55 +59,117 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     scams.push_back(scene_camera(p, path.hfov_deg, o.width, o.height));
     vscams.push_back(scene_camera(p, view_hfov, vw, vh));
   }
-  // Polygons the view at each frame's camera shows, for "does view v show polygon p".
+  // Polygons the view at each frame's camera shows, with the pixels they
+  // cover there (at the frame's size), for "does view v show polygon p";
+  // the pixels each covers on each frame's screen.
   const auto& vv = view_visible != nullptr ? *view_visible : visible;
-  std::vector<std::unordered_set<uint32_t>> shows(n);
-  for (size_t f = 0; f < n; ++f)
-    for (const auto& [id, px] : vv[f]) shows[f].insert(id);
+  std::vector<std::unordered_map<uint32_t, uint32_t>> shows(n), on_screen(n);
+  for (size_t f = 0; f < n; ++f) {
+    for (const auto& [id, px] : vv[f]) shows[f][id] = px;
+    for (const auto& [id, px] : visible[f]) on_screen[f][id] = px;
+  }
+  // The cameras the view visibility was drawn with.
+  std::vector<SceneCamera> rcams;
+  for (const CameraPose& p : path.frames) rcams.push_back(scene_camera(p, view_hfov, o.width, o.height));
   const double inf = std::numeric_limits<double>::infinity();
   // The factor of the view at frame g for polygon id on frame f's screen
   // (+inf if g does not show it): the largest magnification of the
   // view -> screen map (the client's fixed-point homography_scale) at the
   // vertices of the part of the polygon frame f's screen shows, in front of
   // the view's near plane.
-  const auto factor = [&](size_t f, size_t g, uint32_t id) {
-    if (!shows[g].count(id)) return inf;
-    using P3 = std::array<double, 3>;
+  using P3 = std::array<double, 3>;
+  const auto comb = [](const P3& u, double su, const P3& w, double sw) {
+    return P3{u[0] * su + w[0] * sw, u[1] * su + w[1] * sw, u[2] * su + w[2] * sw};
+  };
+  struct Plane {
+    P3 a, c;
+    double b;
+  };
+  // Clips `poly` against planes a . (P - C) >= b.
+  const auto clip = [&](std::vector<P3>& poly, const Plane& pl) {
+    std::vector<P3> out;
+    const auto dist = [&](const P3& p) {
+      return pl.a[0] * (p[0] - pl.c[0]) + pl.a[1] * (p[1] - pl.c[1]) + pl.a[2] * (p[2] - pl.c[2]) - pl.b;
+    };
+    for (size_t i = 0; i < poly.size(); ++i) {
+      const P3& a = poly[i];
+      const P3& b = poly[(i + 1) % poly.size()];
+      const double da = dist(a), db = dist(b);
+      if (da >= 0) out.push_back(a);
+      if ((da >= 0) != (db >= 0)) out.push_back(comb(a, db / (db - da), b, -da / (db - da)));
+    }
+    poly.swap(out);
+  };
+  // The near plane and the four sides of a camera's frustum (w x h pixels).
+  const auto frustum = [&](const SceneCamera& c, int w, int h, std::vector<Plane>* planes) {
+    const double l = c.cx / c.focal, r = (w - c.cx) / c.focal, t = c.cy / c.focal, btm = (h - c.cy) / c.focal;
+    planes->push_back({c.forward, c.position, o.near_z});
+    planes->push_back({comb(c.right, 1, c.forward, l), c.position, 0});
+    planes->push_back({comb(c.right, -1, c.forward, r), c.position, 0});
+    planes->push_back({comb(c.down, 1, c.forward, t), c.position, 0});
+    planes->push_back({comb(c.down, -1, c.forward, btm), c.position, 0});
+  };
+  // The area in pixels of a polygon (inside camera c's frustum) on c's image.
+  const auto area_px = [&](const std::vector<P3>& poly, const SceneCamera& c) {
+    double a = 0;
+    std::vector<std::array<double, 2>> q;
+    for (const P3& p : poly) {
+      const P3 d{p[0] - c.position[0], p[1] - c.position[1], p[2] - c.position[2]};
+      const double z = d[0] * c.forward[0] + d[1] * c.forward[1] + d[2] * c.forward[2];
+      q.push_back({c.focal * (d[0] * c.right[0] + d[1] * c.right[1] + d[2] * c.right[2]) / z,
+                   c.focal * (d[0] * c.down[0] + d[1] * c.down[1] + d[2] * c.down[2]) / z});
+    }
+    for (size_t i = 0; i < q.size(); ++i) a += q[i][0] * q[(i + 1) % q.size()][1] - q[(i + 1) % q.size()][0] * q[i][1];
+    return std::fabs(a) / 2;
+  };
+  const auto corners = [&](uint32_t id) {
     std::vector<P3> poly;
     for (int k = 0; k < 3; ++k) {
       const auto& v = s.vertices[s.indices[3 * static_cast<size_t>(id) + static_cast<size_t>(k)]].pos;
       poly.push_back({v[0], v[1], v[2]});
     }
-    // Clip against planes a . (P - C) >= b of the screen's frustum and the view's near plane.
+    return poly;
+  };
+  // The share of a polygon's area inside camera c's frustum that camera
+  // sees (its pixels in the visibility drawn there over that area), -1 if
+  // the area is too small to tell.
+  const auto seen_share = [&](uint32_t id, const SceneCamera& c, uint32_t px) {
+    std::vector<P3> poly = corners(id);
+    std::vector<Plane> planes;
+    frustum(c, o.width, o.height, &planes);
+    for (const Plane& pl : planes) {
+      clip(poly, pl);
+      if (poly.empty()) return -1.0;
+    }
+    const double a = area_px(poly, c);
+    return a >= 24 ? std::min(1.0, px / a) : -1.0;
+  };
+  // Whether the view at frame g sees a clearly smaller share of the
+  // polygon than frame f's screen does: something stands in front of it
+  // there, which the view would draw onto it.
+  const auto occluded = [&](size_t f, size_t g, uint32_t id) {
+    if (f == g || !(o.occlusion_margin <= 1)) return false;
+    const auto shown = shows[g].find(id);
+    const auto sf = on_screen[f].find(id);
+    if (shown == shows[g].end() || sf == on_screen[f].end()) return false;
+    const double on = seen_share(id, scams[f], sf->second);
+    if (on < 0) return false;
+    const double in_view = seen_share(id, rcams[g], shown->second);
+    return in_view >= 0 && in_view < on - o.occlusion_margin;
+  };
+  const auto factor = [&](size_t f, size_t g, uint32_t id) {
+    const auto shown = shows[g].find(id);
+    if (shown == shows[g].end()) return inf;
+    if (o.occlusion_updates && occluded(f, g, id)) return inf;
+    std::vector<P3> poly = corners(id);
+    // Clip against the screen's frustum and the view's near plane.
     const SceneCamera& sc = scams[f];
     const SceneCamera& vc = vscams[g];
-    struct Plane {
-      P3 a, c;
-      double b;
-    };
-    const double l = sc.cx / sc.focal, r = (o.width - sc.cx) / sc.focal, t = sc.cy / sc.focal, btm = (o.height - sc.cy) / sc.focal;
-    const auto comb = [](const P3& u, double su, const P3& w, double sw) {
-      return P3{u[0] * su + w[0] * sw, u[1] * su + w[1] * sw, u[2] * su + w[2] * sw};
-    };
-    const Plane planes[6] = {{sc.forward, sc.position, o.near_z},
-                             {comb(sc.right, 1, sc.forward, l), sc.position, 0},
-                             {comb(sc.right, -1, sc.forward, r), sc.position, 0},
-                             {comb(sc.down, 1, sc.forward, t), sc.position, 0},
-                             {comb(sc.down, -1, sc.forward, btm), sc.position, 0},
-                             {vc.forward, vc.position, o.near_z * 1.01}};
+    std::vector<Plane> planes;
+    frustum(sc, o.width, o.height, &planes);
+    planes.push_back({vc.forward, vc.position, o.near_z * 1.01});
     for (const Plane& pl : planes) {
-      std::vector<P3> out;
-      const auto dist = [&](const P3& p) {
-        return pl.a[0] * (p[0] - pl.c[0]) + pl.a[1] * (p[1] - pl.c[1]) + pl.a[2] * (p[2] - pl.c[2]) - pl.b;
-      };
-      for (size_t i = 0; i < poly.size(); ++i) {
-        const P3& a = poly[i];
-        const P3& b = poly[(i + 1) % poly.size()];
-        const double da = dist(a), db = dist(b);
-        if (da >= 0) out.push_back(a);
-        if ((da >= 0) != (db >= 0)) out.push_back(comb(a, db / (db - da), b, -da / (db - da)));
-      }
-      poly.swap(out);
+      clip(poly, pl);
       if (poly.empty()) return inf;
     }
     Vec3<Q16_16> tri[3];
@@ -174,14 +236,18 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
       held[victim] = static_cast<int64_t>(best);
       plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(best)});
     }
-    // Each polygon's view: the smallest factor.
+    // Each polygon's view: the smallest factor, among the views that are
+    // not occluded there if any serves it.
     for (const auto& [id, px] : visible[f]) {
       int8_t pick = -1;
       double q = std::numeric_limits<double>::infinity();
+      bool pick_occluded = true;
       for (size_t k = 0; k < held.size(); ++k) {
         if (held[k] < 0) continue;
         const double fk = factor(f, static_cast<size_t>(held[k]), id);
-        if (fk < q) q = fk, pick = static_cast<int8_t>(k);
+        if (fk == inf) continue;
+        const bool occ = occluded(f, static_cast<size_t>(held[k]), id);
+        if (pick < 0 || (pick_occluded && !occ) || (occ == pick_occluded && fk < q)) q = fk, pick = static_cast<int8_t>(k), pick_occluded = occ;
       }
       plan.choice[f].push_back(pick);
       plan.pixels += px;

@@ -6,6 +6,7 @@
 // serves that frame itself at a factor of 1.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -41,6 +42,62 @@ TEST(WalkViews, TheClientCameraProjectsLikeTheGroundTruth) {
     EXPECT_NEAR(xq / 256.0, x, 0.02);
     EXPECT_NEAR(yq / 256.0, y, 0.02);
   }
+}
+
+// A quad of two triangles, corners counter-clockwise about `normal`.
+void add_quad(vds::enc::Scene& s, const std::array<std::array<float, 3>, 4>& c, const std::array<float, 3>& normal) {
+  vds::enc::SceneSurface f;
+  f.texture = 0;
+  f.first_index = static_cast<uint32_t>(s.indices.size());
+  const uint32_t base = static_cast<uint32_t>(s.vertices.size());
+  for (const auto& p : c) {
+    vds::enc::SceneVertex v;
+    v.pos = p;
+    v.normal = normal;
+    s.vertices.push_back(v);
+  }
+  for (uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) s.indices.push_back(base + k);
+  f.index_count = 6;
+  s.surfaces.push_back(f);
+}
+
+TEST(WalkViews, AViewThatSeesAPolygonOnlyPastWhatStandsInFrontOfItDoesNotServeIt) {
+  // A wall at x = 300 facing the origin, and a screen at x = 150 hiding
+  // its half y > 0 from the origin. Frame 0 looks at the wall from the
+  // origin; frame 1 from x = 200, in front of the screen, sees the whole
+  // wall. The view taken at frame 0 shows the wall's triangles (half of
+  // each): drawn onto frame 1 it would paint the screen onto the wall, so
+  // it cannot serve frame 1 and a view update comes there.
+  vds::enc::Scene s;
+  vds::enc::SceneTexture t;
+  t.name = "grey";
+  s.textures.push_back(t);
+  add_quad(s, {{{300, 150, -150}, {300, -150, -150}, {300, -150, 150}, {300, 150, 150}}}, {-1, 0, 0});
+  add_quad(s, {{{150, 150, -150}, {150, 0, -150}, {150, 0, 150}, {150, 150, 150}}}, {-1, 0, 0});
+  vds::enc::CameraPath path;
+  path.frames = {{0, 0, 0, 0, 0}, {200, 0, 0, 0, 0}};
+  vds::enc::RenderOptions ro;
+  ro.supersample = 1;
+  const vds::enc::SceneRenderer r(s, {}, ro);
+  Visible vis;
+  for (const auto& pose : path.frames) vis.push_back(vds::enc::visible_triangles(r.render(pose, path.hfov_deg)));
+  // Frame 0 sees both wall triangles, each only in part; frame 1 the wall alone.
+  ASSERT_EQ(vis[0].size(), 4u);
+  ASSERT_EQ(vis[1].size(), 2u);
+  vds::enc::WalkViewOptions o;
+  o.slots = 1;
+  o.threshold = 100;
+  o.lookahead = 0;
+  o.occlusion_margin = 0.2;
+  o.occlusion_updates = true;
+  const auto plan = vds::enc::plan_walk_views(s, path, vis, o);
+  ASSERT_EQ(plan.updates[0].size(), 1u);
+  ASSERT_EQ(plan.updates[1].size(), 1u);
+  EXPECT_EQ(plan.updates[1][0].camera_frame, 1u);
+  // Without the test the view of frame 0 serves frame 1.
+  o.occlusion_updates = false;
+  const auto blind = vds::enc::plan_walk_views(s, path, vis, o);
+  EXPECT_TRUE(blind.updates[1].empty());
 }
 
 TEST(WalkViews, ATourOfOaDm4IsServedWithinTheThreshold) {

@@ -42,6 +42,8 @@ struct WalkEncodeOptions {
   // distortion); measured not to pay on the figure maps (docs/walkthrough.md).
   bool predict = false;
   double tolerance = 0.005;  // share of a frame's pixels that may go without a view within the threshold
+  double occlusion_margin = 2;  // WalkViewOptions::occlusion_margin (over 1: no occlusion test)
+  bool occlusion_updates = false;  // WalkViewOptions::occlusion_updates
   int quality = -1;       // the views' image quality; -1: each view's by the rate control
   // The rate control: the stream is shaped for a link of rate_kbps into a
   // client whose stream window holds buffer_bytes, every frame's data there
