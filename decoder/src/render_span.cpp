@@ -15,14 +15,27 @@ namespace vds::detail {
 
 namespace {
 
-template <TexAddress A>
+// How a sampler addresses texels: wrapping (power-of-two sizes), clamped to
+// the edge, or as they come — only for the pixels of a span piece that
+// piece_inside() has shown to lie where clamping changes nothing.
+enum class Addr { repeat, clamp, inside };
+
+template <Addr A>
 inline int32_t tx(int32_t u, int32_t mask, int32_t max) {
-  if constexpr (A == TexAddress::repeat) {
+  if constexpr (A == Addr::repeat) {
     return u & mask;
-  } else {
+  } else if constexpr (A == Addr::clamp) {
     return u < 0 ? 0 : (u > max ? max : u);
+  } else {
+    return u;
   }
 }
+
+// The sample coordinates, lo <= u < uhi and vlo <= v < vhi, for which a
+// clamping sampler reads only texels clamping would not move.
+struct UvBox {
+  int32_t ulo, uhi, vlo, vhi;
+};
 
 // Colours: rgb565 as uint16_t, 8-bit channels as 0x00RRGGBB.
 inline uint32_t expand565(uint32_t c) {
@@ -31,32 +44,52 @@ inline uint32_t expand565(uint32_t c) {
 }
 
 // JFIF full-range Y'CbCr -> R'G'B' (colour.h, the image output's
-// constants), each channel rounded and clamped.
+// constants), each channel rounded and clamped. Channels: each channel's
+// value before clamping, plus 256: 0..767 for any Y', Cb, Cr. Each chroma value's part of the sums is looked up rather than
+// multiplied (3 KiB; the same values: R = Y + r[Cr], G = Y + ((g_cb[Cb] +
+// g_cr[Cr]) >> 16), B = Y + b[Cb], with the rounding half and the 256 in
+// the tables).
 struct Channels {
-  int32_t r, g, b;  // rounded, not yet clamped: -256..511
+  int32_t r, g, b;
 };
-inline Channels ycbcr_channels(int32_t y, int32_t cb, int32_t cr) {
+struct ChromaTables {
+  int16_t r[256], b[256];
+  int32_t g_cb[256], g_cr[256];
+};
+constexpr int32_t kChannelBias = 256;
+constexpr ChromaTables make_chroma_tables() {
   using namespace colour;
-  const int32_t cbd = cb - kChromaCentre, crd = cr - kChromaCentre;
-  return {y + ((kCrToR * crd + kHalf) >> kFracBits), y + ((-kCbToG * cbd - kCrToG * crd + kHalf) >> kFracBits),
-          y + ((kCbToB * cbd + kHalf) >> kFracBits)};
+  ChromaTables t{};
+  for (int c = 0; c < 256; ++c) {
+    const int32_t d = c - kChromaCentre;
+    t.r[c] = static_cast<int16_t>(((kCrToR * d + kHalf) >> kFracBits) + kChannelBias);
+    t.b[c] = static_cast<int16_t>(((kCbToB * d + kHalf) >> kFracBits) + kChannelBias);
+    t.g_cb[c] = -kCbToG * d;
+    t.g_cr[c] = -kCrToG * d + kHalf + (kChannelBias << kFracBits);
+  }
+  return t;
 }
-inline uint32_t ycbcr_to_rgb(int32_t y, int32_t cb, int32_t cr) {
+constexpr ChromaTables kChroma = make_chroma_tables();
+inline Channels ycbcr_channels(int32_t y, uint32_t cb, uint32_t cr) {
+  return {y + kChroma.r[cr], y + ((kChroma.g_cb[cb] + kChroma.g_cr[cr]) >> colour::kFracBits), y + kChroma.b[cb]};
+}
+inline uint32_t ycbcr_to_rgb(int32_t y, uint32_t cb, uint32_t cr) {
   const Channels c = ycbcr_channels(y, cb, cr);
-  return (static_cast<uint32_t>(sat_u8(c.r)) << 16) | (static_cast<uint32_t>(sat_u8(c.g)) << 8) | sat_u8(c.b);
+  return (static_cast<uint32_t>(sat_u8(c.r - kChannelBias)) << 16) | (static_cast<uint32_t>(sat_u8(c.g - kChannelBias)) << 8) |
+         sat_u8(c.b - kChannelBias);
 }
 
-// The same straight to RGB565: each channel's value before clamping
-// (-256..511 for any Y', Cb, Cr) indexes a table holding it clamped,
-// rounded to 5 or 6 bits (pack565's rounding) and in place. Exactly
-// pack565(ycbcr_to_rgb(...)), in about 14 instructions less on a Cortex-M4.
+// The same straight to RGB565: each channel's biased value indexes a table
+// holding it clamped, rounded to 5 or 6 bits (pack565's rounding) and in
+// place. Exactly pack565(ycbcr_to_rgb(...)), in about 20 instructions less
+// on a Cortex-M4.
 struct Pack565Table {
   uint16_t r[768], g[768], b[768];
 };
 constexpr Pack565Table make_pack565_table() {
   Pack565Table t{};
   for (int i = 0; i < 768; ++i) {
-    const uint32_t v = static_cast<uint32_t>(i < 256 ? 0 : (i > 511 ? 255 : i - 256));
+    const uint32_t v = static_cast<uint32_t>(i < kChannelBias ? 0 : (i > kChannelBias + 255 ? 255 : i - kChannelBias));
     t.r[i] = static_cast<uint16_t>(((v * 249 + 1014) >> 11) << 11);
     t.g[i] = static_cast<uint16_t>(((v * 253 + 505) >> 10) << 5);
     t.b[i] = static_cast<uint16_t>((v * 249 + 1014) >> 11);
@@ -64,9 +97,9 @@ constexpr Pack565Table make_pack565_table() {
   return t;
 }
 constexpr Pack565Table kPack565 = make_pack565_table();
-inline uint16_t ycbcr_to_565(int32_t y, int32_t cb, int32_t cr) {
+inline uint16_t ycbcr_to_565(int32_t y, uint32_t cb, uint32_t cr) {
   const Channels c = ycbcr_channels(y, cb, cr);
-  return static_cast<uint16_t>(kPack565.r[c.r + 256] | kPack565.g[c.g + 256] | kPack565.b[c.b + 256]);
+  return static_cast<uint16_t>(kPack565.r[c.r] | kPack565.g[c.g] | kPack565.b[c.b]);
 }
 
 // Blend of two 0x00RR00BB (or 0x0000GG00) words with an 8-bit weight f of b:
@@ -106,7 +139,7 @@ inline OutColor<O> from8888(uint32_t c) {
 
 // Y'CbCr to the output format.
 template <PixelFormat O>
-inline OutColor<O> from_ycbcr(int32_t y, int32_t cb, int32_t cr) {
+inline OutColor<O> from_ycbcr(int32_t y, uint32_t cb, uint32_t cr) {
   if constexpr (O == PixelFormat::rgb565) {
     return ycbcr_to_565(y, cb, cr);
   } else {
@@ -139,10 +172,15 @@ struct TexSampler {
   static const TexCtx& ctx(const PolySetup& s) { return s.tex; }
 };
 
-template <TexFormat TF, TexAddress A, PixelFormat O>
+template <TexFormat TF, Addr A, PixelFormat O>
 struct NearestSampler : TexSampler {
   static constexpr int kFracBits = 0;
   static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
+  static constexpr bool kHasInside = A == Addr::clamp && TF == TexFormat::ycbcr420;  // texture_span: the views (flash)
+  using Inside = NearestSampler<TF, Addr::inside, O>;
+  // Every texel of the texture (a 4:2:0 chroma texel (col/2, row/2) is then
+  // inside too: col <= wmax gives col/2 <= cwmax).
+  static UvBox inside_box(const TexCtx& t) { return {0, t.wmax + 1, 0, t.hmax + 1}; }
   // (u, v): the texel containing the sample point.
   static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
     const int32_t col = tx<A>(u, t.wmask, t.wmax);
@@ -168,11 +206,26 @@ constexpr int bilinear_frac_bits(TexFormat tf, PixelFormat o) {
 
 // kNearestChroma (Y'CbCr 4:2:0, Filter::bilinear_luma): chroma from the
 // chroma texel the sample point lies in instead of blended.
-template <TexFormat TF, TexAddress A, PixelFormat O, bool kNearestChroma>
+template <TexFormat TF, Addr A, PixelFormat O, bool kNearestChroma>
 struct BilinearBlend : TexSampler {
   static constexpr int kFracBits = bilinear_frac_bits(TF, O);
   static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
   static constexpr uint32_t kFracMask = (1u << kFracBits) - 1;
+  static constexpr bool kHasInside = A == Addr::clamp && TF == TexFormat::ycbcr420;
+  using Inside = BilinearBlend<TF, Addr::inside, O, kNearestChroma>;
+  // Texel pairs i0, i0 + 1 both inside: 0 <= u < wmax 2^F. The 4:2:0
+  // chroma texel of the nearest rule, (u + 128) >> 9, is then inside too
+  // (u + 128 < 256 w <= 512 cw); the bilinear chroma pair needs
+  // 0 <= cu = u/2 - 64 < cwmax 256 as well.
+  static UvBox inside_box(const TexCtx& t) {
+    UvBox b{0, t.wmax << kFracBits, 0, t.hmax << kFracBits};
+    if constexpr (TF == TexFormat::ycbcr420 && !kNearestChroma) {
+      b.ulo = b.vlo = 128;
+      b.uhi = b.uhi < (t.cwmax << 9) + 128 ? b.uhi : (t.cwmax << 9) + 128;
+      b.vhi = b.vhi < (t.chmax << 9) + 128 ? b.vhi : (t.chmax << 9) + 128;
+    }
+    return b;
+  }
   // (u, v): the sample point minus half a texel, kFracBits fraction bits.
   static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
     const int32_t i0 = u >> kFracBits, j0 = v >> kFracBits;
@@ -200,7 +253,7 @@ struct BilinearBlend : TexSampler {
         const uint32_t s1 = static_cast<uint32_t>(tx<A>((cv >> 8) + 1, t.chmask, t.chmax)) * t.cstride;
         const uint32_t cb = lerp8(lerp8(t.cb[s0 + k0], t.cb[s0 + k1], gu), lerp8(t.cb[s1 + k0], t.cb[s1 + k1], gu), gv);
         const uint32_t cr = lerp8(lerp8(t.cr[s0 + k0], t.cr[s0 + k1], gu), lerp8(t.cr[s1 + k0], t.cr[s1 + k1], gu), gv);
-        return from_ycbcr<O>(static_cast<int32_t>(yy), static_cast<int32_t>(cb), static_cast<int32_t>(cr));
+        return from_ycbcr<O>(static_cast<int32_t>(yy), cb, cr);
       }
     } else if constexpr (TF == TexFormat::rgb565 && O == PixelFormat::rgb565) {
       const uint16_t* p = reinterpret_cast<const uint16_t*>(t.base);
@@ -214,24 +267,26 @@ struct BilinearBlend : TexSampler {
   }
 };
 
-template <TexFormat TF, TexAddress A, PixelFormat O>
+template <TexFormat TF, Addr A, PixelFormat O>
 using BilinearSampler = BilinearBlend<TF, A, O, false>;
-template <TexFormat TF, TexAddress A, PixelFormat O>
+template <TexFormat TF, Addr A, PixelFormat O>
 using LumaBilinearSampler = BilinearBlend<TF, A, O, true>;
 
 // Bilinear filtering of a texture with an apron (Texture::apron): the right
 // and lower neighbours are at +1 and +stride whatever the addressing. Clamp
 // addressing clamps the sample position to [0, size - 1] before splitting it,
 // which gives exactly the clamp-to-edge result (the neighbour then has weight 0).
-template <TexFormat TF, TexAddress A, PixelFormat O>
+template <TexFormat TF, Addr A, PixelFormat O>
 struct BilinearApronSampler : TexSampler {
   static constexpr int kFracBits = bilinear_frac_bits(TF, O);
   static constexpr bool kInlineStart = TF == TexFormat::rgb565 && O == PixelFormat::rgb565;
+  static constexpr bool kHasInside = false;  // its clamp is two compares a coordinate
+  using Inside = void;
   static constexpr uint32_t kFracMask = (1u << kFracBits) - 1;
   static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
     uint32_t index;
     uint32_t fu, fv;
-    if constexpr (A == TexAddress::repeat) {
+    if constexpr (A == Addr::repeat) {
       index = static_cast<uint32_t>((v >> kFracBits) & t.hmask) * t.stride + static_cast<uint32_t>((u >> kFracBits) & t.wmask);
       fu = static_cast<uint32_t>(u) & kFracMask;
       fv = static_cast<uint32_t>(v) & kFracMask;
@@ -279,6 +334,8 @@ inline uint32_t lattice_index(const LatticeFace& f, int32_t R, int32_t i, int32_
 
 struct LatticeSampler {
   using Ctx = LatticeCtx;
+  static constexpr bool kHasInside = false;
+  using Inside = void;
   static const LatticeCtx& ctx(const PolySetup& s) { return s.lat; }
 };
 
@@ -377,7 +434,7 @@ struct LatticeLinearSampler : LatticeSampler {
     const int32_t y = (w0 * t.y[k0] + w1 * t.y[k1] + w2 * t.y[k2] + kHalf) >> kF;
     const int32_t cb = (w0 * t.cb[k0] + w1 * t.cb[k1] + w2 * t.cb[k2] + kHalf) >> kF;
     const int32_t cr = (w0 * t.cr[k0] + w1 * t.cr[k1] + w2 * t.cr[k2] + kHalf) >> kF;
-    return from_ycbcr<O>(y, cb, cr);
+    return from_ycbcr<O>(y, static_cast<uint32_t>(cb), static_cast<uint32_t>(cr));
   }
 };
 
@@ -642,6 +699,63 @@ inline uint8_t* pixel_at(uint8_t* oe, DT* ze, uintptr_t delta, int32_t i) {
   }
 }
 
+// The pixels of one span piece: i = -len .. -1 from the piece end (ze, oe).
+template <class Sampler, bool kProj, PixelFormat O, DepthFormat D>
+[[gnu::always_inline]] inline void span_pixels(typename Depth<D>::T* ze, uint8_t* oe, int32_t len, const RowState& r,
+                                               const typename Sampler::Ctx& tex) {
+  using DT = typename Depth<D>::T;
+  const uintptr_t delta = reinterpret_cast<uintptr_t>(oe) -
+                          (reinterpret_cast<uintptr_t>(ze) >> (sizeof(DT) == 2 * Store<O>::kBytes ? 1 : 0));
+  int32_t q = r.q, w = r.w, u = r.n[0], v = r.n[1];
+  const int32_t dq = r.dq, dw = r.dw, du = r.dn[0], dv = r.dn[1];
+  const int32_t shb = r.sh_base;
+  int32_t i = -len;
+  do {
+    const DT d = Depth<D>::value(q);
+    if (d > ze[i]) {
+      ze[i] = d;
+      int z;
+      const int32_t yr = recip_y(static_cast<uint32_t>(kProj ? w : q), z);
+      const int sh = shb - z;
+      Store<O>::put(pixel_at<O, DT>(oe, ze, delta, i), Sampler::sample(tex, scaled(u, yr, sh), scaled(v, yr, sh)));
+    }
+    q = wrap_add32(q, dq);
+    if constexpr (kProj) w = wrap_add32(w, dw);
+    u = wrap_add32(u, du);
+    v = wrap_add32(v, dv);
+  } while (++i != 0);
+}
+
+// The sample coordinates of pixel k of a piece, as span_pixels computes them.
+template <bool kProj>
+inline void piece_uv(const RowState& r, int32_t k, int32_t* u, int32_t* v) {
+  // Inside the piece no value wraps (row_fast and row_piece check both ends).
+  const int32_t q = static_cast<int32_t>(r.q + int64_t{r.dq} * k);
+  const int32_t w = static_cast<int32_t>(r.w + int64_t{r.dw} * k);
+  int z;
+  const int32_t yr = recip_y(static_cast<uint32_t>(kProj ? w : q), z);
+  const int sh = r.sh_base - z;
+  *u = scaled(static_cast<int32_t>(r.n[0] + int64_t{r.dn[0]} * k), yr, sh);
+  *v = scaled(static_cast<int32_t>(r.n[1] + int64_t{r.dn[1]} * k), yr, sh);
+}
+
+// Whether every pixel of the piece samples inside the box. Over a piece the
+// numerators and the divisor W > 0 are linear in the pixel, so N / W is
+// monotonic and lies between its values at the two ends; the loop's value
+// is N / W times (1 + e) rounded down, |e| < 2^-18 (recip_y), so it lies
+// within |N / W| 2^-18 + 1 of it. Both ends at least a margin m > 2 (that
+// + 1) inside the box therefore keep every pixel between them inside.
+template <bool kProj>
+inline bool piece_inside(const RowState& r, int32_t len, const UvBox& b) {
+  const int32_t far = (b.uhi > b.vhi ? b.uhi : b.vhi);
+  const int32_t m = (far >> 16) + 8;
+  int32_t u0, v0, u1, v1;
+  piece_uv<kProj>(r, 0, &u0, &v0);
+  piece_uv<kProj>(r, len - 1, &u1, &v1);
+  const auto in = [m](int32_t x, int32_t lo, int32_t hi) { return x >= lo + m && x < hi - m; };
+  return in(u0, b.ulo, b.uhi) && in(u1, b.ulo, b.uhi) && in(v0, b.vlo, b.vhi) && in(v1, b.vlo, b.vhi);
+}
+
 template <class Sampler, bool kProj, PixelFormat O, DepthFormat D>
 void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa, int32_t xb) {
   using DT = typename Depth<D>::T;
@@ -666,26 +780,17 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
     // Both buffers are indexed from the piece end with i = -len .. -1.
     DT* const ze = zrow + xa + len;
     uint8_t* const oe = crow + (xa + len) * Store<O>::kBytes;
-    const uintptr_t delta = reinterpret_cast<uintptr_t>(oe) -
-                            (reinterpret_cast<uintptr_t>(ze) >> (sizeof(DT) == 2 * Store<O>::kBytes ? 1 : 0));
-    int32_t q = r.q, w = r.w, u = r.n[0], v = r.n[1];
-    const int32_t dq = r.dq, dw = r.dw, du = r.dn[0], dv = r.dn[1];
-    const int32_t shb = r.sh_base;
-    int32_t i = -len;
-    do {
-      const DT d = Depth<D>::value(q);
-      if (d > ze[i]) {
-        ze[i] = d;
-        int z;
-        const int32_t yr = recip_y(static_cast<uint32_t>(kProj ? w : q), z);
-        const int sh = shb - z;
-        Store<O>::put(pixel_at<O, DT>(oe, ze, delta, i), Sampler::sample(tex, scaled(u, yr, sh), scaled(v, yr, sh)));
+    // A clamping sampler whose piece lies inside the texture samples it
+    // without the clamps (the same texels: about 20 Cortex-M4 instructions
+    // a pixel less for bilinear 4:2:0).
+    if constexpr (Sampler::kHasInside) {
+      if (piece_inside<kProj>(r, len, Sampler::inside_box(tex))) {
+        span_pixels<typename Sampler::Inside, kProj, O, D>(ze, oe, len, r, tex);
+        xa += len;
+        continue;
       }
-      q = wrap_add32(q, dq);
-      if constexpr (kProj) w = wrap_add32(w, dw);
-      u = wrap_add32(u, du);
-      v = wrap_add32(v, dv);
-    } while (++i != 0);
+    }
+    span_pixels<Sampler, kProj, O, D>(ze, oe, len, r, tex);
     xa += len;
   }
 }
@@ -730,14 +835,12 @@ void gouraud_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
 // ---------------------------------------------------------------------------
 // Span function selection (the formats compiled in: vds/config.h)
 // ---------------------------------------------------------------------------
-template <template <TexFormat, TexAddress, PixelFormat> class S, TexFormat TF, PixelFormat O, DepthFormat D>
+template <template <TexFormat, Addr, PixelFormat> class S, TexFormat TF, PixelFormat O, DepthFormat D>
 SpanFn pick_address(bool repeat, bool proj) {
   if (repeat) {
-    return proj ? &texture_span<S<TF, TexAddress::repeat, O>, true, O, D>
-                : &texture_span<S<TF, TexAddress::repeat, O>, false, O, D>;
+    return proj ? &texture_span<S<TF, Addr::repeat, O>, true, O, D> : &texture_span<S<TF, Addr::repeat, O>, false, O, D>;
   }
-  return proj ? &texture_span<S<TF, TexAddress::clamp, O>, true, O, D>
-              : &texture_span<S<TF, TexAddress::clamp, O>, false, O, D>;
+  return proj ? &texture_span<S<TF, Addr::clamp, O>, true, O, D> : &texture_span<S<TF, Addr::clamp, O>, false, O, D>;
 }
 
 template <TexFormat TF, PixelFormat O, DepthFormat D>

@@ -12,10 +12,12 @@
 #include <cstdint>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "../../decoder/src/render_internal.h"
 #include "vds/crc32c.h"
+#include "vds/homography.h"
 #include "vds/enc/image_io.h"
 #include "vds/ref/render.h"
 #include "vds/ref/scene.h"
@@ -407,6 +409,138 @@ TEST(RenderDegenerate, HostileCoordinatesAreSafe) {
       Renderer r;
       ASSERT_EQ(r.init(cfg, arena), Status::ok);
       EXPECT_EQ(r.render(cam, list, 0, [](void*, const Band&) { return true; }, nullptr), Status::ok);
+    }
+  }
+}
+
+// A clamping sampler reads only the texels of its texture, and the same
+// ones whether a span lies inside it (sampled without the clamps) or
+// reaches past an edge. Each texture is drawn twice: its planes in arrays of
+// exactly its size (AddressSanitizer catches a read past the last row) and
+// inside larger planes whose surround is noise (a read past any edge then
+// changes the picture). Perspective-mapped triangles over the texture's
+// edges and inside it, every filter, both mappings (texture coordinates and
+// a view's homography), odd and even sizes.
+TEST(RenderSpans, ClampedTexturesAreReadOnlyInsideWithOrWithoutTheClamps) {
+  std::mt19937 rng(2024);
+  const auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
+  const auto q = [](double x) { return Q16_16::from_raw(static_cast<int32_t>(std::lround(x * 65536))); };
+  const ref::CameraD screen_d = ref::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, 96, 72, 60, 0.1, 60);
+  const Camera screen = ref::to_client(screen_d);
+  for (const auto& [w, h] : {std::pair{37, 23}, std::pair{32, 16}, std::pair{5, 3}}) {
+    for (TexFormat tf : {TexFormat::rgb565, TexFormat::xrgb8888, TexFormat::ycbcr420}) {
+      // Tight planes and padded ones (a border of 3 texels of noise).
+      const int bpp = tf == TexFormat::rgb565 ? 2 : (tf == TexFormat::xrgb8888 ? 4 : 1);
+      const int cw = (w + 1) / 2, ch = (h + 1) / 2, pad = 3;
+      std::vector<uint8_t> ty(static_cast<size_t>(w * h * bpp)), tcb(static_cast<size_t>(cw * ch)), tcr(tcb.size());
+      for (auto& b : ty) b = static_cast<uint8_t>(rng());
+      for (auto& b : tcb) b = static_cast<uint8_t>(rng());
+      for (auto& b : tcr) b = static_cast<uint8_t>(rng());
+      const int pw = w + 2 * pad, ph = h + 2 * pad, pcw = cw + 2 * pad, pch = ch + 2 * pad;
+      std::vector<uint8_t> py(static_cast<size_t>(pw * ph * bpp)), pcb(static_cast<size_t>(pcw * pch)), pcr(pcb.size());
+      for (auto& b : py) b = static_cast<uint8_t>(rng());
+      for (auto& b : pcb) b = static_cast<uint8_t>(rng());
+      for (auto& b : pcr) b = static_cast<uint8_t>(rng());
+      for (int r = 0; r < h; ++r)
+        std::memcpy(&py[static_cast<size_t>(((r + pad) * pw + pad) * bpp)], &ty[static_cast<size_t>(r * w * bpp)], static_cast<size_t>(w * bpp));
+      for (int r = 0; r < ch; ++r) {
+        std::memcpy(&pcb[static_cast<size_t>((r + pad) * pcw + pad)], &tcb[static_cast<size_t>(r * cw)], static_cast<size_t>(cw));
+        std::memcpy(&pcr[static_cast<size_t>((r + pad) * pcw + pad)], &tcr[static_cast<size_t>(r * cw)], static_cast<size_t>(cw));
+      }
+      Texture tight;
+      tight.format = tf;
+      tight.address = TexAddress::clamp;
+      tight.width = static_cast<uint16_t>(w);
+      tight.height = static_cast<uint16_t>(h);
+      tight.stride = static_cast<uint32_t>(w);
+      tight.texels = ty.data();
+      Texture padded = tight;
+      padded.stride = static_cast<uint32_t>(pw);
+      padded.texels = &py[static_cast<size_t>((pad * pw + pad) * bpp)];
+      if (tf == TexFormat::ycbcr420) {
+        tight.cb = tcb.data();
+        tight.cr = tcr.data();
+        tight.chroma_stride = static_cast<uint32_t>(cw);
+        padded.cb = &pcb[static_cast<size_t>(pad * pcw + pad)];
+        padded.cr = &pcr[static_cast<size_t>(pad * pcw + pad)];
+        padded.chroma_stride = static_cast<uint32_t>(pcw);
+      }
+      // Triangles in front of the screen; each mesh maps them from a view
+      // camera of the texture's size near the screen's (view_mapped), or by
+      // texture coordinates from just outside the texture to inside it.
+      std::vector<Vec3<Q16_16>> pos;
+      std::vector<TexCoord> uvs;
+      std::vector<uint16_t> idx;
+      std::vector<Mesh> meshes;
+      const std::vector<Filter> filters = tf == TexFormat::ycbcr420
+                                              ? std::vector<Filter>{Filter::nearest, Filter::bilinear, Filter::bilinear_luma}
+                                              : std::vector<Filter>{Filter::nearest, Filter::bilinear};
+      constexpr int kTriangles = 24;
+      idx.assign(static_cast<size_t>(2 * filters.size() * kTriangles * 3), 0);
+      for (size_t k = 0; k < 2 * filters.size(); ++k) {
+        Mesh m;
+        m.shading = k % 2 == 0 ? Shading::texture : Shading::view_mapped;
+        m.filter = filters[k / 2];
+        m.cull = Cull::none;
+        m.indices = &idx[k * kTriangles * 3];
+        m.num_triangles = kTriangles;
+        const double z = uni(2, 8);
+        const double corner[3][3] = {{-1, -1, z}, {1, -1, z + uni(-1, 1)}, {0, 1, z + uni(-1, 1)}};
+        const Vec3<Q16_16> plane[3] = {{q(corner[0][0]), q(corner[0][1]), q(corner[0][2])},
+                                       {q(corner[1][0]), q(corner[1][1]), q(corner[1][2])},
+                                       {q(corner[2][0]), q(corner[2][1]), q(corner[2][2])}};
+        if (m.shading == Shading::view_mapped) {
+          // Behind the screen's camera, so that the plane fits its few
+          // texels; a focal length the client takes (>= 32 pixels).
+          const double fov_y = 2 * std::atan(h / 2.0 / uni(34, 60)) * 180 / M_PI;
+          const ref::CameraD vd = ref::CameraD::look_at({uni(-0.5, 0.5), uni(-0.5, 0.5), -uni(4, 12)}, {uni(-0.3, 0.3), uni(-0.3, 0.3), z},
+                                                        {0, 1, 0}, w, h, fov_y, 0.1, 60);
+          EXPECT_EQ(plane_homography(screen, ref::to_client(vd), plane, &m.view_map), Status::ok);
+        }
+        // Points of the plane across the screen.
+        const auto on_plane = [&]() {
+          const double a = uni(0, 1), b = uni(0, 1 - a);
+          double v[3];
+          for (int c = 0; c < 3; ++c) {
+            const double big = 4;  // beyond the triangle: the plane, not just the triangle
+            v[c] = corner[0][c] + (a * big - 1) * (corner[1][c] - corner[0][c]) + (b * big - 1) * (corner[2][c] - corner[0][c]);
+          }
+          return Vec3<Q16_16>{q(v[0]), q(v[1]), q(v[2])};
+        };
+        for (int t = 0; t < kTriangles * 3; ++t) {
+          idx[k * kTriangles * 3 + static_cast<size_t>(t)] = static_cast<uint16_t>(pos.size());
+          pos.push_back(on_plane());
+          uvs.push_back({q(uni(-1.5, w + 1.5)), q(uni(-1.5, h + 1.5))});
+        }
+        meshes.push_back(m);
+      }
+      for (Mesh& m : meshes) m.uvs = uvs.data();
+      std::vector<uint8_t> frames[2];
+      for (int variant = 0; variant < 2; ++variant) {
+        for (Mesh& m : meshes) m.texture = variant == 0 ? &tight : &padded;
+        DrawList list{pos.data(), static_cast<uint32_t>(pos.size()), meshes.data(), static_cast<uint32_t>(meshes.size())};
+        RenderConfig cfg;
+        cfg.width = 96;
+        cfg.height = 72;
+        cfg.band_height = 72;
+        cfg.format = PixelFormat::rgb888;
+        cfg.depth = DepthFormat::d32;
+        std::vector<uint8_t> ws(render_workspace_size(cfg));
+        Arena arena(ws.data(), ws.size());
+        Renderer r;
+        ASSERT_EQ(r.init(cfg, arena), Status::ok);
+        struct Sink {
+          std::vector<uint8_t>* out;
+          static bool put(void* ctx, const Band& b) {
+            auto* out = static_cast<Sink*>(ctx)->out;
+            for (int y = 0; y < b.height; ++y) out->insert(out->end(), b.pixels + y * b.stride, b.pixels + y * b.stride + b.width * 3);
+            return true;
+          }
+        } sink{&frames[variant]};
+        ASSERT_EQ(r.render(screen, list, 0, &Sink::put, &sink), Status::ok);
+        EXPECT_GT(r.stats().pixels, 96u * 72u / 2) << "the triangles cover the screen";
+      }
+      EXPECT_EQ(frames[0], frames[1]) << w << "x" << h << " " << tex_name(tf);
     }
   }
 }
