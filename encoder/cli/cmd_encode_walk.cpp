@@ -20,9 +20,9 @@ namespace {
 
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, per_frame, size = "240x180";
-  double rate = 16, threshold = 18, widen = -1, view_scale = -1, occlusion = -1;
+  double rate = 16, threshold = 18, widen = -1, view_scale = -1, occlusion = -1, occlusion_tolerance = -1;
   int lookahead = -1, preroll = -1, window = -1, max_sends = -1;
-  bool predict = false, keep_triangles = false, occlusion_updates = false;
+  bool predict = false, keep_triangles = false, no_occlusion_updates = false;
   int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
 };
 
@@ -53,8 +53,8 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   if (o.lookahead >= 0) wo.lookahead = o.lookahead;
   if (o.widen > 0) wo.view_widen = o.widen;
   if (o.occlusion >= 0) wo.occlusion_margin = o.occlusion;
-  wo.occlusion_updates = o.occlusion_updates;
-  if (o.occlusion_updates && o.occlusion < 0) wo.occlusion_margin = 0.5;
+  if (o.no_occlusion_updates) wo.occlusion_updates = false;
+  if (o.occlusion_tolerance >= 0) wo.occlusion_tolerance = o.occlusion_tolerance;
   if (o.view_scale > 0) wo.view_scale = o.view_scale;
   if (o.refine_delta >= 0) wo.refine_delta = o.refine_delta;
   if (o.refine_after >= 0) wo.refine_after = o.refine_after;
@@ -136,9 +136,13 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--view-scale", o->view_scale, "The views' size over the frame's, each side (default 2/3)")->check(CLI::Range(0.1, 1.0));
   sub->add_option("--occlusion-margin", o->occlusion,
                   "A view seeing this much less of a polygon than the screen does (share of its area) is occluded for it: "
-                  "another view draws it if one serves it (default: no such test; 0.5 with --occlusion-updates)")
+                  "another view draws it if one serves it (default 0.5; over 1: no such test)")
       ->check(CLI::Range(0.0, 2.0));
-  sub->add_flag("--occlusion-updates", o->occlusion_updates, "An occluded view does not serve the polygon: a view update comes instead");
+  sub->add_option("--occlusion-tolerance", o->occlusion_tolerance,
+                  "The share of a frame's pixels that only occluded views may serve before a view update (default 0.02)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_flag("--no-occlusion-updates", o->no_occlusion_updates,
+                "No view updates for occluded views (they only lose to views that are not occluded)");
   sub->add_flag("--keep-triangles", o->keep_triangles,
                 "The client draws the views onto the scene's own triangles (default: neighbours in one plane merged)");
   sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");

@@ -188,6 +188,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vo.tolerance_px = static_cast<size_t>(o.tolerance * o.width * o.height);
   vo.occlusion_margin = o.occlusion_margin;
   vo.occlusion_updates = o.occlusion_updates;
+  vo.occlusion_tolerance_px = static_cast<size_t>(o.occlusion_tolerance * o.width * o.height);
   vo.width = o.width;
   vo.height = o.height;
   // Views see wider than the screen (a pan stays inside a view longer):

@@ -160,7 +160,6 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   const auto factor = [&](size_t f, size_t g, uint32_t id) {
     const auto shown = shows[g].find(id);
     if (shown == shows[g].end()) return inf;
-    if (o.occlusion_updates && occluded(f, g, id)) return inf;
     std::vector<P3> poly = corners(id);
     // Clip against the screen's frustum and the view's near plane.
     const SceneCamera& sc = scams[f];
@@ -196,18 +195,32 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   plan.updates.resize(n);
   plan.choice.resize(n);
   std::vector<int64_t> held(static_cast<size_t>(o.slots), -1);  // the camera frame of each slot's view
-  // Pixels of frame f that the views `v` leave unserved within the threshold.
-  const auto unserved_px = [&](size_t f, const std::vector<int64_t>& v) {
-    size_t px_out = 0;
+  // Whether the views `v` leave frame f unserved: more than tolerance_px
+  // of its pixels with no view within the threshold, or (occlusion_updates)
+  // more than occlusion_tolerance_px served only by occluded views.
+  const auto unserved = [&](size_t f, const std::vector<int64_t>& v) {
+    size_t px_out = 0, px_occluded = 0;
     for (const auto& entry : visible[f]) {
       const uint32_t id = entry.first;
-      if (std::none_of(v.begin(), v.end(), [&](int64_t g) { return g >= 0 && factor(f, static_cast<size_t>(g), id) <= limit; }))
+      bool served = false, clear = false;
+      for (const int64_t g : v) {
+        if (g < 0 || factor(f, static_cast<size_t>(g), id) > limit) continue;
+        served = true;
+        if (!o.occlusion_updates || !occluded(f, static_cast<size_t>(g), id)) {
+          clear = true;
+          break;
+        }
+      }
+      if (!served) {
         px_out += entry.second;
+      } else if (!clear) {
+        px_occluded += entry.second;
+      }
     }
-    return px_out;
+    return px_out > o.tolerance_px || px_occluded > o.occlusion_tolerance_px;
   };
   for (size_t f = 0; f < n; ++f) {
-    if (unserved_px(f, held) > o.tolerance_px) {
+    if (unserved(f, held)) {
       // An empty slot is filled first; else the slot whose view serves the
       // fewest of this frame's pixels goes.
       size_t victim = 0, victim_px = std::numeric_limits<size_t>::max();
@@ -228,9 +241,9 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
       for (size_t g = f; g <= last; ++g) {
         std::vector<int64_t> trial = held;
         trial[victim] = static_cast<int64_t>(g);
-        if (unserved_px(f, trial) > o.tolerance_px) continue;
+        if (unserved(f, trial)) continue;
         size_t run = 1;
-        while (f + run < n && run <= 2 * static_cast<size_t>(o.lookahead) && unserved_px(f + run, trial) <= o.tolerance_px) ++run;
+        while (f + run < n && run <= 2 * static_cast<size_t>(o.lookahead) && !unserved(f + run, trial)) ++run;
         if (run >= best_run) best = g, best_run = run;
       }
       held[victim] = static_cast<int64_t>(best);

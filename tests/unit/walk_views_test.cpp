@@ -98,6 +98,14 @@ TEST(WalkViews, AViewThatSeesAPolygonOnlyPastWhatStandsInFrontOfItDoesNotServeIt
   o.occlusion_updates = false;
   const auto blind = vds::enc::plan_walk_views(s, path, vis, o);
   EXPECT_TRUE(blind.updates[1].empty());
+  // With the test, but as many pixels as the frame has tolerated: no
+  // update, and the occluded view still draws the wall.
+  o.occlusion_updates = true;
+  o.occlusion_tolerance_px = size_t{1} << 30;
+  const auto tolerated = vds::enc::plan_walk_views(s, path, vis, o);
+  EXPECT_TRUE(tolerated.updates[1].empty());
+  ASSERT_EQ(tolerated.choice[1].size(), 2u);
+  for (const int8_t c : tolerated.choice[1]) EXPECT_EQ(c, 0);
 }
 
 TEST(WalkViews, ATourOfOaDm4IsServedWithinTheThreshold) {

@@ -42,8 +42,13 @@ struct WalkEncodeOptions {
   // distortion); measured not to pay on the figure maps (docs/walkthrough.md).
   bool predict = false;
   double tolerance = 0.005;  // share of a frame's pixels that may go without a view within the threshold
-  double occlusion_margin = 2;  // WalkViewOptions::occlusion_margin (over 1: no occlusion test)
-  bool occlusion_updates = false;  // WalkViewOptions::occlusion_updates
+  // Occluded views (WalkViewOptions::occlusion_margin, occlusion_updates;
+  // a margin over 1: no occlusion test), and the share of a frame's pixels
+  // that only occluded views may serve before an update is due. Measured in
+  // docs/walkthrough.md ("Occluded views").
+  double occlusion_margin = 0.5;
+  bool occlusion_updates = true;
+  double occlusion_tolerance = 0.02;
   int quality = -1;       // the views' image quality; -1: each view's by the rate control
   // The rate control: the stream is shaped for a link of rate_kbps into a
   // client whose stream window holds buffer_bytes, every frame's data there

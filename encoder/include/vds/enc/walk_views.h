@@ -49,12 +49,13 @@ struct WalkViewOptions {
   // inside the view, by the view's visibility) this much smaller than the
   // share the screen sees (> 1: no such test). A polygon is drawn from a
   // view that is not occluded for it when one serves it; with
-  // occlusion_updates an occluded view does not serve it at all (a view
-  // update comes instead). Measured (docs/walkthrough.md): the preference
-  // alone changes nothing on the figure maps, the updates meet the
-  // per-frame floor on oa_dm4 but cost oa_rpg3dm2 1.8 dB: off by default.
+  // occlusion_updates, a frame with more than occlusion_tolerance_px
+  // pixels that only occluded views serve gets a view update, like one
+  // with pixels no view serves. Off here; the walkthrough encoder's
+  // defaults (WalkEncodeOptions) turn it on.
   double occlusion_margin = 2;
   bool occlusion_updates = false;
+  size_t occlusion_tolerance_px = 0;
 };
 
 struct WalkViewPlan {
