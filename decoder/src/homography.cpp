@@ -158,9 +158,34 @@ int32_t ratio_sat(int64_t num, int64_t den, int frac) {
 
 }  // namespace
 
-Status plane_homography(const Camera& from, const Camera& to, const Vec3<Q16_16> plane[3], Homography* out) {
-  if (!out || !plane) return Status::invalid_argument;
+Status homography_cameras(const Camera& from, const Camera& to, HomographyCameras* out) {
+  if (!out) return Status::invalid_argument;
   if (validate_camera(from) != Status::ok || validate_camera(to) != Status::ok) return Status::invalid_argument;
+  const BMat left = mul(intrinsics_scaled(to), rotation(to, false));
+  const BMat rot = rotation(from, true);
+  const BMat kinv = inverse_intrinsics_scaled(from);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      out->left[i][j] = left.m[i][j];
+      out->rot_from[i][j] = rot.m[i][j];
+      out->kinv_from[i][j] = kinv.m[i][j];
+    }
+  out->left_e = left.e;
+  out->rot_from_e = rot.e;
+  out->kinv_from_e = kinv.e;
+  out->from_position = from.position;
+  out->to_position = to.position;
+  return Status::ok;
+}
+
+Status plane_homography(const Camera& from, const Camera& to, const Vec3<Q16_16> plane[3], Homography* out) {
+  HomographyCameras cams;
+  const Status s = homography_cameras(from, to, &cams);
+  return s != Status::ok ? s : plane_homography(cams, plane, out);
+}
+
+Status plane_homography(const HomographyCameras& cams, const Vec3<Q16_16> plane[3], Homography* out) {
+  if (!out || !plane) return Status::invalid_argument;
 
   // Plane normal n = (P1 - P0) x (P2 - P0); its scale cancels in the
   // homography, so each edge is normalised on its own.
@@ -174,13 +199,13 @@ Status plane_homography(const Camera& from, const Camera& to, const Vec3<Q16_16>
 
   // delta = n . (P0 - C_from): distance of the plane from the `from` centre
   // (times |n|). Zero means the plane contains that centre.
-  const BVec d = vec_diff(plane[0], from.position);
+  const BVec d = vec_diff(plane[0], cams.from_position);
   const int64_t delta = n.v[0] * d.v[0] + n.v[1] * d.v[1] + n.v[2] * d.v[2];  // < 3 * 2^58
   const int delta_e = n.e + d.e;
   if (delta == 0) return Status::invalid_argument;
 
   // M = delta I + (C_from - C_to) n^T, both terms in units of n x world.
-  const BVec c = vec_diff(from.position, to.position);
+  const BVec c = vec_diff(cams.from_position, cams.to_position);
   const bool same_centre = c.v[0] == 0 && c.v[1] == 0 && c.v[2] == 0;  // a pure rotation
   BMat m{};
   const int cn_e = c.e + n.e;
@@ -194,11 +219,20 @@ Status plane_homography(const Camera& from, const Camera& to, const Vec3<Q16_16>
   m.e = e;
   normalise(m);
 
-  // S^-1 H S = (S^-1 K_to) R_to M R_from^T (K_from^-1 S).
-  BMat h = mul(intrinsics_scaled(to), rotation(to, false));
-  h = mul(h, m);
-  h = mul(h, rotation(from, true));
-  h = mul(h, inverse_intrinsics_scaled(from));
+  // S^-1 H S = (S^-1 K_to) R_to M R_from^T (K_from^-1 S), in that order.
+  BMat left{}, rot{}, kinv{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      left.m[i][j] = cams.left[i][j];
+      rot.m[i][j] = cams.rot_from[i][j];
+      kinv.m[i][j] = cams.kinv_from[i][j];
+    }
+  left.e = cams.left_e;
+  rot.e = cams.rot_from_e;
+  kinv.e = cams.kinv_from_e;
+  BMat h = mul(left, m);
+  h = mul(h, rot);
+  h = mul(h, kinv);
 
   Homography r{};
   for (int i = 0; i < 3; ++i)

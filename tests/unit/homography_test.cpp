@@ -107,6 +107,35 @@ TEST(Homography, MapsScreenPointsLikeTheDoubleVersion) {
   RecordProperty("worst_map_error_px", std::to_string(worst));
 }
 
+// The cameras' part computed once serves every plane between them: the
+// same matrices, bit for bit, and the same refusals.
+TEST(Homography, CamerasComputedOnceGiveTheSameHomographyForEveryPlane) {
+  std::mt19937 rng(77);
+  int compared = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const PlaneCase s = random_setup(rng);
+    HomographyCameras pair;
+    ASSERT_EQ(homography_cameras(s.screen, s.view, &pair), Status::ok);
+    for (int k = 0; k < 20; ++k) {
+      PlaneCase other = random_setup(rng);
+      if (k == 19) other.plane[2] = other.plane[1];  // collinear: refused by both
+      Homography a{}, b{};
+      const Status sa = plane_homography(s.screen, s.view, other.plane, &a);
+      const Status sb = plane_homography(pair, other.plane, &b);
+      ASSERT_EQ(sa, sb);
+      if (sa != Status::ok) continue;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) ASSERT_EQ(a.m[i][j], b.m[i][j]) << trial << " " << k;
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 700);
+  Camera bad = random_setup(rng).screen;
+  bad.fx = Q16_16::from_int(1);
+  HomographyCameras pair;
+  EXPECT_EQ(homography_cameras(bad, bad, &pair), Status::invalid_argument);
+}
+
 TEST(Homography, ScreenPointsOfThePlaneLandOnTheirViewProjection) {
   // Geometric meaning: a point of the plane seen at screen pixel p is seen at
   // view pixel H p. The screen position is rounded to 1/256 pixel first, an

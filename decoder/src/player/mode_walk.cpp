@@ -171,11 +171,26 @@ Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
   const uint16_t* hot = p.walk_geometry.hot();
   const uint32_t n = p.walk_geometry.hot_count();
   for (uint32_t i = 0; i < n; ++i) {
-    const Vec3<Q16_16>* tri = p.walk_geometry.triangle(hot[i]);
-    Mesh& m = put_triangle(w, i, tri);
-    const uint8_t v = w.view_of[hot[i]];
-    m.texture = &w.view_tex[v];
-    m.num_triangles = w.view_ready[v] && plane_homography(cam, w.view_cam[v], tri, &m.view_map) == Status::ok ? 1 : 0;
+    Mesh& m = put_triangle(w, i, p.walk_geometry.triangle(hot[i]));
+    m.texture = &w.view_tex[w.view_of[hot[i]]];
+    m.num_triangles = 0;
+  }
+  // Each view's triangles, with what the screen's and the view's cameras
+  // alone give computed once (the same homographies, half the work).
+  for (uint8_t v = 0; v < kWalkMaxViews; ++v) {
+    if (!w.view_ready[v]) continue;
+    HomographyCameras pair;
+    Status ps = Status::invalid_argument;
+    bool pair_made = false;
+    for (uint32_t i = 0; i < n; ++i) {
+      if (w.view_of[hot[i]] != v) continue;
+      if (!pair_made) {
+        ps = homography_cameras(cam, w.view_cam[v], &pair);
+        pair_made = true;
+      }
+      Mesh& m = w.meshes[i];
+      m.num_triangles = ps == Status::ok && plane_homography(pair, p.walk_geometry.triangle(hot[i]), &m.view_map) == Status::ok ? 1 : 0;
+    }
   }
   return w.renderer.render(cam, draw_list(w, n), 0, detail::render_band_to_player, &p);
 }
