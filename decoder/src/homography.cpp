@@ -29,10 +29,7 @@ int64_t shift_round(int64_t v, int s) {
   return shr_round(v, s);
 }
 
-struct BMat {
-  int64_t m[3][3];
-  int e;  // value = m * 2^e
-};
+using BMat = HomographyCameras::BlockMatrix;
 struct BVec {
   int64_t v[3];
   int e;
@@ -161,18 +158,9 @@ int32_t ratio_sat(int64_t num, int64_t den, int frac) {
 Status homography_cameras(const Camera& from, const Camera& to, HomographyCameras* out) {
   if (!out) return Status::invalid_argument;
   if (validate_camera(from) != Status::ok || validate_camera(to) != Status::ok) return Status::invalid_argument;
-  const BMat left = mul(intrinsics_scaled(to), rotation(to, false));
-  const BMat rot = rotation(from, true);
-  const BMat kinv = inverse_intrinsics_scaled(from);
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      out->left[i][j] = left.m[i][j];
-      out->rot_from[i][j] = rot.m[i][j];
-      out->kinv_from[i][j] = kinv.m[i][j];
-    }
-  out->left_e = left.e;
-  out->rot_from_e = rot.e;
-  out->kinv_from_e = kinv.e;
+  out->left = mul(intrinsics_scaled(to), rotation(to, false));
+  out->rot_from = rotation(from, true);
+  out->kinv_from = inverse_intrinsics_scaled(from);
   out->from_position = from.position;
   out->to_position = to.position;
   return Status::ok;
@@ -220,19 +208,9 @@ Status plane_homography(const HomographyCameras& cams, const Vec3<Q16_16> plane[
   normalise(m);
 
   // S^-1 H S = (S^-1 K_to) R_to M R_from^T (K_from^-1 S), in that order.
-  BMat left{}, rot{}, kinv{};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      left.m[i][j] = cams.left[i][j];
-      rot.m[i][j] = cams.rot_from[i][j];
-      kinv.m[i][j] = cams.kinv_from[i][j];
-    }
-  left.e = cams.left_e;
-  rot.e = cams.rot_from_e;
-  kinv.e = cams.kinv_from_e;
-  BMat h = mul(left, m);
-  h = mul(h, rot);
-  h = mul(h, kinv);
+  BMat h = mul(cams.left, m);
+  h = mul(h, cams.rot_from);
+  h = mul(h, cams.kinv_from);
 
   Homography r{};
   for (int i = 0; i < 3; ++i)

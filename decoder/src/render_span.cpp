@@ -699,6 +699,15 @@ inline uint8_t* pixel_at(uint8_t* oe, DT* ze, uintptr_t delta, int32_t i) {
   }
 }
 
+// The sample coordinates of a pixel from its numerators and divisor.
+[[gnu::always_inline]] inline void sample_uv(int32_t nu, int32_t nv, int32_t div, int32_t shb, int32_t* u, int32_t* v) {
+  int z;
+  const int32_t yr = recip_y(static_cast<uint32_t>(div), z);
+  const int sh = shb - z;
+  *u = scaled(nu, yr, sh);
+  *v = scaled(nv, yr, sh);
+}
+
 // The pixels of one span piece: i = -len .. -1 from the piece end (ze, oe).
 template <class Sampler, bool kProj, PixelFormat O, DepthFormat D>
 [[gnu::always_inline]] inline void span_pixels(typename Depth<D>::T* ze, uint8_t* oe, int32_t len, const RowState& r,
@@ -714,10 +723,9 @@ template <class Sampler, bool kProj, PixelFormat O, DepthFormat D>
     const DT d = Depth<D>::value(q);
     if (d > ze[i]) {
       ze[i] = d;
-      int z;
-      const int32_t yr = recip_y(static_cast<uint32_t>(kProj ? w : q), z);
-      const int sh = shb - z;
-      Store<O>::put(pixel_at<O, DT>(oe, ze, delta, i), Sampler::sample(tex, scaled(u, yr, sh), scaled(v, yr, sh)));
+      int32_t su, sv;
+      sample_uv(u, v, kProj ? w : q, shb, &su, &sv);
+      Store<O>::put(pixel_at<O, DT>(oe, ze, delta, i), Sampler::sample(tex, su, sv));
     }
     q = wrap_add32(q, dq);
     if constexpr (kProj) w = wrap_add32(w, dw);
@@ -732,11 +740,8 @@ inline void piece_uv(const RowState& r, int32_t k, int32_t* u, int32_t* v) {
   // Inside the piece no value wraps (row_fast and row_piece check both ends).
   const int32_t q = static_cast<int32_t>(r.q + int64_t{r.dq} * k);
   const int32_t w = static_cast<int32_t>(r.w + int64_t{r.dw} * k);
-  int z;
-  const int32_t yr = recip_y(static_cast<uint32_t>(kProj ? w : q), z);
-  const int sh = r.sh_base - z;
-  *u = scaled(static_cast<int32_t>(r.n[0] + int64_t{r.dn[0]} * k), yr, sh);
-  *v = scaled(static_cast<int32_t>(r.n[1] + int64_t{r.dn[1]} * k), yr, sh);
+  sample_uv(static_cast<int32_t>(r.n[0] + int64_t{r.dn[0]} * k), static_cast<int32_t>(r.n[1] + int64_t{r.dn[1]} * k),
+            kProj ? w : q, r.sh_base, u, v);
 }
 
 // Whether every pixel of the piece samples inside the box. Over a piece the

@@ -53,10 +53,13 @@ Status plane_homography(const Camera& from, const Camera& to, const Vec3<Q16_16>
 // drawn between the same two cameras: plane_homography(pair, plane) gives
 // plane_homography(from, to, plane) bit for bit, at about half the cost.
 struct HomographyCameras {
-  int64_t left[3][3];     // (S^-1 K_to) R_to
-  int64_t rot_from[3][3];  // R_from^T
-  int64_t kinv_from[3][3];  // K_from^-1 S (scale-free)
-  int left_e, rot_from_e, kinv_from_e;  // each matrix's power-of-two exponent
+  struct BlockMatrix {
+    int64_t m[3][3];
+    int e;  // value = m * 2^e
+  };
+  BlockMatrix left;       // (S^-1 K_to) R_to
+  BlockMatrix rot_from;   // R_from^T
+  BlockMatrix kinv_from;  // K_from^-1 S (scale-free)
   Vec3<Q16_16> from_position, to_position;
 };
 // invalid_argument: a camera fails validate_camera().
