@@ -18,9 +18,14 @@
 namespace vds::cli {
 namespace {
 
+// How far the decimated shape may stray from the scene's (docs/walkthrough.md,
+// "Fewer triangles").
+constexpr double kWalkShapeToleranceM = 1.0 / 16;
+
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, per_frame, size = "240x180";
   double rate = 16, threshold = 18, widen = -1, view_scale = -1, occlusion = -1, occlusion_tolerance = -1;
+  double shape_tolerance = -1, vertex_tolerance = -1;  // metres
   int lookahead = -1, preroll = -1, window = -1, max_sends = -1;
   bool predict = false, keep_triangles = false, no_occlusion_updates = false;
   int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
@@ -33,9 +38,12 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   std::unique_ptr<enc::Scene> drawn;
   if (!o.keep_triangles) {
     enc::ShapeStats st;
-    drawn = std::make_unique<enc::Scene>(enc::simplify_shape(scene, enc::ShapeOptions{}, &st));
-    std::fprintf(stderr, "encode-walk: the client draws %zu triangles for the scene's %zu (%zu regions in one plane drawn as their outline)\n",
-                 st.triangles_out, scene.triangles(), st.merged);
+    enc::ShapeOptions so;
+    so.tolerance = (o.shape_tolerance >= 0 ? o.shape_tolerance : kWalkShapeToleranceM) / scene.metres_per_unit;
+    drawn = std::make_unique<enc::Scene>(enc::simplify_shape(scene, so, &st));
+    std::fprintf(stderr, "encode-walk: the client draws %zu triangles for the scene's %zu (%zu regions in one plane drawn as their outline; "
+                 "%zu triangles decimated to %zu)\n",
+                 st.triangles_out, scene.triangles(), st.merged, st.decimated_in, st.decimated_out);
   }
   const std::vector<uint8_t> text = enc::read_file(o.path);
   const enc::CameraPath path = enc::read_camera_path(std::string(text.begin(), text.end()), o.path);
@@ -47,6 +55,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.quality = o.quality;
   wo.frames_per_record = o.frames_per_record;
   wo.predict = o.predict;
+  if (o.vertex_tolerance >= 0) wo.vertex_tolerance_m = o.vertex_tolerance;
   if (o.preroll >= 0) wo.preroll_ms = static_cast<uint32_t>(o.preroll);
   if (o.window >= 0) wo.buffer_bytes = static_cast<size_t>(o.window);
   if (o.max_sends >= 0) wo.max_sends = o.max_sends;
@@ -144,7 +153,16 @@ void add_encode_walk(CLI::App& app) {
   sub->add_flag("--no-occlusion-updates", o->no_occlusion_updates,
                 "No view updates for occluded views (they only lose to views that are not occluded)");
   sub->add_flag("--keep-triangles", o->keep_triangles,
-                "The client draws the views onto the scene's own triangles (default: neighbours in one plane merged)");
+                "The client draws the views onto the scene's own triangles (default: neighbours in one plane merged, "
+                "surfaces decimated)");
+  sub->add_option("--shape-tolerance", o->shape_tolerance,
+                  "Metres the shape the views are drawn onto may move from the scene's when it is decimated (default " +
+                      std::to_string(kWalkShapeToleranceM) + "; 0: not decimated)")
+      ->check(CLI::Range(0.0, 10.0));
+  sub->add_option("--vertex-tolerance", o->vertex_tolerance,
+                  "Metres a vertex may move to the coarsest power-of-two grid the geometry is sent on (default " +
+                      std::to_string(enc::WalkEncodeOptions{}.vertex_tolerance_m) + ")")
+      ->check(CLI::Range(0.0, 10.0));
   sub->add_option("--y4m", o->y4m, "Also write what the client shows as Y4M");
   sub->add_option("--per-frame", o->per_frame, "Also write each frame's stream bytes and PSNR R,G,B as CSV");
   sub->add_option("--size", o->size, "Frame size WIDTHxHEIGHT (default 240x180)");

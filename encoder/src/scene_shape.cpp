@@ -9,6 +9,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include <meshoptimizer.h>
+
 namespace vds::enc {
 
 namespace {
@@ -90,6 +92,141 @@ bool ear_clip(std::vector<uint32_t> loop, const std::unordered_map<uint32_t, P2>
   return true;
 }
 
+// Whether triangle t of surface sf takes part in merging and decimation:
+// opaque and one-sided (sky, fog, additive, alpha-tested and two-sided
+// triangles stay as they are).
+bool solid(const Scene& s, const SceneSurface& sf) {
+  if (sf.kind != SurfaceKind::opaque) return false;
+  if (sf.texture >= 0 && static_cast<size_t>(sf.texture) < s.textures.size()) {
+    const SceneTexture& tx = s.textures[static_cast<size_t>(sf.texture)];
+    if (tx.blend != ShaderBlend::opaque || tx.two_sided) return false;
+  }
+  return true;
+}
+
+// The solid triangles of `s` decimated within `tolerance` scene units
+// (scene_shape.h). Triangles are grouped by which way round their corners
+// run about the side their vertex normals face; each group is decimated on
+// its own (an edge between the groups is then open, its vertices fixed), so
+// that a decimated triangle's winding still tells its front. A triangle the
+// decimation leaves as it was stays in its surface with its vertices; the
+// others go to a surface of their own per group.
+void decimate(Scene* s, double tolerance, ShapeStats* st) {
+  const size_t nt = s->triangles();
+  std::vector<uint32_t> weld(s->vertices.size());
+  std::vector<float> at;  // welded positions, x y z
+  std::vector<uint32_t> rep;
+  {
+    std::map<std::array<int64_t, 3>, uint32_t> ids;
+    for (size_t v = 0; v < s->vertices.size(); ++v) {
+      std::array<int64_t, 3> k{};
+      for (int a = 0; a < 3; ++a) k[static_cast<size_t>(a)] = std::llround(double{s->vertices[v].pos[static_cast<size_t>(a)]} * 64);
+      const auto [it, fresh] = ids.emplace(k, static_cast<uint32_t>(rep.size()));
+      if (fresh) {
+        rep.push_back(static_cast<uint32_t>(v));
+        for (float c : s->vertices[v].pos) at.push_back(c);
+      }
+      weld[v] = it->second;
+    }
+  }
+  if (rep.empty()) return;
+  const auto pos = [&](uint32_t w) { return V3{at[3 * w], at[3 * w + 1], at[3 * w + 2]}; };
+  std::vector<int32_t> surface_of(nt, -1);
+  for (size_t k = 0; k < s->surfaces.size(); ++k)
+    for (uint32_t i = 0; i < s->surfaces[k].index_count / 3; ++i) surface_of[s->surfaces[k].first_index / 3 + i] = static_cast<int32_t>(k);
+  // Each solid triangle's group: 0 where its corners run counter-clockwise
+  // about its vertex normals, 1 where they run the other way; -1 not decimated.
+  std::vector<int8_t> group(nt, -1);
+  std::vector<std::array<uint32_t, 3>> tri(nt);
+  std::array<std::vector<uint32_t>, 2> indices;
+  for (size_t t = 0; t < nt; ++t) {
+    for (int c = 0; c < 3; ++c) tri[t][static_cast<size_t>(c)] = weld[s->indices[3 * t + static_cast<size_t>(c)]];
+    if (surface_of[t] < 0 || !solid(*s, s->surfaces[static_cast<size_t>(surface_of[t])])) continue;
+    const auto& w = tri[t];
+    if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;
+    const V3 n = cross(sub(pos(w[1]), pos(w[0])), sub(pos(w[2]), pos(w[0])));
+    if (!(len(n) > 1e-9)) continue;
+    V3 vn{0, 0, 0};
+    for (int c = 0; c < 3; ++c) {
+      const auto& q = s->vertices[s->indices[3 * t + static_cast<size_t>(c)]].normal;
+      vn = {vn[0] + q[0], vn[1] + q[1], vn[2] + q[2]};
+    }
+    const int8_t g = dot(n, vn) < 0 ? 1 : 0;
+    group[t] = g;
+    for (uint32_t v : w) indices[static_cast<size_t>(g)].push_back(v);
+  }
+  // Triangles as they were, by their corners from the lowest.
+  const auto key = [](std::array<uint32_t, 3> k) {
+    while (k[0] > k[1] || k[0] > k[2]) k = {k[1], k[2], k[0]};
+    return k;
+  };
+  std::map<std::array<uint32_t, 3>, uint32_t> before;
+  for (size_t t = 0; t < nt; ++t)
+    if (group[t] >= 0) before.emplace(key(tri[t]), static_cast<uint32_t>(t));
+  std::vector<char> stays(nt, 0);
+  std::array<std::vector<std::array<uint32_t, 3>>, 2> fresh;
+  const float scale = meshopt_simplifyScale(at.data(), rep.size(), 3 * sizeof(float));
+  for (size_t g = 0; g < 2; ++g) {
+    std::vector<uint32_t>& in = indices[g];
+    if (in.empty()) continue;
+    std::vector<uint32_t> out(in.size());
+    const float err = scale > 0 ? static_cast<float>(tolerance / scale) : 0.0f;
+    out.resize(meshopt_simplify(out.data(), in.data(), in.size(), at.data(), rep.size(), 3 * sizeof(float), 0, err,
+                                meshopt_SimplifyLockBorder, nullptr));
+    st->decimated_in += in.size() / 3;
+    st->decimated_out += out.size() / 3;
+    for (size_t i = 0; i + 2 < out.size(); i += 3) {
+      const std::array<uint32_t, 3> k{out[i], out[i + 1], out[i + 2]};
+      // (A triangle on three fixed vertices in a line covers nothing.)
+      if (!(len(cross(sub(pos(k[1]), pos(k[0])), sub(pos(k[2]), pos(k[0])))) > 1e-9)) continue;
+      const auto it = before.find(key(k));
+      if (it != before.end() && group[it->second] == static_cast<int8_t>(g)) stays[it->second] = 1;
+      else fresh[g].push_back(k);
+    }
+  }
+  // The scene again: each surface's triangles but the decimated ones, then
+  // each group's new triangles.
+  std::vector<uint32_t> old = std::move(s->indices);
+  std::vector<SceneSurface> surfaces = std::move(s->surfaces);
+  s->indices.clear();
+  s->surfaces.clear();
+  std::array<int32_t, 2> first_surface{-1, -1};
+  for (const SceneSurface& sf : surfaces) {
+    SceneSurface k = sf;
+    k.first_index = static_cast<uint32_t>(s->indices.size());
+    for (uint32_t i = 0; i < sf.index_count / 3; ++i) {
+      const size_t t = sf.first_index / 3 + i;
+      if (group[t] >= 0) {
+        int32_t& f = first_surface[static_cast<size_t>(group[t])];
+        if (f < 0) f = static_cast<int32_t>(&sf - surfaces.data());
+        if (!stays[t]) continue;
+      }
+      for (int c = 0; c < 3; ++c) s->indices.push_back(old[3 * t + static_cast<size_t>(c)]);
+    }
+    k.index_count = static_cast<uint32_t>(s->indices.size()) - k.first_index;
+    if (k.index_count > 0) s->surfaces.push_back(k);
+  }
+  for (size_t g = 0; g < 2; ++g) {
+    if (fresh[g].empty()) continue;
+    SceneSurface k = surfaces[static_cast<size_t>(first_surface[g])];
+    k.first_index = static_cast<uint32_t>(s->indices.size());
+    for (const auto& t : fresh[g]) {
+      V3 n = cross(sub(pos(t[1]), pos(t[0])), sub(pos(t[2]), pos(t[0])));
+      const double l = len(n);
+      const double sign = g == 0 ? 1 : -1;
+      n = {sign * n[0] / l, sign * n[1] / l, sign * n[2] / l};
+      for (uint32_t w : t) {
+        SceneVertex v = s->vertices[rep[w]];
+        v.normal = {static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2])};
+        s->indices.push_back(static_cast<uint32_t>(s->vertices.size()));
+        s->vertices.push_back(v);
+      }
+    }
+    k.index_count = static_cast<uint32_t>(s->indices.size()) - k.first_index;
+    s->surfaces.push_back(k);
+  }
+}
+
 }  // namespace
 
 Scene simplify_shape(const Scene& s, const ShapeOptions& o, ShapeStats* stats) {
@@ -126,12 +263,7 @@ Scene simplify_shape(const Scene& s, const ShapeOptions& o, ShapeStats* stats) {
   for (size_t t = 0; t < nt; ++t) {
     for (uint32_t w : tri[t]) ++uses[w];
     if (surface_of[t] < 0) continue;
-    const SceneSurface& sf = s.surfaces[static_cast<size_t>(surface_of[t])];
-    if (sf.kind != SurfaceKind::opaque) continue;
-    if (sf.texture >= 0 && static_cast<size_t>(sf.texture) < s.textures.size()) {
-      const SceneTexture& tx = s.textures[static_cast<size_t>(sf.texture)];
-      if (tx.blend != ShaderBlend::opaque || tx.two_sided) continue;
-    }
+    if (!solid(s, s.surfaces[static_cast<size_t>(surface_of[t])])) continue;
     if (tri[t][0] == tri[t][1] || tri[t][1] == tri[t][2] || tri[t][0] == tri[t][2]) continue;
     const V3 nrm = cross(sub(pos(tri[t][1]), pos(tri[t][0])), sub(pos(tri[t][2]), pos(tri[t][0])));
     const double l = len(nrm);
@@ -527,6 +659,7 @@ Scene simplify_shape(const Scene& s, const ShapeOptions& o, ShapeStats* stats) {
     k.index_count = static_cast<uint32_t>(out.indices.size()) - k.first_index;
     out.surfaces.push_back(k);
   }
+  if (o.tolerance > 0) decimate(&out, o.tolerance, &st);
   st.triangles_out = out.triangles();
   if (stats) *stats = st;
   return out;

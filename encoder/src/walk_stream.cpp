@@ -239,7 +239,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   if (o.frames_per_record < 1 || o.frames_per_record > kWalkMaxFramesPerRecord)
     throw std::invalid_argument("encode_walk: 1 to 8 frames a record");
   wp.frames_per_record = static_cast<uint8_t>(o.frames_per_record);
-  wp.quantum_raw = choose_walk_quantum(drawn, 1.0 / 16);
+  wp.quantum_raw = choose_walk_quantum(drawn, o.vertex_tolerance_m / s.metres_per_unit);
   wp.view_focal_q16 = static_cast<int32_t>(std::lround(scene_camera(path.frames[0], view_hfov, view_w, view_h).focal * 65536));
   wp.view_width = static_cast<uint16_t>(view_w);
   wp.view_height = static_cast<uint16_t>(view_h);

@@ -215,4 +215,100 @@ TEST(SceneShape, SkyAlphaTestedAndRepeatedTrianglesAreNotMerged) {
   EXPECT_EQ(sky_tris, 2u);
 }
 
+// A gentle bump, z = h sin(pi x / 16) sin(pi y / 16) over 16 x 16 units,
+// as a model's 32 x 32 quads sharing their vertices; its normals point up.
+// wind = 1: its triangles wind the other way round them.
+Scene bump(double h, int wind) {
+  Builder b;
+  constexpr int kN = 32;
+  vds::enc::SceneSurface f;
+  f.texture = 0;
+  f.face_type = 3;
+  f.first_index = 0;
+  const auto z = [h](double x, double y) { return h * std::sin(M_PI * x / 16) * std::sin(M_PI * y / 16); };
+  for (int j = 0; j <= kN; ++j)
+    for (int i = 0; i <= kN; ++i) {
+      const double x = 16.0 * i / kN, y = 16.0 * j / kN;
+      b.vertex(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z(x, y)));
+      b.s.vertices.back().normal = {0, 0, 1};
+    }
+  for (int j = 0; j < kN; ++j)
+    for (int i = 0; i < kN; ++i) {
+      const uint32_t a = static_cast<uint32_t>(j * (kN + 1) + i), c = a + kN + 1;
+      for (uint32_t v : {a, a + 1, c + 1, a, c + 1, c}) b.s.indices.push_back(v);
+    }
+  if (wind == 1)
+    for (size_t t = 0; t < b.s.triangles(); ++t) std::swap(b.s.indices[3 * t + 1], b.s.indices[3 * t + 2]);
+  f.index_count = static_cast<uint32_t>(b.s.indices.size());
+  b.s.surfaces.push_back(f);
+  return b.s;
+}
+
+TEST(SceneShape, DecimatedSurfacesStayWithinTheToleranceAndKeepTheirRims) {
+  constexpr double kH = 0.3, kTol = 0.25;
+  const auto height = [](double x, double y) { return kH * std::sin(M_PI * x / 16) * std::sin(M_PI * y / 16); };
+  for (int wind = 0; wind < 2; ++wind) {
+    const Scene in = bump(kH, wind);
+    // (No plane merges the bump's nearly flat rows: the decimation alone.)
+    vds::enc::ShapeOptions none;
+    none.plane_tolerance = 1e-9;
+    EXPECT_EQ(vds::enc::simplify_shape(in, none).triangles(), in.triangles());
+    vds::enc::ShapeOptions o = none;
+    o.tolerance = kTol;
+    vds::enc::ShapeStats st;
+    const Scene s = vds::enc::simplify_shape(in, o, &st);
+    EXPECT_EQ(st.decimated_in, 2048u);
+    EXPECT_LT(s.triangles(), in.triangles() / 8) << "winding " << wind;
+    EXPECT_EQ(st.triangles_out, s.triangles());
+    // Its rim, an open edge, stays where it was: its corners are kept and
+    // points just inside it are covered (below).
+    for (const std::array<float, 2> r : {std::array<float, 2>{0, 0}, {16, 0}, {0, 16}, {16, 16}}) {
+      bool kept = false;
+      for (uint32_t v : s.indices) kept = kept || (s.vertices[v].pos[0] == r[0] && s.vertices[v].pos[1] == r[1]);
+      EXPECT_TRUE(kept) << r[0] << ", " << r[1];
+    }
+    // Each triangle's vertex normals face the side its vertices' normals
+    // faced (up), and its corners run round them as before.
+    for (size_t t = 0; t < s.triangles(); ++t) {
+      std::array<std::array<double, 3>, 3> p{};
+      for (int c = 0; c < 3; ++c) {
+        const auto& v = s.vertices[s.indices[3 * t + static_cast<size_t>(c)]];
+        EXPECT_GT(v.normal[2], 0.9f);
+        for (int a = 0; a < 3; ++a) p[static_cast<size_t>(c)][static_cast<size_t>(a)] = v.pos[static_cast<size_t>(a)];
+      }
+      const double nz = (p[1][0] - p[0][0]) * (p[2][1] - p[0][1]) - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]);
+      EXPECT_EQ(nz > 0, wind == 0) << "triangle " << t;
+    }
+    // Every point of the bump is covered once, within the tolerance of
+    // its height; a quarter of them lie just inside its rim.
+    vds::test::Xorshift32 rng;
+    for (int i = 0; i < 2000; ++i) {
+      double x = 0.001 + 15.998 * (rng.next() % 100003) / 100003.0, y = 0.001 + 15.998 * (rng.next() % 100019) / 100019.0;
+      if (i % 4 == 0) (i % 8 == 0 ? x : y) = (i % 16 == 0) ? 0.001 : 15.999;
+      int covered = 0;
+      double z = 0;
+      for (size_t t = 0; t < s.triangles(); ++t) {
+        P q[3];
+        double zc[3];
+        for (int c = 0; c < 3; ++c) {
+          const auto& v = s.vertices[s.indices[3 * t + static_cast<size_t>(c)]].pos;
+          q[c] = {v[0], v[1]};
+          zc[c] = v[2];
+        }
+        if (wind == 1) {
+          std::swap(q[1], q[2]);
+          std::swap(zc[1], zc[2]);
+        }
+        const double area = side(q[0], q[1], q[2]);
+        const double w0 = side(q[1], q[2], {x, y}) / area, w1 = side(q[2], q[0], {x, y}) / area, w2 = side(q[0], q[1], {x, y}) / area;
+        if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+        ++covered;
+        z = w0 * zc[0] + w1 * zc[1] + w2 * zc[2];
+      }
+      ASSERT_EQ(covered, 1) << "at " << x << ", " << y;
+      EXPECT_NEAR(z, height(x, y), kTol) << "at " << x << ", " << y;
+    }
+  }
+}
+
 }  // namespace

@@ -20,9 +20,16 @@
 //   outline is cut into triangles ear by ear;
 // - a region whose outline cannot be cut so (it touches itself at a
 //   vertex, or an ear cannot be found) keeps its triangles.
+// - then, with ShapeOptions::tolerance above 0, the opaque one-sided
+//   triangles are decimated: edges collapse (a vertex onto a neighbour)
+//   while the surface stays within the tolerance of where it was (a
+//   quadric error bound); a vertex on an open edge of the welded mesh (a
+//   model's rim, a T-junction, where a surface meets one that faces the
+//   other way round its winding) never moves, so no crack opens.
 // The result has the scene's textures and lightmaps; merged regions are
 // surfaces of their own, with the first triangle's texture, and vertices of
-// their own whose normals are the region's.
+// their own whose normals are the region's; decimated triangles likewise,
+// each with vertices of its own whose normals are its own.
 #pragma once
 #include <cstddef>
 
@@ -32,6 +39,7 @@ namespace vds::enc {
 
 struct ShapeOptions {
   double plane_tolerance = 1.0 / 16;  // scene units
+  double tolerance = 0;               // scene units a decimated surface may move (0: none)
 };
 
 struct ShapeStats {
@@ -39,6 +47,7 @@ struct ShapeStats {
   size_t merged = 0;            // regions drawn as their outline
   size_t kept = 0;              // regions that keep their triangles
   size_t repeats = 0;           // triangles dropped as repeats of another
+  size_t decimated_in = 0, decimated_out = 0;  // triangles the decimation took, and gave back
   size_t triangles_in = 0, triangles_out = 0;
 };
 

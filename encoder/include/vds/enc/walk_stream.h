@@ -37,6 +37,10 @@ struct WalkEncodeOptions {
   int window = 2;         // hot: visible within this many frames either side
   int max_sends = 0;      // polygons a frame sends at most before the rest go a frame earlier (0: no limit)
   int frames_per_record = kWalkMaxFramesPerRecord;  // most frames a WFRM record holds
+  // Metres a vertex may move to the grid the geometry is sent on: the
+  // coarsest power of two of the scene's unit, from 1 unit down, that keeps
+  // every vertex of what the client draws within it.
+  double vertex_tolerance_m = 1.0 / 64;
   // View updates ask the client to draw its prediction of the view, and
   // are coded as a residual against it when that pays (rate and
   // distortion); measured not to pay on the figure maps (docs/walkthrough.md).
