@@ -104,8 +104,9 @@ bool solid(const Scene& s, const SceneSurface& sf) {
   return true;
 }
 
-// The solid triangles of `s` decimated within `tolerance` scene units
-// (scene_shape.h). Triangles are grouped by which way round their corners
+// The solid triangles of `s` that are not polygon faces (face_type 1:
+// a map's brush faces and the merged regions) decimated within `tolerance`
+// scene units (scene_shape.h). Triangles are grouped by which way round their corners
 // run about the side their vertex normals face; each group is decimated on
 // its own (an edge between the groups is then open, its vertices fixed), so
 // that a decimated triangle's winding still tells its front. A triangle the
@@ -141,7 +142,9 @@ void decimate(Scene* s, double tolerance, ShapeStats* st) {
   std::array<std::vector<uint32_t>, 2> indices;
   for (size_t t = 0; t < nt; ++t) {
     for (int c = 0; c < 3; ++c) tri[t][static_cast<size_t>(c)] = weld[s->indices[3 * t + static_cast<size_t>(c)]];
-    if (surface_of[t] < 0 || !solid(*s, s->surfaces[static_cast<size_t>(surface_of[t])])) continue;
+    if (surface_of[t] < 0) continue;
+    const SceneSurface& sf = s->surfaces[static_cast<size_t>(surface_of[t])];
+    if (sf.face_type == 1 || !solid(*s, sf)) continue;
     const auto& w = tri[t];
     if (w[0] == w[1] || w[1] == w[2] || w[0] == w[2]) continue;
     const V3 n = cross(sub(pos(w[1]), pos(w[0])), sub(pos(w[2]), pos(w[0])));

@@ -258,6 +258,10 @@ TEST(SceneShape, DecimatedSurfacesStayWithinTheToleranceAndKeepTheirRims) {
     vds::enc::ShapeStats st;
     const Scene s = vds::enc::simplify_shape(in, o, &st);
     EXPECT_EQ(st.decimated_in, 2048u);
+    // The same triangles as a polygon face (a map's brush face) stay.
+    Scene poly = in;
+    poly.surfaces[0].face_type = 1;
+    EXPECT_EQ(vds::enc::simplify_shape(poly, o).triangles(), in.triangles());
     EXPECT_LT(s.triangles(), in.triangles() / 8) << "winding " << wind;
     EXPECT_EQ(st.triangles_out, s.triangles());
     // Its rim, an open edge, stays where it was: its corners are kept and

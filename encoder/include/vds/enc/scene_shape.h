@@ -21,9 +21,12 @@
 // - a region whose outline cannot be cut so (it touches itself at a
 //   vertex, or an ear cannot be found) keeps its triangles.
 // - then, with ShapeOptions::tolerance above 0, the opaque one-sided
-//   triangles are decimated: edges collapse (a vertex onto a neighbour)
-//   while the surface stays within the tolerance of where it was (a
-//   quadric error bound); a vertex on an open edge of the welded mesh (a
+//   triangles of curved patches and models (every face but polygon faces,
+//   SceneSurface::face_type 1, which the merge has drawn as outlines) are
+//   decimated: edges collapse (a vertex onto a neighbour) while the
+//   surface stays near where it was (a quadric error bound of the
+//   tolerance: a measure of distance to the planes around a vertex, not a
+//   strict bound); a vertex on an open edge of the welded mesh (a
 //   model's rim, a T-junction, where a surface meets one that faces the
 //   other way round its winding) never moves, so no crack opens.
 // The result has the scene's textures and lightmaps; merged regions are
