@@ -3,7 +3,9 @@
 // picks the format. Invariants: no crash, sanitizer report or hang; a
 // refusal is a std::runtime_error naming the input; an accepted scene has
 // whole triangles whose indices name its vertices, surfaces inside its
-// indices, and textures its surfaces name.
+// indices, and textures its surfaces name; so has the shape `vds
+// encode-walk` makes of it (vds/enc/scene_shape.h: merged, then decimated),
+// with no more triangles than the scene.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -14,6 +16,7 @@
 
 #include "seed_corpus.h"
 #include "vds/enc/scene.h"
+#include "vds/enc/scene_shape.h"
 
 namespace {
 
@@ -44,13 +47,21 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string name = kNames[data[0] % 3];
   try {
     const vds::enc::Scene s = vds::enc::read_model_scene(data + 1, size - 1, name);
-    if (s.indices.size() % 3 != 0) abort();
-    for (uint32_t i : s.indices)
-      if (i >= s.vertices.size()) abort();
-    for (const auto& f : s.surfaces) {
-      if (f.first_index + static_cast<uint64_t>(f.index_count) > s.indices.size() || f.index_count % 3 != 0) abort();
-      if (f.texture >= static_cast<int>(s.textures.size())) abort();
-    }
+    const auto check = [](const vds::enc::Scene& x) {
+      if (x.indices.size() % 3 != 0) abort();
+      for (uint32_t i : x.indices)
+        if (i >= x.vertices.size()) abort();
+      for (const auto& f : x.surfaces) {
+        if (f.first_index + static_cast<uint64_t>(f.index_count) > x.indices.size() || f.index_count % 3 != 0) abort();
+        if (f.texture >= static_cast<int>(x.textures.size())) abort();
+      }
+    };
+    check(s);
+    vds::enc::ShapeOptions so;
+    so.tolerance = 1.0 / 16;  // metres: the walkthrough's default
+    const vds::enc::Scene shape = vds::enc::simplify_shape(s, so);
+    check(shape);
+    if (shape.triangles() > s.triangles()) abort();
   } catch (const std::runtime_error& e) {
     if (std::strncmp(e.what(), name.c_str(), name.size()) != 0) abort();
   }
