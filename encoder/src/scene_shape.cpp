@@ -92,6 +92,45 @@ bool ear_clip(std::vector<uint32_t> loop, const std::unordered_map<uint32_t, P2>
   return true;
 }
 
+// A scene's vertices welded by position (to 1/64 unit): `rep` maps each
+// welded id to the first vertex there, `tri` holds each triangle's corners
+// as welded ids.
+struct Welded {
+  std::vector<uint32_t> rep;
+  std::vector<std::array<uint32_t, 3>> tri;
+};
+Welded weld_positions(const Scene& s) {
+  Welded w;
+  std::vector<uint32_t> weld(s.vertices.size());
+  std::map<std::array<int64_t, 3>, uint32_t> ids;
+  for (size_t v = 0; v < s.vertices.size(); ++v) {
+    std::array<int64_t, 3> k{};
+    for (int a = 0; a < 3; ++a) k[static_cast<size_t>(a)] = std::llround(double{s.vertices[v].pos[static_cast<size_t>(a)]} * 64);
+    const auto [it, fresh] = ids.emplace(k, static_cast<uint32_t>(w.rep.size()));
+    if (fresh) w.rep.push_back(static_cast<uint32_t>(v));
+    weld[v] = it->second;
+  }
+  w.tri.resize(s.triangles());
+  for (size_t t = 0; t < w.tri.size(); ++t)
+    for (int c = 0; c < 3; ++c) w.tri[t][static_cast<size_t>(c)] = weld[s.indices[3 * t + static_cast<size_t>(c)]];
+  return w;
+}
+
+// Each triangle's surface (-1: none holds it).
+std::vector<int32_t> surfaces_of(const Scene& s) {
+  std::vector<int32_t> of(s.triangles(), -1);
+  for (size_t k = 0; k < s.surfaces.size(); ++k)
+    for (uint32_t i = 0; i < s.surfaces[k].index_count / 3; ++i) of[s.surfaces[k].first_index / 3 + i] = static_cast<int32_t>(k);
+  return of;
+}
+
+// A triangle's corners turned (its winding kept) to start at the lowest:
+// the same for a triangle with the same corners the same way round.
+std::array<uint32_t, 3> lowest_first(std::array<uint32_t, 3> k) {
+  while (k[0] > k[1] || k[0] > k[2]) k = {k[1], k[2], k[0]};
+  return k;
+}
+
 // Whether triangle t of surface sf takes part in merging and decimation:
 // opaque and one-sided (sky, fog, additive, alpha-tested and two-sided
 // triangles stay as they are).
@@ -114,34 +153,20 @@ bool solid(const Scene& s, const SceneSurface& sf) {
 // others go to a surface of their own per group.
 void decimate(Scene* s, double tolerance, ShapeStats* st) {
   const size_t nt = s->triangles();
-  std::vector<uint32_t> weld(s->vertices.size());
-  std::vector<float> at;  // welded positions, x y z
-  std::vector<uint32_t> rep;
-  {
-    std::map<std::array<int64_t, 3>, uint32_t> ids;
-    for (size_t v = 0; v < s->vertices.size(); ++v) {
-      std::array<int64_t, 3> k{};
-      for (int a = 0; a < 3; ++a) k[static_cast<size_t>(a)] = std::llround(double{s->vertices[v].pos[static_cast<size_t>(a)]} * 64);
-      const auto [it, fresh] = ids.emplace(k, static_cast<uint32_t>(rep.size()));
-      if (fresh) {
-        rep.push_back(static_cast<uint32_t>(v));
-        for (float c : s->vertices[v].pos) at.push_back(c);
-      }
-      weld[v] = it->second;
-    }
-  }
+  const Welded wd = weld_positions(*s);
+  const std::vector<uint32_t>& rep = wd.rep;
+  const std::vector<std::array<uint32_t, 3>>& tri = wd.tri;
   if (rep.empty()) return;
+  std::vector<float> at;  // welded positions, x y z
+  for (uint32_t v : rep)
+    for (float c : s->vertices[v].pos) at.push_back(c);
   const auto pos = [&](uint32_t w) { return V3{at[3 * w], at[3 * w + 1], at[3 * w + 2]}; };
-  std::vector<int32_t> surface_of(nt, -1);
-  for (size_t k = 0; k < s->surfaces.size(); ++k)
-    for (uint32_t i = 0; i < s->surfaces[k].index_count / 3; ++i) surface_of[s->surfaces[k].first_index / 3 + i] = static_cast<int32_t>(k);
+  const std::vector<int32_t> surface_of = surfaces_of(*s);
   // Each solid triangle's group: 0 where its corners run counter-clockwise
   // about its vertex normals, 1 where they run the other way; -1 not decimated.
   std::vector<int8_t> group(nt, -1);
-  std::vector<std::array<uint32_t, 3>> tri(nt);
   std::array<std::vector<uint32_t>, 2> indices;
   for (size_t t = 0; t < nt; ++t) {
-    for (int c = 0; c < 3; ++c) tri[t][static_cast<size_t>(c)] = weld[s->indices[3 * t + static_cast<size_t>(c)]];
     if (surface_of[t] < 0) continue;
     const SceneSurface& sf = s->surfaces[static_cast<size_t>(surface_of[t])];
     if (sf.face_type == 1 || !solid(*s, sf)) continue;
@@ -159,13 +184,9 @@ void decimate(Scene* s, double tolerance, ShapeStats* st) {
     for (uint32_t v : w) indices[static_cast<size_t>(g)].push_back(v);
   }
   // Triangles as they were, by their corners from the lowest.
-  const auto key = [](std::array<uint32_t, 3> k) {
-    while (k[0] > k[1] || k[0] > k[2]) k = {k[1], k[2], k[0]};
-    return k;
-  };
   std::map<std::array<uint32_t, 3>, uint32_t> before;
   for (size_t t = 0; t < nt; ++t)
-    if (group[t] >= 0) before.emplace(key(tri[t]), static_cast<uint32_t>(t));
+    if (group[t] >= 0) before.emplace(lowest_first(tri[t]), static_cast<uint32_t>(t));
   std::vector<char> stays(nt, 0);
   std::array<std::vector<std::array<uint32_t, 3>>, 2> fresh;
   const float scale = meshopt_simplifyScale(at.data(), rep.size(), 3 * sizeof(float));
@@ -182,7 +203,7 @@ void decimate(Scene* s, double tolerance, ShapeStats* st) {
       const std::array<uint32_t, 3> k{out[i], out[i + 1], out[i + 2]};
       // (A triangle on three fixed vertices in a line covers nothing.)
       if (!(len(cross(sub(pos(k[1]), pos(k[0])), sub(pos(k[2]), pos(k[0])))) > 1e-9)) continue;
-      const auto it = before.find(key(k));
+      const auto it = before.find(lowest_first(k));
       if (it != before.end() && group[it->second] == static_cast<int8_t>(g)) stays[it->second] = 1;
       else fresh[g].push_back(k);
     }
@@ -237,29 +258,15 @@ Scene simplify_shape(const Scene& s, const ShapeOptions& o, ShapeStats* stats) {
   const size_t nt = s.triangles();
   st.triangles_in = nt;
   // Vertices by position (1/64 unit), the first of each position standing for it.
-  std::vector<uint32_t> weld(s.vertices.size());
-  std::vector<uint32_t> rep;  // welded id -> a vertex of the scene
-  {
-    std::map<std::array<int64_t, 3>, uint32_t> ids;
-    for (size_t v = 0; v < s.vertices.size(); ++v) {
-      std::array<int64_t, 3> k{};
-      for (int a = 0; a < 3; ++a) k[static_cast<size_t>(a)] = std::llround(double{s.vertices[v].pos[static_cast<size_t>(a)]} * 64);
-      const auto [it, fresh] = ids.emplace(k, static_cast<uint32_t>(rep.size()));
-      if (fresh) rep.push_back(static_cast<uint32_t>(v));
-      weld[v] = it->second;
-    }
-  }
+  const Welded wd = weld_positions(s);
+  const std::vector<uint32_t>& rep = wd.rep;  // welded id -> a vertex of the scene
+  const std::vector<std::array<uint32_t, 3>>& tri = wd.tri;
   const auto pos = [&](uint32_t w) {
     const auto& p = s.vertices[rep[w]].pos;
     return V3{p[0], p[1], p[2]};
   };
-  std::vector<std::array<uint32_t, 3>> tri(nt);
-  for (size_t t = 0; t < nt; ++t)
-    for (int c = 0; c < 3; ++c) tri[t][static_cast<size_t>(c)] = weld[s.indices[3 * t + static_cast<size_t>(c)]];
   // Which triangles may join a region, and each one's surface.
-  std::vector<int32_t> surface_of(nt, -1);
-  for (size_t k = 0; k < s.surfaces.size(); ++k)
-    for (uint32_t i = 0; i < s.surfaces[k].index_count / 3; ++i) surface_of[s.surfaces[k].first_index / 3 + i] = static_cast<int32_t>(k);
+  const std::vector<int32_t> surface_of = surfaces_of(s);
   std::vector<V3> normal(nt);
   std::vector<char> joins(nt, 0);
   std::vector<uint32_t> uses(rep.size(), 0);  // triangles using each welded vertex
@@ -281,9 +288,7 @@ Scene simplify_shape(const Scene& s, const ShapeOptions& o, ShapeStats* stats) {
     std::map<std::array<uint32_t, 3>, uint32_t> seen;
     for (size_t t = 0; t < nt; ++t) {
       if (!joins[t]) continue;
-      std::array<uint32_t, 3> k = tri[t];
-      while (k[0] > k[1] || k[0] > k[2]) k = {k[1], k[2], k[0]};
-      if (!seen.emplace(k, static_cast<uint32_t>(t)).second) {
+      if (!seen.emplace(lowest_first(tri[t]), static_cast<uint32_t>(t)).second) {
         repeat[t] = 1;
         joins[t] = 0;
         ++st.repeats;
