@@ -12,7 +12,7 @@ PACKAGES=(
   qemu-system-arm
   # host libraries
   libgtest-dev libgmock-dev libbenchmark-dev libusb-1.0-0-dev
-  libdraco-dev draco libmeshoptimizer-dev libcli11-dev libpng-dev libassimp-dev libzip-dev libtinyxml2-dev
+  libdraco-dev draco libmeshoptimizer-dev libcli11-dev libpng-dev libassimp-dev libzip-dev libtinyxml2-dev libstb-dev
   libsdl2-dev
   # anchors the benchmarks and conformance tests compare against
   libjpeg-turbo-progs libturbojpeg0-dev libwebp-dev

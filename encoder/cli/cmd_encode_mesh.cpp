@@ -111,7 +111,7 @@ void add_encode_mesh(CLI::App& app) {
   auto o = std::make_shared<EncodeMeshOptions>();
   CLI::App* sub =
       app.add_subcommand("encode-mesh", "Encode a mesh file as a progressive model stream (levels of vertex splits)");
-  sub->add_option("IN", o->input, "Mesh file: OBJ, PLY, glTF 2.0, 3DS (assimp) or Draco .drc")->required();
+  sub->add_option("IN", o->input, "Mesh file: OBJ, PLY, glTF 2.0, GLB, 3DS, Collada, IQM, MD2, MD3, MS3D (assimp) or Draco .drc")->required();
   sub->add_option("-o,--output", o->output, "Stream to write")->required();
   sub->add_option("--bits", o->bits, "Quantisation bits per axis")->capture_default_str()->check(CLI::Range(2, 16));
   sub->add_option("--levels", o->levels, "At most this many refinement levels (0: as many as the error allows)")

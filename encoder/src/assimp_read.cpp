@@ -14,7 +14,9 @@
 #include "mesh_glb_check.h"
 #include "mesh_collada_check.h"
 #include "mesh_iqm_check.h"
+#include "mesh_md2_check.h"
 #include "mesh_md3_check.h"
+#include "mesh_ms3d_check.h"
 #include "mesh_ply_check.h"
 #include "text.h"
 
@@ -138,7 +140,7 @@ class ConfinedIO : public Assimp::DefaultIOSystem {
 // (tests/fuzz/fuzz_mesh_import.cpp). Assimp reads dozens more, some of
 // which trust the counts a file declares.
 bool imported_format(const std::string& ext) {
-  static const char* const kFormats[] = {"obj", "ply", "gltf", "glb", "3ds", "dae", "iqm", "md3"};
+  static const char* const kFormats[] = {"obj", "ply", "gltf", "glb", "3ds", "dae", "iqm", "md2", "md3", "ms3d"};
   for (const char* f : kFormats)
     if (ext == f) return true;
   return false;
@@ -162,6 +164,9 @@ const aiScene* read_with_assimp(Assimp::Importer& importer, const uint8_t* data,
   // assimp's loader takes them as given.
   if (format == "iqm") check_iqm(data, size, name);
   if (format == "md3") check_md3(data, size, name);
+  // MD2's offsets and MS3D's chained counts too.
+  if (format == "md2") check_md2(data, size, name);
+  if (format == "ms3d") check_ms3d(data, size, name);
   // Collada's counts, strides and indices too.
   if (format == "dae") check_collada(data, size, name);
   // The model under its own name with its format's extension (see ConfinedIO).
@@ -183,7 +188,7 @@ const aiScene* read_with_assimp(Assimp::Importer& importer, const uint8_t* data,
   // looks like a PLY to it) and hand the bytes to a loader nothing checked.
   if (!imported_format(format) || importer.GetImporter(format.c_str()) == nullptr)
     throw std::runtime_error(name + ": not a mesh format this tool reads ('" + format +
-                             "'; it reads .obj, .ply, .gltf, .glb, .3ds, .dae, .iqm, .md3 and .drc)");
+                             "'; it reads .obj, .ply, .gltf, .glb, .3ds, .dae, .iqm, .md2, .md3, .ms3d and .drc)");
   for (size_t i = importer.GetImporterCount(); i-- > 0;) {
     Assimp::BaseImporter* loader = importer.GetImporter(i);
     std::set<std::string> extensions;

@@ -19,18 +19,25 @@ namespace vds::enc {
 namespace {
 
 Image read_texture(const aiScene* as, const std::string& path, const std::filesystem::path& root, unsigned m,
-                   const std::string& file, std::string* where) {
-  if (const aiTexture* emb = as->GetEmbeddedTexture(file.c_str())) {
+                   const std::string& named_file, std::string* where) {
+  if (const aiTexture* emb = as->GetEmbeddedTexture(named_file.c_str())) {
     if (emb->mHeight != 0)
       throw std::runtime_error(path + ": material " + std::to_string(m) +
                                " has an uncompressed embedded texture (only image files are read)");
-    *where = path + ":" + file;
+    *where = path + ":" + named_file;
     try {
       return decode_image(reinterpret_cast<const uint8_t*>(emb->pcData), emb->mWidth, *where, 3);
     } catch (const std::runtime_error& e) {
       throw std::runtime_error(path + ": material " + std::to_string(m) + "'s embedded texture: " + e.what());
     }
   }
+  // Windows paths (an MS3D's ".\jeep1.jpg") name the same file with '/'.
+  std::string file = named_file;
+  std::replace(file.begin(), file.end(), '\\', '/');
+  // A name assimp made up for a model that names no image ("$texture_dummy.bmp"
+  // for an MD2 without skins) is the model's own name with an image's
+  // extension, as such models ship (sydney.md2 beside sydney.bmp).
+  if (!file.empty() && file[0] == '$') file = std::filesystem::path(path).stem().string() + ".png";
   std::string resolved = root.empty() ? std::string() : confined_path(root, file);
   if (root.empty())
     throw std::runtime_error(path + ": material " + std::to_string(m) + " names texture '" + file +
@@ -42,7 +49,7 @@ Image read_texture(const aiScene* as, const std::string& path, const std::filesy
   if (!std::filesystem::is_regular_file(resolved, ec)) {
     // Models often name a texture by another path, case or image format
     // than the file has: the same name in the model's folder is taken, else
-    // the same name with another image extension (PNG, JPEG, TGA, in that order).
+    // the same name with another image extension (PNG, JPEG, TGA, BMP, in that order).
     const std::filesystem::path named(file);
     const std::string leaf = ascii_lower(named.filename().string()), stem = ascii_lower(named.stem().string());
     resolved.clear();
@@ -52,15 +59,18 @@ Image read_texture(const aiScene* as, const std::string& path, const std::filesy
       const std::string have = ascii_lower(entry.path().filename().string());
       if (have == leaf) resolved = entry.path().string();
       const std::string ext = extension_of(have);
-      const int rank = ext == "png" ? 0 : (ext == "jpg" || ext == "jpeg") ? 1 : ext == "tga" ? 2 : 99;
+      const int rank = ext == "png" ? 0 : (ext == "jpg" || ext == "jpeg") ? 1 : ext == "tga" ? 2 : ext == "bmp" ? 3 : 99;
       if (rank < other_rank && ascii_lower(entry.path().stem().string()) == stem) {
         other = entry.path().string();
         other_rank = rank;
       }
     }
     if (resolved.empty()) resolved = other;
+    if (resolved.empty() && file != named_file && named_file[0] == '$')
+      throw std::runtime_error(path + ": material " + std::to_string(m) +
+                               " names no image, and no image beside the model has its name (PNG, JPEG, TGA or BMP)");
     if (resolved.empty())
-      throw std::runtime_error(path + ": material " + std::to_string(m) + " names texture '" + file +
+      throw std::runtime_error(path + ": material " + std::to_string(m) + " names texture '" + named_file +
                                "', which does not exist");
   }
   *where = resolved;

@@ -29,10 +29,7 @@ void table(const uint8_t* d, size_t size, size_t base, size_t field, uint64_t co
 }
 
 uint32_t count(const uint8_t* d, size_t at, uint32_t limit, const char* what, const std::string& name) {
-  const int32_t v = static_cast<int32_t>(load_le32(d + at));
-  if (v < 0 || static_cast<uint32_t>(v) > limit)
-    refuse_at_byte(name, std::string(what) + " " + std::to_string(v) + " (0.." + std::to_string(limit) + ")", at);
-  return static_cast<uint32_t>(v);
+  return field_in(d, at, 0, limit, what, name);
 }
 
 }  // namespace

@@ -11,7 +11,7 @@
 //    with samples for every face.
 //
 // Seed corpus: when the corpus directory is empty, small valid inputs are
-// written (a header, a level, an OBJ, a Collada file).
+// written (a header, a level, an OBJ, a Collada file, an MD2, an MS3D).
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -22,14 +22,16 @@
 #include <string>
 #include <vector>
 
+#include "model_seeds.h"
 #include "seed_corpus.h"
 #include "vds/enc/mesh_colors.h"
 #include "vds/mesh_colors.h"
 
 namespace {
 
-const char* const kNames[] = {"input.obj", "input.gltf", "input.glb", "input.dae", "input.iqm", "input.3ds", "input.md3"};
-constexpr int kFormats = 7;
+const char* const kNames[] = {"input.obj", "input.gltf", "input.glb", "input.dae", "input.iqm",
+                              "input.3ds", "input.md3", "input.md2", "input.ms3d"};
+constexpr int kFormats = 9;
 
 // A fixed 3 x 3 grid of quads with mixed resolutions, and a valid stream for it.
 struct Fixed {
@@ -100,6 +102,8 @@ void seed(const std::filesystem::path& dir) {
         "<input semantic=\"VERTEX\" source=\"#v\" offset=\"0\"/><p>0 1 2</p></triangles></mesh></geometry>"
         "</library_geometries><library_visual_scenes><visual_scene id=\"s\"><node><instance_geometry url=\"#g\"/></node>"
         "</visual_scene></library_visual_scenes><scene><instance_visual_scene url=\"#s\"/></scene></COLLADA>");
+  write(dir / "seed_md2", 3, std::string(1, '\7') + vds::test::md2_seed());
+  write(dir / "seed_ms3d", 3, std::string(1, '\10') + vds::test::ms3d_seed());
 }
 
 void decode(const uint8_t* data, size_t size, bool as_level, bool paper) {

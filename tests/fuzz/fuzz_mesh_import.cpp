@@ -1,7 +1,7 @@
 // libFuzzer: the host's mesh import (vds/enc/mesh_import.h), what `vds
 // encode-mesh` does with a user's file: the project's PLY check, assimp
-// (with its data-structure validation) for OBJ, PLY, glTF, GLB, Collada
-// IQM and MD3 (those two checked by the project's own readers first), libdraco
+// (with its data-structure validation) for OBJ, PLY, glTF, GLB, Collada,
+// IQM, MD2, MD3 and MS3D (checked by the project's own readers first), libdraco
 // for Draco, then the repair rule. The first byte picks the format the
 // file's name says; the rest is the file. Invariants: no crash, sanitizer
 // report, hang or allocation beyond libFuzzer's limit; a refusal is a
@@ -10,7 +10,8 @@
 //
 // Seed corpus: when the corpus directory is empty, small valid files are
 // written to it first (an OBJ, an ASCII and a binary PLY, a glTF with its
-// buffer inline, a GLB, a Draco mesh, a Collada file, an IQM file, an MD3).
+// buffer inline, a GLB, a Draco mesh, a Collada file, an IQM file, an MD3, an
+// MD2, an MS3D).
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -21,14 +22,16 @@
 #include <string>
 #include <vector>
 
+#include "model_seeds.h"
 #include "seed_corpus.h"
 #include "vds/enc/mesh_import.h"
 
 namespace {
 
 const char* const kNames[] = {"input.obj", "input.ply", "input.gltf", "input.glb", "input.drc",
-                              "input.3ds", "input.off", "input.dae", "input.iqm", "input.md3"};
-constexpr int kFormats = 10;  // .off: a format the tool refuses
+                              "input.3ds", "input.off", "input.dae", "input.iqm", "input.md3",
+                              "input.md2", "input.ms3d"};
+constexpr int kFormats = 12;  // .off: a format the tool refuses
 
 void write(const std::filesystem::path& p, uint8_t pick, const std::string& body) {
   std::ofstream f(p, std::ios::binary);
@@ -155,6 +158,8 @@ void seed(const std::filesystem::path& dir) {
     md3.replace(104, 4, le32(eof));
     write(dir / "seed_md3", 9, md3);
   }
+  write(dir / "seed_md2", 10, vds::test::md2_seed());
+  write(dir / "seed_ms3d", 11, vds::test::ms3d_seed());
   write(dir / "seed_off", 6, "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 1 2 3\n3 2 0 3\n");
 }
 

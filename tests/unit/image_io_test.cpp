@@ -115,6 +115,53 @@ TEST(ImageIoHostile, TgaKindsReadAsWritten) {
   EXPECT_NE(refusal(tga(10, 2, 2, 24, {0x01, 1, 2, 3, 4, 5})).find("ends inside its pixels"), std::string::npos);
 }
 
+namespace {
+
+// A Windows BMP: a 54-byte header, then the rows bottom first, each padded
+// to 4 bytes (24 bits: B, G, R).
+std::vector<uint8_t> bmp(int w, int h, int bits, uint32_t compression, const std::vector<uint8_t>& rows) {
+  auto le = [](std::vector<uint8_t>& f, uint32_t v, int n) {
+    for (int i = 0; i < n; ++i) f.push_back(static_cast<uint8_t>(v >> (8 * i)));
+  };
+  std::vector<uint8_t> f = {'B', 'M'};
+  le(f, 54 + static_cast<uint32_t>(rows.size()), 4);
+  le(f, 0, 4);
+  le(f, 54, 4);
+  le(f, 40, 4);
+  le(f, static_cast<uint32_t>(w), 4);
+  le(f, static_cast<uint32_t>(h), 4);
+  le(f, 1, 2);
+  le(f, static_cast<uint32_t>(bits), 2);
+  le(f, compression, 4);
+  le(f, static_cast<uint32_t>(rows.size()), 4);
+  le(f, 2835, 4);
+  le(f, 2835, 4);
+  le(f, 0, 4);
+  le(f, 0, 4);
+  f.insert(f.end(), rows.begin(), rows.end());
+  return f;
+}
+
+}  // namespace
+
+TEST(ImageIoHostile, BmpReadAsWrittenAndRefusedWhereItLies) {
+  // 2x2, 24 bits: the bottom row (1,2,3 4,5,6) first, then the top row.
+  const std::vector<uint8_t> rows = {1, 2, 3, 4, 5, 6, 0, 0, 7, 8, 9, 10, 11, 12, 0, 0};
+  const std::vector<uint8_t> f = bmp(2, 2, 24, 0, rows);
+  const vds::io::Image img = vds::io::decode_image(f.data(), f.size(), "b", 3);
+  ASSERT_EQ(img.width, 2);
+  ASSERT_EQ(img.height, 2);
+  EXPECT_EQ(img.pixels, (std::vector<uint8_t>{9, 8, 7, 12, 11, 10, 3, 2, 1, 6, 5, 4}));
+  // Rows missing from the end, a size beyond the limit, run-length coding.
+  std::vector<uint8_t> cut = f;
+  cut.resize(cut.size() - 3);
+  EXPECT_NE(refusal(cut).find("end at byte 70, past the file's 67"), std::string::npos) << refusal(cut);
+  EXPECT_NE(refusal(bmp(20000, 20000, 24, 0, rows)).find("the BMP declares a 20000x20000 image"), std::string::npos)
+      << refusal(bmp(20000, 20000, 24, 0, rows));
+  EXPECT_NE(refusal(bmp(2, 2, 8, 1, rows)).find("BMP"), std::string::npos);
+  EXPECT_NE(refusal({'B', 'M', 0, 0}).find("f: a BMP file of 4 bytes"), std::string::npos);
+}
+
 TEST(ImageIoHostile, DeclaredSizesMustFitTheFile) {
   // A PNG of a few dozen bytes declaring 16384 x 4096 RGBA: 256 MiB of rows.
   std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A};

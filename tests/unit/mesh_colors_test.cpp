@@ -448,6 +448,17 @@ TEST_P(MeshColorsModes, VertexSamplesFromTheVertexColours) {
 INSTANTIATE_TEST_SUITE_P(PaperAndVds, MeshColorsModes, ::testing::Values(true, false),
                          [](const ::testing::TestParamInfo<bool>& i) { return i.param ? "paper" : "vds"; });
 
+// A model converted at R <= 16, coded at quality 1 and decoded: the finest
+// level's luma within `min_db` of the model's.
+void expect_round_trip(const enc::TexturedModel& t, double min_db) {
+  enc::MeshColorsOptions o;
+  o.max_res_log2 = 4;
+  const enc::MeshColorsModel m = enc::to_mesh_colors(t, o);
+  const enc::MccEncoded e = enc::encode_mesh_colors(m, 1);
+  const auto planes = enc::decode_mesh_colors_level(m, e, 0);
+  EXPECT_GE(plane_psnr(planes[0], m.levels[0][0]), min_db) << t.name;
+}
+
 // Real data: assimp-testmodels, which make test installs (scripts/fetch-data.sh).
 TEST(MeshColorsImport, TheDuckAndMrFixitConvertAndRoundTrip) {
   const char* duck = "/usr/share/assimp/models/Collada/duck_triangulate.dae";
@@ -462,14 +473,7 @@ TEST(MeshColorsImport, TheDuckAndMrFixitConvertAndRoundTrip) {
   const enc::TexturedModel f = enc::load_textured_model(fixit);
   ASSERT_EQ(f.textures.size(), 2u);  // Body and Head, found by name with another extension
   EXPECT_GT(f.triangles.size(), 2000u);
-  enc::MeshColorsOptions o;
-  o.max_res_log2 = 4;
-  for (const enc::TexturedModel* t : {&d, &f}) {
-    const enc::MeshColorsModel m = enc::to_mesh_colors(*t, o);
-    const enc::MccEncoded e = enc::encode_mesh_colors(m, 1);
-    const auto planes = enc::decode_mesh_colors_level(m, e, 0);
-    EXPECT_GE(plane_psnr(planes[0], m.levels[0][0]), 34) << t->name;  // mrfixit measured 35.5
-  }
+  for (const enc::TexturedModel* t : {&d, &f}) expect_round_trip(*t, 34);  // mrfixit measured 35.5
 }
 
 std::vector<uint8_t> read_bytes(const char* path) {
@@ -510,6 +514,151 @@ TEST(MeshColorsImport, IqmCountsThatDoNotFitAreRefusedNamingTheFile) {
   b = good;
   set32(b, 16, 1);  // version
   refused(b, "IQM version 1");
+}
+
+// Quake II and MilkShape models: Sydney (an MD2 without skins, beside
+// sydney.bmp) and the jeep (an MS3D naming ".\jeep1.jpg").
+TEST(MeshColorsImport, Md2AndMs3dModelsConvertWithTheirImages) {
+  const char* sydney = "/usr/share/assimp/models/MD2/sydney.md2";
+  const char* jeep = "/usr/share/assimp/models/MS3D/jeep1.ms3d";
+  for (const char* path : {sydney, jeep})
+    ASSERT_TRUE(std::ifstream(path).good()) << path << " not installed: scripts/fetch-data.sh installs assimp-testmodels";
+  const enc::TexturedModel s = enc::load_textured_model(sydney);
+  EXPECT_EQ(s.triangles.size(), 679u);
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(s.textures[0].width, 308);  // the BMP beside it
+  EXPECT_EQ(s.textures[0].height, 193);
+  const enc::TexturedModel j = enc::load_textured_model(jeep);
+  EXPECT_EQ(j.triangles.size(), 2032u);
+  ASSERT_EQ(j.textures.size(), 1u);
+  EXPECT_EQ(j.textures[0].width, 512);
+  for (const enc::TexturedModel* t : {&s, &j}) expect_round_trip(*t, 34);
+  // Alone in a folder, Sydney names no image that exists.
+  const std::string dir = std::string(::testing::TempDir()) + "/md2_alone";
+  std::filesystem::create_directories(dir);
+  enc::write_file(dir + "/sydney.md2", read_bytes(sydney));
+  try {
+    enc::load_textured_model(dir + "/sydney.md2");
+    ADD_FAILURE() << "a model whose image is missing was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("names no image, and no image beside the model has its name"), std::string::npos)
+        << e.what();
+  }
+}
+
+std::string model_refusal(const std::string& bytes, const std::string& name) {
+  try {
+    vds::enc::read_textured_model(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), name);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void put(std::string& b, size_t at, uint32_t v, int n) {
+  for (int i = 0; i < n; ++i) b[at + i] = static_cast<char>(v >> (8 * i));
+}
+
+TEST(MeshColorsImport, Md2CountsOffsetsAndIndicesThatLieAreRefusedNamingTheFile) {
+  const std::vector<uint8_t> bytes = read_bytes("/usr/share/assimp/models/MD2/sydney.md2");
+  ASSERT_GT(bytes.size(), 68u) << "assimp-testmodels not installed";
+  const std::string good(bytes.begin(), bytes.end());
+  // The valid file passes the check (from memory it stops at its image).
+  EXPECT_EQ(model_refusal(good, "s.md2").find("(byte "), std::string::npos) << model_refusal(good, "s.md2");
+  const uint32_t tris_at = static_cast<uint32_t>(bytes[52] | bytes[53] << 8);
+  struct Lie {
+    size_t at;
+    uint32_t value;
+    int bytes;
+    const char* says;
+  };
+  const Lie lies[] = {
+      {4, 9, 4, "s.md2: MD2 version 9 (8 is read) (byte 4)"},
+      {40, 0, 4, "s.md2: frames 0 (1..512) (byte 40)"},
+      {24, 3000, 4, "s.md2: vertices 3000 (1..2048) (byte 24)"},
+      {8, 0, 4, "s.md2: skin width 0 (1..4096) (byte 8)"},
+      {16, 100, 4, "s.md2: frame size (a frame of these vertices needs at least) 100"},
+      {56, 300000, 4, "s.md2: the frames: 198 of 1408 bytes at offset 300000 do not fit the file's 302128 bytes (byte 56)"},
+      {64, 302129, 4, "s.md2: the end offset 302129 lies outside the file's 302128 bytes (byte 64)"},
+      {tris_at, 342, 2, "s.md2: triangle 0 names vertex 342 of 342"},
+      {tris_at + 8, 456, 2, "s.md2: triangle 0 names texture coordinate 456 of 456"},
+  };
+  for (const Lie& l : lies) {
+    std::string b = good;
+    put(b, l.at, l.value, l.bytes);
+    EXPECT_NE(model_refusal(b, "s.md2").find(l.says), std::string::npos) << model_refusal(b, "s.md2");
+  }
+  EXPECT_NE(model_refusal(good.substr(0, 5000), "s.md2").find("do not fit the file's 5000 bytes"), std::string::npos);
+  EXPECT_NE(model_refusal("IDP2", "s.md2").find("not a Quake II model"), std::string::npos);
+}
+
+// A MilkShape model: three vertices, one triangle, one group naming
+// `material`, `materials` materials, no joints; `tail` after.
+std::string ms3d(int material, int materials, const std::string& tail = "") {
+  auto le = [](uint32_t v, int n) {
+    std::string s(static_cast<size_t>(n), '\0');
+    for (int i = 0; i < n; ++i) s[static_cast<size_t>(i)] = static_cast<char>(v >> (8 * i));
+    return s;
+  };
+  auto f32 = [&](float f) {
+    uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return le(u, 4);
+  };
+  std::string m = "MS3D000000" + le(4, 4) + le(3, 2);
+  const float p[3][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  for (const auto& v : p) m += std::string(1, '\0') + f32(v[0]) + f32(v[1]) + f32(v[2]) + le(0xFF, 1) + le(0, 1);
+  m += le(1, 2);
+  m += le(0, 2) + le(0, 2) + le(1, 2) + le(2, 2);                            // flags, the vertices
+  for (int k = 0; k < 9; ++k) m += f32(k % 3 == 2 ? 1.0f : 0.0f);            // normals
+  for (int k = 0; k < 6; ++k) m += f32(0.5f);                                // s, t
+  m += le(1, 1) + le(0, 1);                                                  // smoothing group, group
+  m += le(1, 2) + le(0, 1) + std::string(32, 'g') + le(1, 2) + le(0, 2) + le(static_cast<uint32_t>(material) & 0xFF, 1);
+  m += le(static_cast<uint32_t>(materials), 2);
+  for (int i = 0; i < materials; ++i) {
+    std::string mat(361, '\0');
+    mat[0] = 'm';
+    for (int k = 0; k < 4; ++k) mat.replace(32 + 16 + 4 * k, 4, f32(0.8f));  // diffuse
+    m += mat;
+  }
+  m += f32(24) + f32(0) + le(1, 4) + le(0, 2);  // animation, no joints
+  return m + tail;
+}
+
+TEST(MeshColorsImport, Ms3dTablesThatLieAreRefusedNamingTheFile) {
+  auto le = [](uint32_t v) {
+    std::string s(4, '\0');
+    for (int i = 0; i < 4; ++i) s[static_cast<size_t>(i)] = static_cast<char>(v >> (8 * i));
+    return s;
+  };
+  // Valid: no material, one material, and the optional tables after.
+  EXPECT_EQ(model_refusal(ms3d(-1, 0), "j.ms3d"), "");
+  EXPECT_EQ(model_refusal(ms3d(0, 1), "j.ms3d"), "");
+  const std::string tail = le(1) + le(0) + le(0) + le(0) + le(1) + le(2) + "hi" + le(3) + std::string(3 * 14, '\0') + le(1) +
+                           le(1) + std::string(12, '\0');
+  EXPECT_EQ(model_refusal(ms3d(-1, 0, tail), "j.ms3d"), "");
+  EXPECT_NE(model_refusal(ms3d(1, 1), "j.ms3d").find("j.ms3d: a group names material 1 of 1"), std::string::npos);
+  std::string b = ms3d(-1, 0);
+  put(b, 16 + 45 + 2 + 2, 3, 2);  // the triangle's first vertex
+  EXPECT_NE(model_refusal(b, "j.ms3d").find("j.ms3d: triangle 0 names vertex 3 of 3 (byte 65)"), std::string::npos)
+      << model_refusal(b, "j.ms3d");
+  b = ms3d(-1, 0);
+  put(b, 16 + 45 + 2 + 70 + 2 + 33 + 2, 1, 2);  // the group's triangle
+  EXPECT_NE(model_refusal(b, "j.ms3d").find("group 0 names triangle 1 of 1"), std::string::npos) << model_refusal(b, "j.ms3d");
+  b = ms3d(-1, 0);
+  put(b, 14, 40000, 2);  // vertices: their table runs past the end
+  EXPECT_NE(model_refusal(b, "j.ms3d").find("the vertices: 600000 bytes, past the file's end"), std::string::npos)
+      << model_refusal(b, "j.ms3d");
+  b = ms3d(-1, 0);
+  put(b, 10, 7, 4);
+  EXPECT_NE(model_refusal(b, "j.ms3d").find("MS3D version 7"), std::string::npos);
+  EXPECT_NE(model_refusal(ms3d(-1, 0, "xyz"), "j.ms3d").find("the comments' version: 4 bytes, past the file's end"),
+            std::string::npos)
+      << model_refusal(ms3d(-1, 0, "xyz"), "j.ms3d");
+  EXPECT_NE(model_refusal(ms3d(-1, 0, tail + "x"), "j.ms3d").find("1 bytes after the model's last table"), std::string::npos);
+  const std::string s = ms3d(-1, 0);
+  for (size_t n = 0; n < s.size(); n += 7)
+    EXPECT_NE(model_refusal(s.substr(0, n), "j.ms3d").find("j.ms3d: "), std::string::npos) << "prefix " << n;
 }
 
 }  // namespace

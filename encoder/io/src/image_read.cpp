@@ -1,9 +1,11 @@
 // Host image files in: PNG through libpng, JPEG through libjpeg-turbo (its
-// TurboJPEG interface), TGA and binary PNM (P5, P6) through the readers below (uncompressed and RLE,
+// TurboJPEG interface), BMP through stb_image (Debian's libstb), TGA and
+// binary PNM (P5, P6) through the readers below (uncompressed and RLE,
 // true colour and grey: what game textures use). Every reader checks the
 // size an image declares against vds/io/image.h's limits before a pixel is
 // decoded, and refuses with the file's name, what is wrong and where.
 #include <png.h>
+#include <stb_image.h>
 #include <turbojpeg.h>
 
 #include <cstring>
@@ -52,6 +54,41 @@ Image convert(const Image& in, int want) {
     }
   }
   return out;
+}
+
+// --- BMP ------------------------------------------------------------------------
+
+// Windows bitmaps (older models' skins): palettised, 16, 24 and 32 bits,
+// uncompressed. stb_image reads them; its header pass gives the size,
+// checked before any pixel is decoded, and the rows it will read must be in
+// the file (stb_image reads zeros past the end).
+Image read_bmp(const uint8_t* data, size_t size, const std::string& what) {
+  if (size > static_cast<size_t>(INT32_MAX)) refuse(what, "a BMP file over 2 GiB");
+  if (size < 30) refuse(what, "a BMP file of " + std::to_string(size) + " bytes ends inside its header");
+  const int n = static_cast<int>(size);
+  int w = 0, h = 0, c = 0;
+  if (stbi_info_from_memory(data, n, &w, &h, &c) == 0)
+    refuse(what, std::string("not a BMP file this tool reads (") + stbi_failure_reason() + ")");
+  check_size(what, "the BMP", w, h);
+  const auto le32 = [data](size_t at) {
+    return uint32_t{data[at]} | uint32_t{data[at + 1]} << 8 | uint32_t{data[at + 2]} << 16 | uint32_t{data[at + 3]} << 24;
+  };
+  if (size < 54 || le32(14) < 40) refuse(what, "an OS/2 BMP or a BMP header of under 40 bytes (Windows BMPs are read)");
+  const uint32_t bits = uint32_t{data[28]} | uint32_t{data[29]} << 8;
+  const uint32_t compression = le32(30);
+  if (compression != 0 && compression != 3)
+    refuse(what, "a compressed BMP (compression " + std::to_string(compression) + "; uncompressed ones are read)");
+  const uint64_t row = (uint64_t{static_cast<uint32_t>(w)} * bits + 31) / 32 * 4;
+  const uint64_t need = uint64_t{le32(10)} + row * static_cast<uint32_t>(h);
+  if (need > size)
+    refuse(what, "the BMP's " + std::to_string(w) + "x" + std::to_string(h) + " pixels of " + std::to_string(bits) +
+                     " bits end at byte " + std::to_string(need) + ", past the file's " + std::to_string(size));
+  const int want = c == 4 ? 4 : 3;
+  std::unique_ptr<stbi_uc, void (*)(void*)> px(stbi_load_from_memory(data, n, &w, &h, &c, want), stbi_image_free);
+  if (!px) refuse(what, std::string("damaged BMP file (") + stbi_failure_reason() + ")");
+  Image img(w, h, want);
+  std::memcpy(img.pixels.data(), px.get(), static_cast<size_t>(w) * h * want);
+  return img;
 }
 
 // --- PNG ------------------------------------------------------------------------
@@ -311,7 +348,7 @@ Image decode_image(const uint8_t* data, size_t size, const std::string& what, in
   else if (size >= 3 && data[0] == 'P' && (data[1] == '5' || data[1] == '6'))
     img = read_pnm(data, size, what);
   else if (size >= 2 && data[0] == 'B' && data[1] == 'M')
-    refuse(what, "a BMP file (PNG, JPEG, PNM or TGA are read)");
+    img = read_bmp(data, size, what);
   else
     img = read_tga(data, size, what);
   return convert(img, want_channels);

@@ -1,7 +1,7 @@
-// Host image files: load PNG (libpng), JPEG (libjpeg-turbo), PNM and TGA, write PNG (libpng),
-// and the measures every benchmark uses (PSNR). A leaf library (libpng and
-// libjpeg-turbo only, nothing of vds) that the encoder and the host-native board both
-// use.
+// Host image files: load PNG (libpng), JPEG (libjpeg-turbo), BMP (stb_image), PNM and TGA,
+// write PNG (libpng), and the measures every benchmark uses (PSNR). A leaf library
+// (libpng, libjpeg-turbo and stb_image only, nothing of vds) that the encoder and the
+// host-native board both use.
 #pragma once
 #include <array>
 #include <cstddef>
@@ -35,8 +35,8 @@ constexpr int64_t kMaxImagePixels = int64_t{64} << 20;
 // Loads an image file; `want_channels` 0 keeps the file's own, 1/3/4 converts.
 // Throws std::runtime_error naming the file and the reason.
 Image load_image(const std::string& path, int want_channels = 0);
-// Decodes an in-memory image file (PNG, JPEG, binary PNM or TGA; the kind from its first
-// bytes, TGA when none matches).
+// Decodes an in-memory image file (PNG, JPEG, BMP, binary PNM or TGA; the kind from its
+// first bytes, TGA when none matches).
 Image decode_image(const uint8_t* data, size_t size, const std::string& what, int want_channels = 0);
 // A heightmap: one height per pixel, in the file's own levels. Grey images
 // give their sample (8-bit, or 16-bit from a 16-bit PNG or a PGM of maxval
