@@ -84,6 +84,24 @@ WalkPose flight_pose(const WalkPose* keys, uint32_t count, uint32_t spacing, uin
   return p;
 }
 
+WalkPose steer_pose(const WalkPose& p, const SteerInput& in, int32_t step_q16) {
+  WalkPose out = p;
+  out.yaw = static_cast<uint16_t>(p.yaw + in.turn);
+  int32_t pitch = static_cast<int16_t>(p.pitch) + int32_t{in.tilt};
+  if (pitch > kMaxSteerPitch) pitch = kMaxSteerPitch;
+  if (pitch < -int32_t{kMaxSteerPitch}) pitch = -int32_t{kMaxSteerPitch};
+  out.pitch = static_cast<uint16_t>(pitch);
+  const int64_t step = int64_t{step_q16} * (in.fast ? 4 : 1);
+  // Heading (cos, sin) of the new yaw in Q1.15; right of it is (sin, -cos).
+  const int64_t c = cos_q1_15(out.yaw).raw(), s = sin_q1_15(out.yaw).raw();
+  const int64_t dx = (in.forward * c + in.right * s) * step >> 15;
+  const int64_t dy = (in.forward * s - in.right * c) * step >> 15;
+  const int64_t dz = in.up * step / 2;
+  const auto add = [](Q16_16 v, int64_t d) { return Q16_16::from_raw(sat_s32(int64_t{v.raw()} + d)); };
+  out.position = {add(p.position.x, dx), add(p.position.y, dy), add(p.position.z, dz)};
+  return out;
+}
+
 // --- BlockStore ---------------------------------------------------------------
 //
 // One buffer: the entries (sorted by id) from its start, the coefficients

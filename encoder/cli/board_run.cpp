@@ -132,7 +132,9 @@ BoardResult run_on_board(const BoardArgs& a, const std::string& name, const Serv
       argv.insert(argv.end(), {"--frames", (dir / "frames").string(), "--y4m", (dir / "frames.y4m").string(), "--contact-sheet",
                                (dir / "contact_sheet.png").string()});
     if (a.window) argv.push_back("--window");
+    if (!a.controls.empty()) argv.insert(argv.end(), {"--controls", fs::absolute(a.controls).string()});
   } else {
+    if (!a.controls.empty()) throw Failure(kExitUsage, "--controls is for the host board (the qemu board has no controls)");
     const uint16_t port = free_port();
     o.link = "tcp:127.0.0.1:" + std::to_string(port);
     argv = {a.qemu, "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none", "-serial",

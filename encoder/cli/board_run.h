@@ -20,6 +20,7 @@ struct BoardArgs {
   uint32_t baud = 115200;
   uint32_t timeout = 600;
   bool window = false;
+  std::string controls;  // host board: a controls script (the viewer's keys, scripted)
 };
 
 struct BoardResult {

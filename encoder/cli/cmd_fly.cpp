@@ -228,6 +228,8 @@ void run_encode(const FlyOptions& o) {
 // `vds serve-terrain`: the server live. The client plays the flight the
 // stream's TFLY gives it and sends its pose up every pose period; the
 // server answers the newest pose it has received as the frames fall due.
+// A viewer who steers (the host board's window or controls script) sends
+// steered poses, which the server draws (TFRM with the pose).
 // Afterwards the stream as sent is replayed through the client library and
 // every frame the board showed must equal the replay's.
 void run_serve_terrain(const FlyOptions& o) {
@@ -267,6 +269,8 @@ void run_serve_terrain(const FlyOptions& o) {
   for (const enc::TerrainStreamFrame& f : live.frames()) texture += f.texture_bytes, answered += f.texture_bytes != 0;
   std::printf("%s: %zu frames made, %zu bytes; %u poses received (%u refused); %u updates, %zu bytes of texture\n",
               name.c_str(), live.frames().size(), made.size(), live.poses_received(), live.poses_refused(), answered, texture);
+  if (live.steered_frames() != 0)
+    std::printf("%s: %u frames drawn from the viewer's steered pose\n", name.c_str(), live.steered_frames());
   std::vector<uint32_t> want;
   try {
     want = enc::client_frame_crcs(made);
@@ -280,6 +284,8 @@ void run_serve_terrain(const FlyOptions& o) {
     check_serve_report(r.report);
   }
   if (live.poses_received() == 0) throw Failure(kExitBadInput, name + ": no pose came up the link");
+  if (!o.board.controls.empty() && live.steered_frames() == 0)
+    throw Failure(kExitBadInput, name + ": the controls script steered no frame (no steered pose came up the link)");
 }
 
 void map_options(CLI::App* sub, FlyOptions* o) {
@@ -341,6 +347,11 @@ void add_serve_terrain(CLI::App& app) {
   sub->add_option("--qemu", o->board.qemu, "QEMU's Arm system emulator")->capture_default_str();
   sub->add_option("--timeout", o->board.timeout, "Give up after this many seconds (default 600)");
   sub->add_option("--stream-out", o->stream_out, "Write the stream as it was sent");
+  sub->add_flag("--window", o->board.window,
+                "Host board: show the frames in a live window and steer the viewer with its keys and mouse (W/A/S/D, arrows, R/F, Shift; drag)");
+  sub->add_option("--controls", o->board.controls,
+                  "Host board: steer the viewer from a script instead (lines 'FRAMES FORWARD RIGHT UP TURN TILT [fast]')")
+      ->check(CLI::ExistingFile);
   sub->callback([o] { run_serve_terrain(*o); });
 }
 

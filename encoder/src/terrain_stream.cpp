@@ -153,7 +153,8 @@ TerrainLive::TerrainLive(const TerrainCoding& t, const CameraPath& path, const T
 
 bool TerrainLive::pose(const uint8_t* data, size_t n) {
   if (data == nullptr || n != terrain::kPoseMessageBytes) return ++refused_, false;
-  const uint32_t frame = load_le32(data);
+  const bool steered = (load_le32(data) & terrain::kPoseSteered) != 0;
+  const uint32_t frame = load_le32(data) & ~terrain::kPoseSteered;
   if (frame >= sender_.frames() || (have_pose_ && frame <= pose_frame_)) return ++refused_, false;
   if (have_pose_) {
     previous_ = pose_;
@@ -164,6 +165,11 @@ bool TerrainLive::pose(const uint8_t* data, size_t n) {
   pose_frame_ = frame;
   have_pose_ = true;
   ++poses_;
+  // A steered pose is drawn from the next frame written on.
+  if (steered) {
+    steered_ = true;
+    steered_pose_ = pose_;
+  }
   return true;
 }
 
@@ -204,10 +210,14 @@ void TerrainLive::next_frame() {
     // A link with nothing to send carries nothing: no credit is saved up.
     if (tf.update.wanted == 0 || u.empty()) credit_ = std::min(credit_, per_frame_);
   }
-  uint8_t frm[terrain::kFrameBytes];
+  uint8_t frm[terrain::kSteeredFrameBytes];
   store_le32(frm, f);
-  w_->add_chunk(chunk::kTerrainFrame, frm);
-  credit_ -= static_cast<double>(terrain::kFrameBytes + kChunkFraming);
+  if (steered_) terrain::pose_to_bytes(steered_pose_, frm + terrain::kFrameBytes);
+  const size_t frm_bytes = steered_ ? terrain::kSteeredFrameBytes : terrain::kFrameBytes;
+  w_->add_chunk(chunk::kTerrainFrame, std::span<const uint8_t>(frm, frm_bytes));
+  credit_ -= static_cast<double>(frm_bytes + kChunkFraming);
+  tf.steered = steered_;
+  if (steered_) ++steered_frames_;
   tf.stream_bytes = w_->size();
   frames_.push_back(tf);
   if (o_.progress) o_.progress(frames_.size());

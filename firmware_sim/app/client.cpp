@@ -193,6 +193,8 @@ Status start_stream() {
     if (kind != vds::terrain::kSendPose) return false;
     return g.link.send_datagram(link::channel::kPose, data, n) == Status::ok;
   };
+  // The viewer's controls, where the board has any.
+  cb.steer = [](void*, vds::terrain::SteerInput* in) { return board::read_controls(in); };
   return g.player.init(g.arena, vds::kClientPlayerConfig, cb);
 }
 

@@ -18,6 +18,7 @@
 #include <array>
 
 #include "jpeg_sample_422.h"
+#include "vds/bytes.h"
 #include "vds/container.h"
 #include "vds/enc/frames.h"
 #include "vds/enc/mesh_encoder.h"
@@ -158,7 +159,7 @@ const std::vector<uint8_t>& valid_model() {
 }
 
 // A terrain flight of 8 frames over a 13 x 11-point heightmap with a
-// 96 x 80 colour map (12 x 10 cells), drawn 64 x 48.
+// 96 x 80 colour map (12 x 10 cells), drawn 64 x 48, steered from frame 3.
 const std::vector<uint8_t>& valid_terrain() {
   static const std::vector<uint8_t> s = [] {
     vds::enc::TerrainMap m;
@@ -192,7 +193,21 @@ const std::vector<uint8_t>& valid_terrain() {
     o.cache_log2 = 2;
     o.link.latency_frames = 0;
     o.link.rate_bytes_per_s = 0;
-    return vds::enc::write_terrain_stream(t, path, o).bytes;
+    // From frame 3 on, the viewer's steered pose (TFRM with a pose).
+    vds::enc::TerrainLive live(t, path, o);
+    for (uint32_t f = 0; f < 8; ++f) {
+      if (f == 3) {
+        uint8_t msg[vds::terrain::kPoseMessageBytes];
+        vds::store_le32(msg, 2 | vds::terrain::kPoseSteered);
+        vds::WalkPose p = live.sender().pose(2);
+        p.yaw = static_cast<uint16_t>(p.yaw + 3000);
+        vds::terrain::pose_to_bytes(p, msg + 4);
+        if (!live.pose(msg, sizeof msg)) abort();
+      }
+      live.next_frame();
+    }
+    if (live.steered_frames() != 5) abort();
+    return live.bytes();
   }();
   return s;
 }
@@ -263,6 +278,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     auto& v = *static_cast<Watch*>(ctx);
     if (!v.open) abort();
     v.open = false;
+    return true;
+  };
+  // The viewer's controls, always moving it: a terrain stream's client
+  // steers and clamps its own pose after every frame, whatever it drew.
+  cb.steer = [](void*, vds::terrain::SteerInput* in) {
+    in->forward = 1;
+    in->up = -1;
+    in->turn = 900;
+    in->fast = true;
     return true;
   };
   if (predict) {

@@ -172,10 +172,22 @@ struct Feeder {
   vds::Player player;
   std::vector<std::vector<uint8_t>> poses_up;
   uint32_t frames = 0;
+  std::vector<uint32_t> crcs;
+  // The viewer's controls, one entry a frame (none past the end).
+  std::vector<terrain::SteerInput> controls;
   Feeder() {
     vds::PlayerCallbacks cb;
     cb.ctx = this;
-    cb.frame_shown = [](void* ctx, const vds::PlayedFrame&) { ++static_cast<Feeder*>(ctx)->frames; };
+    cb.frame_shown = [](void* ctx, const vds::PlayedFrame& f) {
+      ++static_cast<Feeder*>(ctx)->frames;
+      static_cast<Feeder*>(ctx)->crcs.push_back(f.crc);
+    };
+    cb.steer = [](void* ctx, terrain::SteerInput* in) {
+      Feeder& me = *static_cast<Feeder*>(ctx);
+      if (me.frames - 1 >= me.controls.size()) return false;
+      *in = me.controls[me.frames - 1];
+      return true;
+    };
     cb.send_up = [](void* ctx, uint8_t kind, const uint8_t* d, size_t n) {
       if (kind == terrain::kSendPose) static_cast<Feeder*>(ctx)->poses_up.emplace_back(d, d + n);
       return true;
@@ -207,12 +219,16 @@ void expect_mirror(const enc::TerrainCoding& t, const enc::TerrainLive& live, co
 struct LiveRun {
   uint32_t frames = 0, poses_sent = 0, poses_lost = 0;
   std::vector<uint8_t> stream;
-  std::vector<uint32_t> crcs;
-  uint32_t refused = 0, updates = 0;
+  std::vector<uint32_t> crcs, shown;  // the replay's, the player's own
+  std::vector<std::vector<uint8_t>> poses;  // every pose sent up
+  uint32_t refused = 0, updates = 0, steered = 0;
+  int32_t cell_q16 = 0;  // the stream's cell size, world units
 };
-LiveRun play_live(const enc::TerrainCoding& t, const enc::CameraPath& path, double lose, bool stale, uint64_t seed) {
+LiveRun play_live(const enc::TerrainCoding& t, const enc::CameraPath& path, double lose, bool stale, uint64_t seed,
+                  const std::vector<terrain::SteerInput>& controls = {}) {
   enc::TerrainLive live(t, path, small_client());
   Feeder client;
+  client.controls = controls;
   vds::test::Xorshift32 r{static_cast<uint32_t>(seed)};
   LiveRun run;
   std::vector<std::pair<uint32_t, std::vector<uint8_t>>> in_flight;  // (arrival frame, message)
@@ -237,6 +253,7 @@ LiveRun play_live(const enc::TerrainCoding& t, const enc::CameraPath& path, doub
     expect_mirror(t, live, client.player, f);
     for (std::vector<uint8_t>& m : client.poses_up) {
       ++run.poses_sent;
+      run.poses.push_back(m);
       if ((r.next() % 1000) < lose * 1000) {
         ++run.poses_lost;
         continue;
@@ -247,8 +264,11 @@ LiveRun play_live(const enc::TerrainCoding& t, const enc::CameraPath& path, doub
   }
   EXPECT_EQ(client.player.finish(), Status::ok) << client.player.error_detail();
   run.frames = client.frames;
+  run.shown = client.crcs;
   run.stream = made;
   run.refused = live.poses_refused();
+  run.steered = live.steered_frames();
+  run.cell_q16 = live.sender().params().cell_q16;
   for (const enc::TerrainStreamFrame& tf : live.frames()) run.updates += tf.texture_bytes != 0;
   run.crcs = enc::client_frame_crcs(made);
   return run;
@@ -282,6 +302,86 @@ TEST(TerrainStream, PosesLostStaleOrRepeatedStillPlayBitExactly) {
   // own replay says (checked frame by frame against the mirror above).
   EXPECT_NE(lossy.stream, clean.stream);
   EXPECT_EQ(lossy.crcs.size(), 80u);
+}
+
+// A viewer steers from frame 20 to 49 (forward, turning left, climbing):
+// its poses go up marked as steered every frame the controls move it, the
+// server draws the newest (TFRM with a pose) from the frame after one
+// arrives, and the client's frames are still its replay's.
+TEST(TerrainStream, AViewerWhoSteersIsDrawnWhereTheControlsTakeIt) {
+  const enc::TerrainCoding t = enc::code_terrain(vds::test::terrain_test_map(), 6);
+  const enc::CameraPath path = circle_flight(t, 80);
+  terrain::SteerInput ahead;
+  ahead.forward = 1;
+  ahead.up = 1;
+  ahead.turn = 182;  // a degree a frame, to the left
+  std::vector<terrain::SteerInput> controls(20);
+  controls.insert(controls.end(), 30, ahead);
+  const LiveRun flown = play_live(t, path, 0.0, false, 1);
+  const LiveRun steered = play_live(t, path, 0.0, false, 1, controls);
+  ASSERT_EQ(steered.frames, 80u);
+  EXPECT_EQ(steered.shown, steered.crcs);  // the client showed what the stream alone gives
+  EXPECT_EQ(flown.steered, 0u);
+  // Poses reach the server 2 frames after they are sent: the first steered
+  // one (sent after frame 20) is drawn from frame 22 on.
+  EXPECT_EQ(steered.steered, 80u - 22u);
+  for (uint32_t f = 0; f < 22; ++f) EXPECT_EQ(steered.shown[f], flown.shown[f]) << f;
+  for (uint32_t f = 23; f < 80; ++f) EXPECT_NE(steered.shown[f], flown.shown[f]) << f;
+  // Up the link: the flight's poses every 4th frame until frame 20, then a
+  // steered pose every frame the controls move the viewer (20..49), then
+  // every 4th frame again, still steered.
+  uint32_t flight = 0, marked = 0;
+  vds::WalkPose last{};
+  for (const std::vector<uint8_t>& m : steered.poses) {
+    ASSERT_EQ(m.size(), terrain::kPoseMessageBytes);
+    const uint32_t word = vds::load_le32(m.data()), frame = word & ~terrain::kPoseSteered;
+    if ((word & terrain::kPoseSteered) == 0) {
+      ++flight;
+      EXPECT_LT(frame, 20u);
+      continue;
+    }
+    ++marked;
+    const vds::WalkPose p = terrain::pose_from_bytes(m.data() + 4);
+    if (frame > 20 && frame < 50) {
+      // Each frame turns a degree and moves a quarter of a cell forward.
+      EXPECT_EQ(static_cast<uint16_t>(p.yaw - last.yaw), 182u) << frame;
+      const double step = std::hypot(p.position.x.raw() - last.position.x.raw(), p.position.y.raw() - last.position.y.raw());
+      EXPECT_NEAR(step, steered.cell_q16 / 4, steered.cell_q16 / 1000.0) << frame;
+    }
+    last = p;
+  }
+  EXPECT_EQ(flight, 5u);        // frames 0, 4, ..., 16
+  EXPECT_EQ(marked, 30u + 7u);  // frames 20..49, then 52, 56, ..., 76
+}
+
+TEST(TerrainSteer, MovesAlongTheHeadingTurnsAndKeepsThePitchInRange) {
+  vds::WalkPose p;
+  p.position = {vds::Q16_16::from_raw(100 << 16), vds::Q16_16::from_raw(50 << 16), vds::Q16_16::from_raw(20 << 16)};
+  p.yaw = 16384;  // facing +Y
+  terrain::SteerInput in;
+  in.forward = 1;
+  vds::WalkPose q = terrain::steer_pose(p, in, 2 << 16);
+  EXPECT_EQ(q.position.x.raw(), 100 << 16);
+  EXPECT_NEAR(q.position.y.raw(), 52 << 16, 4);  // two units along +Y (cos/sin in Q1.15)
+  EXPECT_EQ(q.position.z.raw(), 20 << 16);
+  in = {};
+  in.right = 1;
+  in.fast = true;
+  q = terrain::steer_pose(p, in, 2 << 16);  // to the right of +Y is +X, four times as far
+  EXPECT_NEAR(q.position.x.raw(), 108 << 16, 32);
+  EXPECT_NEAR(q.position.y.raw(), 50 << 16, 32);
+  in = {};
+  in.up = -1;
+  in.turn = -16384;  // a quarter turn to the right: facing +X
+  q = terrain::steer_pose(p, in, 2 << 16);
+  EXPECT_EQ(q.position.z.raw(), 19 << 16);
+  EXPECT_EQ(q.yaw, 0);
+  in = {};
+  in.tilt = 30000;
+  EXPECT_EQ(terrain::steer_pose(p, in, 1 << 16).pitch, terrain::kMaxSteerPitch);
+  in.tilt = -30000;
+  EXPECT_EQ(terrain::steer_pose(p, in, 1 << 16).pitch, static_cast<uint16_t>(-terrain::kMaxSteerPitch));
+  EXPECT_FALSE(terrain::SteerInput{}.any());
 }
 
 // --- Malformed records -----------------------------------------------------------------

@@ -48,6 +48,12 @@
 //   workspace is full, the bytes a base mesh needs); the caller words it.
 // - send_up() is the back-channel for what the client sends upstream
 //   (poses, reports); modes that talk back use it.
+// - steer(), when given, reads the viewer's controls once a frame (a
+//   terrain stream, after the frame is drawn): true when they move the
+//   viewer. The terrain mode then steers a pose of its own from the one
+//   just drawn and sends it up as a steered pose every frame they move it
+//   (else every pose period); the frames it draws still come from the
+//   stream alone (the server draws the steered pose it received).
 // Bit-exact: the same stream and configuration give the same bands on
 // every platform. No heap, no float, no exceptions.
 #pragma once
@@ -128,6 +134,7 @@ struct PlayerCallbacks {
   void (*wait_until)(void* ctx, uint64_t due_ms) = nullptr;
   void (*notice)(void* ctx, PlayerNotice what, uint32_t a, uint32_t b, uint32_t c) = nullptr;
   bool (*send_up)(void* ctx, uint8_t kind, const uint8_t* data, size_t n) = nullptr;
+  bool (*steer)(void* ctx, terrain::SteerInput* in) = nullptr;
   void (*level)(void* ctx, const PlayedLevel& level) = nullptr;
   PredictFn predict = nullptr;  // called with ctx
 };

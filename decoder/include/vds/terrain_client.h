@@ -93,13 +93,39 @@ WalkPose flight_pose(const WalkPose* keys, uint32_t count, uint32_t spacing, uin
 // (decode_elevation). Fine pieces come in row order, after the coarse pass.
 inline constexpr uint32_t kElevationHeaderBytes = 5;
 
-// TFRM payload: u32 the frame's index (0, 1, 2, ... in order).
+// TFRM payload: u32 the frame's index (0, 1, 2, ... in order), and
+// optionally a pose (16 bytes): the frame is drawn from it instead of the
+// flight's (a steered viewer: the server draws the pose the client sent).
 inline constexpr uint32_t kFrameBytes = 4;
+inline constexpr uint32_t kSteeredFrameBytes = kFrameBytes + kPoseBytes;
 
 // The pose the client sends up (PlayerCallbacks::send_up kind kSendPose;
-// the link's pose datagram): u32 frame, then the pose (16 bytes).
+// the link's pose datagram): u32 frame, then the pose (16 bytes). Bit 31
+// of the frame (kPoseSteered) marks a pose the viewer steered, which the
+// server then draws (TFRM with a pose) from the next frame it writes on.
 inline constexpr uint8_t kSendPose = 2;
 inline constexpr uint32_t kPoseMessageBytes = 4 + kPoseBytes;
+inline constexpr uint32_t kPoseSteered = 0x80000000u;
+
+// --- Steering -------------------------------------------------------------------
+//
+// A viewer's controls for one frame (PlayerCallbacks::steer): forward,
+// right and up each -1, 0 or 1 (keys), turn and tilt in 2^-16 turn this
+// frame (keys or a mouse), fast: four times the speed.
+struct SteerInput {
+  int8_t forward = 0, right = 0, up = 0;
+  int16_t turn = 0, tilt = 0;
+  bool fast = false;
+  bool any() const { return forward != 0 || right != 0 || up != 0 || turn != 0 || tilt != 0; }
+};
+// The pose after one frame of `in` from `p`: yaw plus turn (left, seen
+// from above, for turn > 0), pitch plus tilt within +-kMaxSteerPitch, the
+// position moved `step` world units (Q16.16; 4 step when fast) along the
+// horizontal heading for forward, to its right for right, and half that
+// up. Integer arithmetic (the library's sine and cosine): every platform
+// gets the same pose.
+inline constexpr uint16_t kMaxSteerPitch = 14563;  // 80 degrees
+WalkPose steer_pose(const WalkPose& p, const SteerInput& in, int32_t step_q16);
 
 // --- The block store ----------------------------------------------------------
 //

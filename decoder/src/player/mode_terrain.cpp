@@ -74,6 +74,9 @@ struct TerrainPlay {
   // The flight's keys.
   WalkPose* keys = nullptr;
   uint32_t key_count = 0, spacing = 0;
+  // The viewer's own pose once its controls have moved it (steer()).
+  bool steering = false;
+  WalkPose steered{};
   // Transformed blocks: luma slots W x W, chroma (W/2) x (W/2) per component.
   uint32_t win = 0, cwin = 0;
   uint32_t* ytag = nullptr;
@@ -810,6 +813,50 @@ Status draw(Player& p, TerrainPlay& w, const WalkPose& pose) {
   return w.renderer.render(cam, list, kSky, detail::render_band_to_player, &p);
 }
 
+// --- The viewer's pose, up the back-channel ------------------------------------------
+
+// The ground's height under (x, y), world units Q16.16, from the nearest
+// grid point (0 before the elevation's first pass).
+int64_t ground_under(const TerrainPlay& w, Q16_16 x, Q16_16 y) {
+  if (!w.coarse_in || w.params.cell_q16 <= 0) return 0;
+  const int64_t cell = w.params.cell_q16;
+  int64_t i = (int64_t{x.raw()} + cell / 2) / cell, j = w.params.cells_y - (int64_t{y.raw()} + cell / 2) / cell;
+  i = i < 0 ? 0 : (i > w.params.cells_x ? w.params.cells_x : i);
+  j = j < 0 ? 0 : (j > w.params.cells_y ? w.params.cells_y : j);
+  return int64_t{w.heights[j * w.pw + i]} * w.params.height_step_q16;
+}
+
+// After frame `frame`, drawn from `drawn`: the viewer's controls, if they
+// move it, steer the client's own pose (from the drawn one the first time),
+// kept over the map and a cell above the ground under it; a steered pose
+// goes up every frame the controls move it and every pose period, the
+// flight's every pose period until then.
+void send_pose(Player& p, TerrainPlay& w, uint32_t frame, const WalkPose& drawn) {
+  const PlayerCallbacks& cb = p.callbacks();
+  terrain::SteerInput in;
+  const bool moved = cb.steer != nullptr && cb.steer(cb.ctx, &in) && in.any();
+  if (moved) {
+    if (!w.steering) w.steered = drawn;
+    w.steering = true;
+    // A quarter of a cell a frame (a cell when fast): about the scripted
+    // flyover's speed on a map of 128 cells.
+    WalkPose s = terrain::steer_pose(w.steered, in, w.params.cell_q16 / 4);
+    const int64_t xmax = int64_t{w.params.cells_x} * w.params.cell_q16, ymax = int64_t{w.params.cells_y} * w.params.cell_q16;
+    const auto clamp = [](int64_t v, int64_t lo, int64_t hi) { return Q16_16::from_raw(sat_s32(v < lo ? lo : (v > hi ? hi : v))); };
+    s.position.x = clamp(s.position.x.raw(), 0, xmax);
+    s.position.y = clamp(s.position.y.raw(), 0, ymax);
+    const int64_t floor = ground_under(w, s.position.x, s.position.y) + w.params.cell_q16;
+    if (s.position.z.raw() < floor) s.position.z = Q16_16::from_raw(sat_s32(floor));
+    w.steered = s;
+  }
+  const bool period = w.params.pose_period != 0 && frame % w.params.pose_period == 0;
+  if (cb.send_up == nullptr || !(period || (moved && w.params.pose_period != 0))) return;
+  uint8_t msg[terrain::kPoseMessageBytes];
+  store_le32(msg, w.steering ? frame | terrain::kPoseSteered : frame);
+  terrain::pose_to_bytes(w.steering ? w.steered : terrain::flight_pose(w.keys, w.key_count, w.spacing, frame), msg + 4);
+  cb.send_up(cb.ctx, terrain::kSendPose, msg, sizeof msg);
+}
+
 // --- Chunks -------------------------------------------------------------------------
 
 ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size) {
@@ -850,28 +897,25 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
     const Status s = apply_update(w, payload, size);
     if (s != Status::ok) refuse(s, "TTEX was refused");
   } else {  // TFRM
-    const uint32_t frame = size == terrain::kFrameBytes ? load_le32(payload) : ~0u;
+    const bool has_pose = size == terrain::kSteeredFrameBytes;
+    const uint32_t frame = size == terrain::kFrameBytes || has_pose ? load_le32(payload) : ~0u;
     if (frame != p.frames_shown() || frame >= p.header().frame_count || w.key_count == 0) {
       refuse(Status::malformed, "TFRM is not the next frame of the flight");
     } else {
       p.add_decode(p.work_clock() - t0);
+      const WalkPose drawn = has_pose ? terrain::pose_from_bytes(payload + terrain::kFrameBytes)
+                                      : terrain::flight_pose(w.keys, w.key_count, w.spacing, frame);
       if (!p.begin_frame()) {
         result = ChunkResult::abort;
       } else {
         const uint64_t display_before = p.display_total();
         const uint64_t d0 = p.work_clock();
-        const Status ds = draw(p, w, terrain::flight_pose(w.keys, w.key_count, w.spacing, frame));
+        const Status ds = draw(p, w, drawn);
         p.add_display((p.work_clock() - d0) - (p.display_total() - display_before));
         if (ds != Status::ok) refuse(ds, "the frame could not be drawn");
         else if (!p.end_frame()) result = ChunkResult::abort;
       }
-      if (result == ChunkResult::consumed && w.params.pose_period != 0 && frame % w.params.pose_period == 0 &&
-          p.callbacks().send_up != nullptr) {
-        uint8_t msg[terrain::kPoseMessageBytes];
-        store_le32(msg, frame);
-        terrain::pose_to_bytes(terrain::flight_pose(w.keys, w.key_count, w.spacing, frame), msg + 4);
-        p.callbacks().send_up(p.callbacks().ctx, terrain::kSendPose, msg, sizeof msg);
-      }
+      if (result == ChunkResult::consumed) send_pose(p, w, frame, drawn);
       p.leave_chunk();
       return result;
     }

@@ -3,17 +3,21 @@
 // chosen baud rate; its display writes PNG frames, a Y4M video and a
 // contact sheet, and shows them in a live window (SDL2) on request; its
 // workspace budget is a run-time option. The console is stdout. There is no
-// instruction counter (count with callgrind instead).
+// instruction counter (count with callgrind instead). The viewer's controls
+// come from the live window's keys and mouse, or from a controls script.
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -42,10 +46,51 @@ struct Options {
   int contact_columns = 6;
   bool window = false;         // live window (SDL2)
   int window_scale = 2;
+  std::string controls;        // a controls script (read_controls), instead of the window's keys
 };
 
 Options g_opt;
 Clock::time_point g_start;
+// The controls script, one entry a frame; g_control_next the next to read.
+std::vector<terrain::SteerInput> g_script;
+size_t g_control_next = 0;
+
+// A controls script: lines "FRAMES FORWARD RIGHT UP TURN TILT [fast]" (the
+// first three -1, 0 or 1; turn and tilt in degrees a frame, turn positive
+// to the left, tilt up), each holding for FRAMES frames; '#' starts a
+// comment line.
+std::vector<terrain::SteerInput> read_controls_script(const std::string& path) {
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error(path + ": cannot read the controls script");
+  std::vector<terrain::SteerInput> out;
+  std::string line;
+  for (int n = 1; std::getline(f, line); ++n) {
+    std::istringstream in(line);
+    std::string first;
+    if (!(in >> first) || first[0] == '#') continue;
+    long frames = 0;
+    int fwd = 0, right = 0, up = 0;
+    double turn = 0, tilt = 0;
+    std::string fast, extra;
+    std::istringstream head(first);
+    const bool ok = static_cast<bool>(head >> frames) && head.eof() && static_cast<bool>(in >> fwd >> right >> up >> turn >> tilt);
+    if (ok && !(in >> fast)) fast.clear();
+    if (!ok || frames < 1 || frames > 1000000 || fwd < -1 || fwd > 1 || right < -1 || right > 1 || up < -1 || up > 1 ||
+        !(turn >= -90 && turn <= 90) || !(tilt >= -90 && tilt <= 90) || (!fast.empty() && fast != "fast") || (in >> extra) ||
+        out.size() + static_cast<size_t>(frames) > 10000000)
+      throw std::runtime_error(path + ": line " + std::to_string(n) +
+                               " is not 'FRAMES FORWARD RIGHT UP TURN TILT [fast]' (frames 1..1000000, moves -1..1, degrees within 90)");
+    terrain::SteerInput s;
+    s.forward = static_cast<int8_t>(fwd);
+    s.right = static_cast<int8_t>(right);
+    s.up = static_cast<int8_t>(up);
+    s.turn = static_cast<int16_t>(std::lround(turn * 65536.0 / 360.0));
+    s.tilt = static_cast<int16_t>(std::lround(tilt * 65536.0 / 360.0));
+    s.fast = !fast.empty();
+    out.insert(out.end(), static_cast<size_t>(frames), s);
+  }
+  return out;
+}
 std::unique_ptr<link::Backend> g_uart;
 Window g_window;
 bool g_uart_traffic = false;  // a byte has arrived: the host is there
@@ -222,6 +267,15 @@ void display_end_frame(uint32_t frame_crc) {
   ++g_frame_index;
 }
 
+bool read_controls(terrain::SteerInput* in) {
+  if (!g_opt.controls.empty()) {
+    if (g_control_next >= g_script.size()) return false;
+    *in = g_script[g_control_next++];
+    return in->any();
+  }
+  return g_opt.window && g_window.controls(in);
+}
+
 size_t workspace_budget() { return g_opt.workspace; }
 
 int32_t host_file_read(const char* path, uint32_t offset, uint8_t* buf, uint32_t max) {
@@ -250,8 +304,11 @@ int main(int argc, char** argv) {
   app.add_flag("--window", g_opt.window, "Show the frames in a live window (SDL2)");
   app.add_option("--window-scale", g_opt.window_scale, "Window pixels per frame pixel")->check(CLI::Range(1, 8))
       ->capture_default_str();
+  app.add_option("--controls", g_opt.controls,
+                 "The viewer's controls from a script instead of the window's keys: lines 'FRAMES FORWARD RIGHT UP TURN TILT [fast]'");
   CLI11_PARSE(app, argc, argv);
   try {
+    if (!g_opt.controls.empty()) vds::board::g_script = vds::board::read_controls_script(g_opt.controls);
     if (!g_opt.frames_dir.empty()) std::filesystem::create_directories(g_opt.frames_dir);
     if (g_opt.uart == "pty-new") {
       vds::link::PtyPair pair = vds::link::open_pty_pair();

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "vds/io/image.h"
+#include "vds/terrain_client.h"
 
 namespace vds::board {
 
@@ -21,6 +22,11 @@ class Window {
   bool is_open() const { return impl_ != nullptr; }
   // Shows a frame; false once the user has closed the window.
   bool show(const io::Image& rgb, uint32_t index);
+  // The viewer's controls now: W/S or Up/Down forward and back, A/D to the
+  // sides, Left/Right turn, R/F or Page Up/Down up and down, Shift fast,
+  // and the mouse dragged with its left button held turns and tilts. false
+  // when nothing moves the viewer (or the window is closed).
+  bool controls(terrain::SteerInput* in);
 
   struct Impl;
 

@@ -162,6 +162,9 @@ uint32_t instruction_resolution() { return kInstructionsPerTick; }
 
 void log(const char* text) { semihost(kSysWrite0, text); }
 
+// No controls on this board: a flight script steers it.
+bool read_controls(terrain::SteerInput*) { return false; }
+
 int32_t host_file_read(const char* path, uint32_t offset, uint8_t* buf, uint32_t max) {
   uint32_t len = 0;
   while (path[len]) ++len;

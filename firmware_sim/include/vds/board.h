@@ -6,6 +6,10 @@
 #include <cstddef>
 #include <cstdint>
 
+namespace vds::terrain {
+struct SteerInput;  // vds/terrain_client.h
+}  // namespace vds::terrain
+
 namespace vds::board {
 
 // Brings up clocks, the UART and the counter. Called once, first.
@@ -49,6 +53,10 @@ void log(const char* text);
 void display_begin_frame(uint16_t width, uint16_t height);
 void display_band(uint16_t y0, uint16_t rows, const uint16_t* rgb565, size_t stride_pixels);
 void display_end_frame(uint32_t frame_crc);
+
+// The viewer's controls (keys, a stick, a mouse), read once a frame: false
+// when the board has none or they do not move the viewer this frame.
+bool read_controls(terrain::SteerInput* in);
 
 // The workspace budget of this run, bytes: the application must not use
 // more (a compile-time constant on hardware, an option on the host board).

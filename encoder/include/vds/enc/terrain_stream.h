@@ -87,6 +87,7 @@ struct TerrainStreamFrame {
   size_t elevation_bytes = 0;  // fine elevation sent with this frame
   size_t texture_bytes = 0;    // the update sent with it (TTEX payload)
   uint32_t pose_frame = 0;     // the newest pose the server had (frames + 1: none yet)
+  bool steered = false;        // drawn from the viewer's steered pose (TFRM with a pose)
   UpdateStats update;
 };
 
@@ -95,7 +96,9 @@ struct TerrainStreamFrame {
 // update answering the newest pose received (and, predicting, where the
 // viewer will be by this frame from the two newest), and the frame's TFRM,
 // all within `rate_bytes_per_s` (0: unlimited). Poses arrive through pose()
-// as the client sends them; nothing else of the flight is used.
+// as the client sends them; nothing else of the flight is used. Once a
+// steered pose has come (the viewer's controls move it), every TFRM carries
+// the newest one, and the client draws it.
 class TerrainLive {
  public:
   TerrainLive(const TerrainCoding& t, const CameraPath& path, const TerrainStreamOptions& o);
@@ -114,6 +117,8 @@ class TerrainLive {
   uint32_t elevation_frame() const { return elevation_frame_; }
   uint32_t poses_received() const { return poses_; }
   uint32_t poses_refused() const { return refused_; }
+  // Frames written with the viewer's steered pose.
+  uint32_t steered_frames() const { return steered_frames_; }
   // The whole stream (after finished()).
   const std::vector<uint8_t>& bytes() const { return done_; }
 
@@ -132,6 +137,11 @@ class TerrainLive {
   uint32_t pose_frame_ = 0, previous_frame_ = 0;
   WalkPose pose_{}, previous_{};
   uint32_t poses_ = 0, refused_ = 0;
+  // The newest steered pose (terrain::kPoseSteered): every TFRM carries it
+  // once one has come.
+  bool steered_ = false;
+  WalkPose steered_pose_{};
+  uint32_t steered_frames_ = 0;
   bool finished_ = false;
 };
 
