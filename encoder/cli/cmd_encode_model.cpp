@@ -144,7 +144,7 @@ void add_encode_model(CLI::App& app) {
   auto o = std::make_shared<EncodeModelOptions>();
   CLI::App* sub = app.add_subcommand(
       "encode-model", "Encode a textured model as a model stream: progressive mesh, then mesh colors coarse to fine");
-  sub->add_option("IN", o->input, "Model file: glTF 2.0, OBJ+MTL, 3DS, Collada, IQM or MD3, textures beside it")
+  sub->add_option("IN", o->input, "Model file: glTF 2.0, OBJ+MTL, 3DS, Collada, IQM, MD2, MD3 or MS3D, textures beside it; or a Quake III player's folder (ARCHIVE.pk3:FOLDER inside an archive)")
       ->required();
   sub->add_option("-o,--output", o->output, "Stream to write")->required();
   auto* q = sub->add_option("--quality", o->quality, "Colour quality factor (the JPEG tables' multiplier; lower is finer)")

@@ -253,7 +253,7 @@ void run(const MeshColorsOptions& o) {
 void add_mesh_colors(CLI::App& app) {
   auto o = std::make_shared<MeshColorsOptions>();
   CLI::App* c = app.add_subcommand("mesh-colors", "a textured model as mesh colors, through the mesh colors codec");
-  c->add_option("model", o->input, "model file (glTF, OBJ, Collada, IQM, MS3D, 3DS, MD2, MD3, ...)")->required();
+  c->add_option("model", o->input, "model file (glTF, OBJ, Collada, IQM, MS3D, 3DS, MD2, MD3), or a Quake III player's folder (ARCHIVE.pk3:FOLDER inside an archive)")->required();
   c->add_option("--quality", o->quality, "quality factors (the JPEG tables' multiplier)")->check(kPositive);
   c->add_option("--codec", o->codecs, "mesh colors codecs: vds (the improved one), paper (the thesis's)")
       ->check(CLI::IsMember({"vds", "paper"}));

@@ -1,5 +1,7 @@
 // vds encoder: textured models through assimp, and their conversion to mesh
 // colors (the rules are in vds/enc/mesh_colors.h).
+#include <stdlib.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -10,8 +12,10 @@
 #include <assimp/postprocess.h>
 
 #include "assimp_read.h"
+#include "mesh_md3_check.h"
 #include "text.h"
 #include "vds/enc/mesh_colors.h"
+#include "vds/enc/scene.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/mesh_colors.h"
 
@@ -182,14 +186,129 @@ TexturedModel read_model(const uint8_t* data, size_t size, const std::string& pa
   return t;
 }
 
-}  // namespace
-
-TexturedModel load_textured_model(const std::string& path) {
+TexturedModel load_model_file(const std::string& path) {
   const std::vector<uint8_t> bytes = read_file(path);
   std::error_code ec;
   const std::filesystem::path root = std::filesystem::weakly_canonical(std::filesystem::absolute(path), ec).parent_path();
   if (ec) throw std::runtime_error(path + ": cannot resolve its folder (" + ec.message() + ")");
   return read_model(bytes.data(), bytes.size(), path, root);
+}
+
+// --- Quake III players ------------------------------------------------------------------
+//
+// A player is three MD3 parts in one folder, each with its skin: the legs
+// (lower.md3), the torso (upper.md3) placed on the legs' tag_torso, the
+// head (head.md3) placed on the torso's tag_head, all at frame 0 (the game
+// does the same with the frames of an animation). assimp turns an MD3's Z
+// up into Y up, (x, y, z) -> (x, z, -y): a tag, in the file's axes, is
+// applied between the two turns.
+
+constexpr const char* kPlayerParts[3] = {"lower", "upper", "head"};
+
+bool is_player_folder(const std::filesystem::path& dir) {
+  std::error_code ec;
+  for (const char* part : kPlayerParts)
+    if (!std::filesystem::is_regular_file(dir / (std::string(part) + ".md3"), ec)) return false;
+  return true;
+}
+
+Md3Tag part_tag(const std::filesystem::path& file, const char* tag) {
+  const std::vector<uint8_t> bytes = read_file(file.string());
+  check_md3(bytes.data(), bytes.size(), file.string());
+  Md3Tag t;
+  if (!md3_tag(bytes.data(), bytes.size(), file.string(), tag, 0, &t))
+    throw std::runtime_error(file.string() + ": has no " + tag + " to join the player's next part to");
+  return t;
+}
+
+// `part` placed by `tags` (the outermost first) and appended to `into`.
+void append_part(TexturedModel& into, const TexturedModel& part, const std::vector<Md3Tag>& tags) {
+  const uint32_t base = static_cast<uint32_t>(into.positions.size());
+  const int materials = static_cast<int>(into.materials.size()), textures = static_cast<int>(into.textures.size());
+  for (const std::array<double, 3>& a : part.positions) {
+    std::array<double, 3> q = {a[0], -a[2], a[1]};  // back to the file's axes
+    for (size_t k = tags.size(); k-- > 0;) {
+      const Md3Tag& t = tags[k];
+      std::array<double, 3> p = t.origin;
+      for (int c = 0; c < 3; ++c) p[c] += q[0] * t.axis[0][c] + q[1] * t.axis[1][c] + q[2] * t.axis[2][c];
+      q = p;
+    }
+    into.positions.push_back({q[0], q[2], -q[1]});
+  }
+  for (const std::array<uint32_t, 3>& t : part.triangles) into.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+  into.uv.insert(into.uv.end(), part.uv.begin(), part.uv.end());
+  into.colour.insert(into.colour.end(), part.colour.begin(), part.colour.end());
+  for (int m : part.material) into.material.push_back(m + materials);
+  for (TexturedMaterial m : part.materials) {
+    if (m.texture >= 0) m.texture += textures;
+    into.materials.push_back(m);
+  }
+  into.textures.insert(into.textures.end(), part.textures.begin(), part.textures.end());
+  into.texture_files.insert(into.texture_files.end(), part.texture_files.begin(), part.texture_files.end());
+  into.dropped_faces += part.dropped_faces;
+}
+
+TexturedModel load_player(const std::filesystem::path& dir, const std::string& name) {
+  TexturedModel t;
+  t.name = name;
+  const Md3Tag torso = part_tag(dir / "lower.md3", "tag_torso"), head = part_tag(dir / "upper.md3", "tag_head");
+  append_part(t, load_model_file((dir / "lower.md3").string()), {});
+  append_part(t, load_model_file((dir / "upper.md3").string()), {torso});
+  append_part(t, load_model_file((dir / "head.md3").string()), {torso, head});
+  if (t.positions.size() > mc::kMaxVertices)
+    throw std::runtime_error(name + ": the player's three parts hold " + std::to_string(t.positions.size()) + " vertices");
+  return t;
+}
+
+// A player's folder inside a .pk3 archive ("ARCHIVE.pk3:models/players/NAME"):
+// the files directly in it (each at most 64 MiB, 256 MiB in all) copied to
+// a private temporary folder, read as a player, and the folder removed.
+TexturedModel load_player_from_archive(const std::string& archive, std::string folder, const std::string& name) {
+  while (!folder.empty() && folder.back() == '/') folder.pop_back();
+  const Pk3Set pk3(archive);
+  const std::string prefix = ascii_lower(folder) + "/";
+  std::vector<std::string> files;
+  for (const std::string& e : pk3.entries(prefix, ""))
+    if (e.size() > prefix.size() && e.find('/', prefix.size()) == std::string::npos) files.push_back(e);
+  if (files.empty()) throw std::runtime_error(name + ": the archive has no folder '" + folder + "'");
+  std::string dir_template = (std::filesystem::temp_directory_path() / "vds-player-XXXXXX").string();
+  if (mkdtemp(dir_template.data()) == nullptr) throw std::runtime_error(name + ": cannot make a temporary folder");
+  const std::filesystem::path dir(dir_template);
+  struct Remove {
+    std::filesystem::path p;
+    ~Remove() {
+      std::error_code ec;
+      std::filesystem::remove_all(p, ec);
+    }
+  } remove{dir};
+  uint64_t total = 0;
+  for (const std::string& e : files) {
+    std::vector<uint8_t> bytes;
+    pk3.read(e, &bytes);
+    total += bytes.size();
+    if (total > (uint64_t{256} << 20)) throw std::runtime_error(name + ": the folder's files come to over 256 MiB");
+    write_file((dir / e.substr(prefix.size())).string(), bytes);
+  }
+  if (!is_player_folder(dir))
+    throw std::runtime_error(name + ": the folder does not hold a player's lower.md3, upper.md3 and head.md3");
+  TexturedModel t = load_player(dir, name);
+  for (std::string& f : t.texture_files) f = archive + ":" + folder + "/" + std::filesystem::path(f).filename().string();
+  return t;
+}
+
+}  // namespace
+
+TexturedModel load_textured_model(const std::string& path) {
+  const size_t pk3 = ascii_lower(path).find(".pk3:");
+  if (pk3 != std::string::npos) return load_player_from_archive(path.substr(0, pk3 + 4), path.substr(pk3 + 5), path);
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    if (!is_player_folder(path))
+      throw std::runtime_error(path + ": a folder is read as a Quake III player, and this one does not hold lower.md3, "
+                               "upper.md3 and head.md3");
+    return load_player(path, path);
+  }
+  return load_model_file(path);
 }
 
 TexturedModel read_textured_model(const uint8_t* data, size_t size, const std::string& name) {

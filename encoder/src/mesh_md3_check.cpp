@@ -1,6 +1,10 @@
 // vds encoder: the MD3 check (mesh_md3_check.h).
 #include "mesh_md3_check.h"
 
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <cmath>
 #include <cstring>
 #include <stdexcept>
 
@@ -76,6 +80,32 @@ void check_md3(const uint8_t* d, size_t size, const std::string& name) {
       refuse_at_byte(name, "surface " + std::to_string(s) + " ends at offset " + std::to_string(end) + ", past the file", at + 104);
     at += static_cast<size_t>(end);
   }
+}
+
+bool md3_tag(const uint8_t* d, size_t size, const std::string& name, const std::string& tag, uint32_t frame, Md3Tag* out) {
+  const uint32_t frames = load_le32(d + 76), tags = load_le32(d + 80);
+  if (frame >= frames) refuse_at_byte(name, "no frame " + std::to_string(frame) + " (the model has " + std::to_string(frames) + ")", 76);
+  const size_t base = static_cast<size_t>(static_cast<int32_t>(load_le32(d + 96)));
+  for (uint32_t t = 0; t < tags; ++t) {
+    const size_t at = base + (size_t{frame} * tags + t) * 112;  // inside the file after check_md3
+    if (at > size || size - at < 112) refuse_at_byte(name, "the tags lie past the file", 96);
+    char n[65] = {};
+    std::memcpy(n, d + at, 64);
+    std::string have(n);
+    if (have.size() != tag.size() ||
+        !std::equal(have.begin(), have.end(), tag.begin(), [](char a, char b) { return std::tolower(a) == std::tolower(b); }))
+      continue;
+    float f[12];
+    for (int k = 0; k < 12; ++k) f[k] = std::bit_cast<float>(load_le32(d + at + 64 + 4 * k));
+    for (int k = 0; k < 12; ++k)
+      if (!std::isfinite(f[k])) refuse_at_byte(name, "tag '" + tag + "' holds a number that is not finite", at + 64 + 4 * k);
+    for (int c = 0; c < 3; ++c) {
+      out->origin[c] = f[c];
+      for (int r = 0; r < 3; ++r) out->axis[r][c] = f[3 + 3 * r + c];
+    }
+    return true;
+  }
+  return false;
 }
 
 }  // namespace vds::enc

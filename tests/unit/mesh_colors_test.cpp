@@ -19,6 +19,7 @@
 #include <string>
 
 #include "vds/enc/mesh_colors.h"
+#include "vds/enc/scene.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/mesh_colors.h"
 #include "vds/ref/scene.h"
@@ -753,6 +754,45 @@ TEST(MeshColorsImport, Md3CountsAndIndicesThatLieAreRefusedNamingTheFile) {
   b.replace(4, 4, le32s(16));
   EXPECT_NE(md3_refusal(b).find("MD3 version 16"), std::string::npos);
   EXPECT_NE(md3_refusal(md3(2).substr(0, 200)).find("p.md3: "), std::string::npos);
+}
+
+// openarena-data (scripts/fetch-data.sh): a player read straight from its
+// archive is its legs, its torso on the legs' tag_torso and its head on
+// the torso's tag_head, each with its skin's texture.
+TEST(MeshColorsImport, AQuakePlayerIsItsThreePartsJoinedAtTheirTags) {
+  const std::string pk3 = vds::enc::openarena_dir() + "/pak2-players.pk3";
+  ASSERT_TRUE(std::ifstream(pk3).good()) << pk3 << " not installed: scripts/fetch-data.sh installs openarena-data";
+  const vds::enc::TexturedModel m = vds::enc::load_textured_model(pk3 + ":models/players/major");
+  EXPECT_EQ(m.positions.size(), 201u + 272u + 97u);  // lower, upper, head
+  ASSERT_EQ(m.textures.size(), 3u);
+  for (const std::string& f : m.texture_files) EXPECT_EQ(f.rfind(pk3 + ":models/players/major/", 0), 0u) << f;
+  // Y up: from the legs' feet (lower.md3's frame 0 reaches 24.7 below its
+  // origin) to the head's top (its tag_head 16.0 above the torso's, which
+  // is 12.6 above the legs', and the head 6.8 above that).
+  double lo = 1e9, hi = -1e9;
+  for (const auto& p : m.positions) lo = std::min(lo, p[1]), hi = std::max(hi, p[1]);
+  EXPECT_NEAR(lo, -24.7, 0.05);
+  EXPECT_NEAR(hi, 12.57 + 15.99 + 6.78, 0.1);
+  expect_round_trip(m, 30);
+  // What is not a player is refused, by name.
+  auto refusal = [](const std::string& path) {
+    try {
+      vds::enc::load_textured_model(path);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refusal(pk3 + ":models/players/nobody").find("the archive has no folder 'models/players/nobody'"), std::string::npos);
+  const std::string dir = std::string(::testing::TempDir()) + "/md3_player";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  EXPECT_NE(refusal(dir).find("does not hold lower.md3, upper.md3 and head.md3"), std::string::npos) << refusal(dir);
+  for (const char* part : {"lower", "upper", "head"}) {
+    const std::string b = md3(2);
+    vds::enc::write_file(dir + "/" + part + ".md3", std::vector<uint8_t>(b.begin(), b.end()));
+  }
+  EXPECT_NE(refusal(dir).find("lower.md3: has no tag_torso to join the player's next part to"), std::string::npos) << refusal(dir);
 }
 
 }  // namespace

@@ -58,8 +58,11 @@ struct TexturedModel {
 };
 
 // Loads a model file (the rule above). Texture images are read from the
-// model's folder or below it (PNG, JPEG, TGA, PNM) or from the file itself
-// (GLB). Throws std::runtime_error naming the file, what is wrong and where.
+// model's folder or below it (PNG, JPEG, TGA, BMP, PNM) or from the file
+// itself (GLB). A folder holding lower.md3, upper.md3 and head.md3 is a
+// Quake III player: its three parts joined at their tags (frame 0); so is
+// "ARCHIVE.pk3:FOLDER", the player's folder read from inside a .pk3.
+// Throws std::runtime_error naming the file, what is wrong and where.
 TexturedModel load_textured_model(const std::string& path);
 // The same for a file's bytes held in memory; `name`'s extension says the
 // format; no other file may be opened (only textures the file holds are read).
