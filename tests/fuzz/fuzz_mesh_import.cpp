@@ -6,12 +6,14 @@
 // file's name says; the rest is the file. Invariants: no crash, sanitizer
 // report, hang or allocation beyond libFuzzer's limit; a refusal is a
 // std::runtime_error naming the input; an accepted mesh has triangles whose
-// indices lie inside its vertices.
+// indices lie inside its vertices; an MD3 the project's check accepts has
+// its tags read (a Quake III player's parts are joined at them).
 //
 // Seed corpus: when the corpus directory is empty, small valid files are
 // written to it first (an OBJ, an ASCII and a binary PLY, a glTF with its
 // buffer inline, a GLB, a Draco mesh, a Collada file, an IQM file, an MD3, an
 // MD2, an MS3D).
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -22,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "mesh_md3_check.h"  // encoder/src: the tags a player is joined at
 #include "model_seeds.h"
 #include "seed_corpus.h"
 #include "vds/enc/mesh_import.h"
@@ -170,9 +173,30 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
   return 0;
 }
 
+// An MD3 the check accepts: its tags (what a player's parts are joined at)
+// read at its first and last frame, finite or refused by name.
+void md3_tags(const uint8_t* data, size_t size, const char* name) {
+  try {
+    vds::enc::check_md3(data, size, name);
+    const uint32_t frames = data[76] | data[77] << 8 | data[78] << 16 | static_cast<uint32_t>(data[79]) << 24;
+    for (const char* tag : {"tag_torso", "tag_head"})
+      for (uint32_t f : {0u, frames == 0 ? 0u : frames - 1}) {
+        vds::enc::Md3Tag t;
+        if (!vds::enc::md3_tag(data, size, name, tag, f, &t)) continue;
+        for (int c = 0; c < 3; ++c)
+          if (!std::isfinite(t.origin[c]) || !std::isfinite(t.axis[c][0]) || !std::isfinite(t.axis[c][1]) ||
+              !std::isfinite(t.axis[c][2]))
+            abort();
+      }
+  } catch (const std::runtime_error& e) {
+    if (std::strncmp(e.what(), name, std::strlen(name)) != 0) abort();
+  }
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   const char* name = kNames[data[0] % kFormats];
+  if (std::strcmp(name, "input.md3") == 0) md3_tags(data + 1, size - 1, name);
   try {
     const vds::enc::Mesh raw = vds::enc::load_mesh_bytes(data + 1, size - 1, name);
     for (const auto& t : raw.triangles)

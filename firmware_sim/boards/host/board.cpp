@@ -27,6 +27,7 @@
 #include "vds/io/y4m.h"
 #include "vds/link/backend.h"
 #include "vds/link/fd_backends.h"
+#include "controls_script.h"
 #include "window.h"
 
 extern "C" int vds_app_main();
@@ -55,41 +56,16 @@ Clock::time_point g_start;
 std::vector<terrain::SteerInput> g_script;
 size_t g_control_next = 0;
 
-// A controls script: lines "FRAMES FORWARD RIGHT UP TURN TILT [fast]" (the
-// first three -1, 0 or 1; turn and tilt in degrees a frame, turn positive
-// to the left, tilt up), each holding for FRAMES frames; '#' starts a
-// comment line.
+// The controls script's file, read whole (controls_script.h).
 std::vector<terrain::SteerInput> read_controls_script(const std::string& path) {
-  std::ifstream f(path);
+  constexpr size_t kMaxBytes = size_t{16} << 20;
+  std::ifstream f(path, std::ios::binary);
   if (!f) throw std::runtime_error(path + ": cannot read the controls script");
-  std::vector<terrain::SteerInput> out;
-  std::string line;
-  for (int n = 1; std::getline(f, line); ++n) {
-    std::istringstream in(line);
-    std::string first;
-    if (!(in >> first) || first[0] == '#') continue;
-    long frames = 0;
-    int fwd = 0, right = 0, up = 0;
-    double turn = 0, tilt = 0;
-    std::string fast, extra;
-    std::istringstream head(first);
-    const bool ok = static_cast<bool>(head >> frames) && head.eof() && static_cast<bool>(in >> fwd >> right >> up >> turn >> tilt);
-    if (ok && !(in >> fast)) fast.clear();
-    if (!ok || frames < 1 || frames > 1000000 || fwd < -1 || fwd > 1 || right < -1 || right > 1 || up < -1 || up > 1 ||
-        !(turn >= -90 && turn <= 90) || !(tilt >= -90 && tilt <= 90) || (!fast.empty() && fast != "fast") || (in >> extra) ||
-        out.size() + static_cast<size_t>(frames) > 10000000)
-      throw std::runtime_error(path + ": line " + std::to_string(n) +
-                               " is not 'FRAMES FORWARD RIGHT UP TURN TILT [fast]' (frames 1..1000000, moves -1..1, degrees within 90)");
-    terrain::SteerInput s;
-    s.forward = static_cast<int8_t>(fwd);
-    s.right = static_cast<int8_t>(right);
-    s.up = static_cast<int8_t>(up);
-    s.turn = static_cast<int16_t>(std::lround(turn * 65536.0 / 360.0));
-    s.tilt = static_cast<int16_t>(std::lround(tilt * 65536.0 / 360.0));
-    s.fast = !fast.empty();
-    out.insert(out.end(), static_cast<size_t>(frames), s);
-  }
-  return out;
+  std::string text(kMaxBytes + 1, '\0');
+  f.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<size_t>(f.gcount()));
+  if (text.size() > kMaxBytes) throw std::runtime_error(path + ": a controls script over 16 MiB");
+  return parse_controls_script(text, path);
 }
 std::unique_ptr<link::Backend> g_uart;
 Window g_window;
