@@ -13,7 +13,7 @@
 #   colors codec against each anchor.
 #
 # Usage: bench/run_model.sh [BUILD_DIR]   (default build/host-release)
-#   MODELS (default: the duck, the milk truck, mrfixit, an OpenArena player's torso: PLAYER=major);
+#   MODELS (default: the duck, the milk truck, mrfixit, an OpenArena player: PLAYER=major);
 #   WORK (default BUILD_DIR/model);
 #   VIEWS=24 SIZE=256 SUPERSAMPLE=3; QUALITIES (mesh colors quality factors); MAX_RES (face resolution cap, 2^r).
 set -euo pipefail
@@ -25,13 +25,14 @@ WORK=${WORK:-$BUILD/model}
 RESULTS=${RESULTS:-$ROOT/bench/results}
 A=/usr/share/assimp/models
 mkdir -p "$WORK"
-# An OpenArena player's torso (openarena-data's pak2-players.pk3), taken out
-# of the archive with its skin and textures.
+# An OpenArena player (openarena-data's pak2-players.pk3), taken out of the
+# archive with its skins and textures: its folder is the whole player, legs,
+# torso and head joined at their tags (vds reads ARCHIVE.pk3:FOLDER as well).
 PLAYER=${PLAYER:-major}
 /usr/bin/python3 "$ROOT/bench/extract_oa_player.py" "$WORK/oa" "$PLAYER"
-MODELS=${MODELS:-"duck:$A/Collada/duck_triangulate.dae truck:$A/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf mrfixit:$A/IQM/mrfixit.iqm $PLAYER:$WORK/oa/models/players/$PLAYER/upper.md3"}
-# Models whose up axis is +z (Quake III's); assimp gives the others +y.
-Z_UP=${Z_UP:-$PLAYER}
+MODELS=${MODELS:-"duck:$A/Collada/duck_triangulate.dae truck:$A/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf mrfixit:$A/IQM/mrfixit.iqm $PLAYER:$WORK/oa/models/players/$PLAYER"}
+# Models whose up axis is +z; assimp gives most formats +y (an MD3's Z up too).
+Z_UP=${Z_UP:-}
 VIEWS=${VIEWS:-24}
 SIZE=${SIZE:-256}
 SS=${SUPERSAMPLE:-3}

@@ -8,7 +8,7 @@
 #
 # Usage: bench/run_model_client.sh [BUILD_DIR]   (default build/host-release,
 #   built whole: its cm4/firmware_sim/vds_fw_client.elf and the host board)
-#   MODELS (default: glTF's textured box at R <= 64, the OpenArena torso).
+#   MODELS (default: glTF's textured box at R <= 64, an OpenArena player).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-build/host-release}
@@ -20,7 +20,7 @@ A=/usr/share/assimp/models
 PLAYER=${PLAYER:-major}
 mkdir -p "$WORK" "$RESULTS"
 /usr/bin/python3 "$ROOT/bench/extract_oa_player.py" "$WORK/oa" "$PLAYER"
-MODELS=${MODELS:-"box:$A/glTF2/BoxTextured-glTF/BoxTextured.gltf:--max-res=6 $PLAYER:$WORK/oa/models/players/$PLAYER/upper.md3:--up=+z"}
+MODELS=${MODELS:-"box:$A/glTF2/BoxTextured-glTF/BoxTextured.gltf:--max-res=6 $PLAYER:$WORK/oa/models/players/$PLAYER:--up=+y"}
 ELF="$BUILD/cm4/firmware_sim/vds_fw_client.elf"
 HOSTFW="$BUILD/firmware_sim/vds_fw_client_host"
 for f in "$VDS" "$ELF" "$HOSTFW"; do

@@ -33,8 +33,8 @@ A=/usr/share/assimp/models
 PLAYER=${PLAYER:-major}
 mkdir -p "$WORK" "$RESULTS"
 /usr/bin/python3 "$ROOT/bench/extract_oa_player.py" "$WORK/oa" "$PLAYER"
-MODELS=${MODELS:-"duck:$A/Collada/duck_triangulate.dae truck:$A/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf mrfixit:$A/IQM/mrfixit.iqm $PLAYER:$WORK/oa/models/players/$PLAYER/upper.md3"}
-Z_UP=${Z_UP:-$PLAYER}
+MODELS=${MODELS:-"duck:$A/Collada/duck_triangulate.dae truck:$A/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf mrfixit:$A/IQM/mrfixit.iqm $PLAYER:$WORK/oa/models/players/$PLAYER"}
+Z_UP=${Z_UP:-}
 QUALITIES=${QUALITIES:-0.5 1 2 4}
 VIEWS=${VIEWS:-8}
 for tool in cjpeg djpeg cwebp dwebp draco_encoder; do
