@@ -9,7 +9,7 @@
 # progressive model at 2 KB/s to the host-native board, drawn after every
 # level; a walkthrough of the OpenArena map oa_dm4 at 2 KB/s to both
 # boards; a terrain flight over a Trigger Rally map, served live to both
-# boards as they send their poses up; then the client self-test on both boards and the size of the
+# boards as they send their poses up, and steered on the host board; then the client self-test on both boards and the size of the
 # client's parts. Everything goes to out/demo/; the summary
 # is out/demo/report.md.
 set -euo pipefail
@@ -58,7 +58,7 @@ python3 "$ROOT/scripts/demo_walk.py" --vds "$VDS" --host-board "$ROOT/$BUILD/fir
 }
 grep -E '^(`|On the Cortex)' "$OUT/walk.md"
 
-echo "demo: 5/8 a terrain flight over the Trigger Rally map grass, served live (vds serve-terrain) to both boards as they send their poses up"
+echo "demo: 5/8 a terrain flight over the Trigger Rally map grass, served live (vds serve-terrain) to both boards as they send their poses up, then steered on the host board"
 mkdir -p "$OUT/terrain"
 TERRAIN_OK=1
 for board in host qemu; do
@@ -68,6 +68,18 @@ for board in host qemu; do
     --stream-out "$OUT/terrain/$board.vds" > "$OUT/terrain/$board.log" 2>&1 || TERRAIN_OK=0
   grep -E '^grass \(live\): [0-9]+ frames made|^  replay ' "$OUT/terrain/$board.log" | sed "s/^/  $board: /"
 done
+# The same flight steered on the host board by a controls script, as a
+# viewer's keys would steer it (--window: the window's own keys and mouse).
+cat > "$OUT/terrain/steer.controls" <<'CONTROLS'
+# FRAMES FORWARD RIGHT UP TURN TILT [fast]: the flight, then a turning climb
+20 0 0 0 0 0
+40 1 0 0 4.5 0
+20 1 0 1 4.5 -0.5
+20 0 0 0 -3 0
+CONTROLS
+"$VDS" serve-terrain grass --frames 100 --rate 4000 --board host --firmware "$ROOT/$BUILD/firmware_sim/vds_fw_client_host" \
+  --controls "$OUT/terrain/steer.controls" --board-out "$OUT/terrain/steered" > "$OUT/terrain/steered.log" 2>&1 || TERRAIN_OK=0
+grep -E "^grass \(live\): [0-9]+ frames drawn from the viewer|^  replay " "$OUT/terrain/steered.log" | sed "s/^/  host, steered: /"
 [ "$TERRAIN_OK" = 1 ] || { echo "demo: the terrain run failed (logs: out/demo/terrain/)" >&2; exit 1; }
 
 echo "demo: 6/8 client self-test on the host board and on the Cortex-M4 board (QEMU mps2-an386)"
@@ -103,6 +115,14 @@ echo "demo: 8/8 writing the report"
   echo
   echo '```'
   for board in host qemu; do grep -E '^grass \(live\): [0-9]+ frames made|^  replay |^  client stats' "$OUT/terrain/$board.log"; done
+  echo '```'
+  echo
+  echo "Steered: the same flight on the host board with \`--controls out/demo/terrain/steer.controls\` (what the"
+  echo "window's keys give with \`--window\`): the client sends its steered pose up, the server draws it, and the"
+  echo "frames still equal the replay (\`out/demo/terrain/steered/contact_sheet.png\`)."
+  echo
+  echo '```'
+  grep -E '^grass \(live\): [0-9]+ frames drawn from the viewer|^  replay ' "$OUT/terrain/steered.log"
   echo '```'
   echo
   echo "## Client self-test, host board against the Cortex-M4 board"
