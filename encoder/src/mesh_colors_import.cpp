@@ -269,7 +269,9 @@ TexturedModel load_player_from_archive(const std::string& archive, std::string f
   const std::string prefix = ascii_lower(folder) + "/";
   std::vector<std::string> files;
   for (const std::string& e : pk3.entries(prefix, ""))
-    if (e.size() > prefix.size() && e.find('/', prefix.size()) == std::string::npos) files.push_back(e);
+    if (e.size() > prefix.size() && e.find('/', prefix.size()) == std::string::npos && e.substr(prefix.size()) != "." &&
+        e.substr(prefix.size()) != "..")
+      files.push_back(e);
   if (files.empty()) throw std::runtime_error(name + ": the archive has no folder '" + folder + "'");
   std::string dir_template = (std::filesystem::temp_directory_path() / "vds-player-XXXXXX").string();
   if (mkdtemp(dir_template.data()) == nullptr) throw std::runtime_error(name + ": cannot make a temporary folder");
