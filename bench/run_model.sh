@@ -13,7 +13,7 @@
 #   colors codec against each anchor.
 #
 # Usage: bench/run_model.sh [BUILD_DIR]   (default build/host-release)
-#   MODELS (default: the duck, the milk truck, mrfixit, an OpenArena player: PLAYER=major);
+#   MODELS (default: the duck, the milk truck, mrfixit, an OpenArena player: PLAYER=major; Sydney, the jeep);
 #   WORK (default BUILD_DIR/model);
 #   VIEWS=24 SIZE=256 SUPERSAMPLE=3; QUALITIES (mesh colors quality factors); MAX_RES (face resolution cap, 2^r).
 set -euo pipefail
@@ -30,7 +30,9 @@ mkdir -p "$WORK"
 # torso and head joined at their tags (vds reads ARCHIVE.pk3:FOLDER as well).
 PLAYER=${PLAYER:-major}
 /usr/bin/python3 "$ROOT/bench/extract_oa_player.py" "$WORK/oa" "$PLAYER"
-MODELS=${MODELS:-"duck:$A/Collada/duck_triangulate.dae truck:$A/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf mrfixit:$A/IQM/mrfixit.iqm $PLAYER:$WORK/oa/models/players/$PLAYER"}
+# Then two more of assimp-testmodels: Quake II's Sydney (MD2, a BMP skin) and
+# MilkShape's jeep (MS3D, a texture reused across many faces).
+MODELS=${MODELS:-"duck:$A/Collada/duck_triangulate.dae truck:$A/glTF/CesiumMilkTruck/CesiumMilkTruck.gltf mrfixit:$A/IQM/mrfixit.iqm $PLAYER:$WORK/oa/models/players/$PLAYER sydney:$A/MD2/sydney.md2 jeep:$A/MS3D/jeep1.ms3d"}
 # Models whose up axis is +z; assimp gives most formats +y (an MD3's Z up too).
 Z_UP=${Z_UP:-}
 VIEWS=${VIEWS:-24}
