@@ -14,15 +14,10 @@ constexpr size_t kHeaderBytes = 68;
 constexpr uint32_t kMaxSkins = 32, kMaxVerts = 2048, kMaxTriangles = 4096, kMaxFrames = 512, kMaxSkinSide = 4096;
 constexpr uint32_t kFrameHeaderBytes = 40;
 
-// `count` items of `item` bytes at the offset stored at `at`: inside the file.
+// `count` items of `item` bytes at the offset stored at `at`: after the
+// header and inside the file.
 size_t table(const uint8_t* d, size_t size, size_t at, uint64_t count, uint64_t item, const char* what, const std::string& name) {
-  const int32_t off = load_le32s(d + at);
-  if (count == 0) return 0;
-  if (off < static_cast<int32_t>(kHeaderBytes) || static_cast<size_t>(off) > size || count * item > size - static_cast<size_t>(off))
-    refuse_at_byte(name, std::string(what) + ": " + std::to_string(count) + " of " + std::to_string(item) + " bytes at offset " +
-                             std::to_string(off) + " do not fit the file's " + std::to_string(size) + " bytes",
-                   at);
-  return static_cast<size_t>(off);
+  return table_in_file(d, size, 0, at, count, item, static_cast<int64_t>(kHeaderBytes), what, name);
 }
 
 }  // namespace

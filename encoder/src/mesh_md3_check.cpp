@@ -20,16 +20,10 @@ constexpr uint32_t kMaxFrames = 1024, kMaxTags = 16, kMaxSurfaces = 32, kMaxShad
                    kMaxTriangles = 8192;
 
 // `count` items of `item` bytes at `base` + the offset stored at `field`:
-// inside [0, size).
+// inside the file.
 void table(const uint8_t* d, size_t size, size_t base, size_t field, uint64_t count, uint64_t item, const char* what,
            const std::string& name) {
-  if (count == 0) return;
-  const int64_t off = static_cast<int32_t>(load_le32(d + field));
-  const int64_t at = static_cast<int64_t>(base) + off;
-  if (off < 0 || at > static_cast<int64_t>(size) || count * item > size - static_cast<size_t>(at))
-    refuse_at_byte(name, std::string(what) + ": " + std::to_string(count) + " of " + std::to_string(item) + " bytes at offset " +
-                   std::to_string(off) + " do not fit the file",
-         field);
+  table_in_file(d, size, base, field, count, item, 0, what, name);
 }
 
 uint32_t count(const uint8_t* d, size_t at, uint32_t limit, const char* what, const std::string& name) {

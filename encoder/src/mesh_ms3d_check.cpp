@@ -39,14 +39,7 @@ class Walk {
     if (n > limit) refuse_at_byte(name_, what + " " + std::to_string(n) + " (at most " + std::to_string(limit) + ")", here);
     return n;
   }
-  uint32_t count32(uint32_t limit, const std::string& what) {
-    const size_t here = at_;
-    const int32_t n = i32(what);
-    if (n < 0 || static_cast<uint32_t>(n) > limit)
-      refuse_at_byte(name_, what + " " + std::to_string(n) + " (0.." + std::to_string(limit) + ")", here);
-    return static_cast<uint32_t>(n);
-  }
-  const uint8_t* data() const { return d_; }
+  uint32_t count32(uint32_t limit, const std::string& what) { return field_in(d_, skip(4, what), 0, limit, what, name_); }
   [[noreturn]] void refuse(const std::string& what, size_t where) const { refuse_at_byte(name_, what, where); }
 
  private:

@@ -153,8 +153,9 @@ TerrainLive::TerrainLive(const TerrainCoding& t, const CameraPath& path, const T
 
 bool TerrainLive::pose(const uint8_t* data, size_t n) {
   if (data == nullptr || n != terrain::kPoseMessageBytes) return ++refused_, false;
-  const bool steered = (load_le32(data) & terrain::kPoseSteered) != 0;
-  const uint32_t frame = load_le32(data) & ~terrain::kPoseSteered;
+  const uint32_t word = load_le32(data);
+  const bool steered = (word & terrain::kPoseSteered) != 0;
+  const uint32_t frame = word & ~terrain::kPoseSteered;
   if (frame >= sender_.frames() || (have_pose_ && frame <= pose_frame_)) return ++refused_, false;
   if (have_pose_) {
     previous_ = pose_;
@@ -217,7 +218,6 @@ void TerrainLive::next_frame() {
   w_->add_chunk(chunk::kTerrainFrame, std::span<const uint8_t>(frm, frm_bytes));
   credit_ -= static_cast<double>(frm_bytes + kChunkFraming);
   tf.steered = steered_;
-  if (steered_) ++steered_frames_;
   tf.stream_bytes = w_->size();
   frames_.push_back(tf);
   if (o_.progress) o_.progress(frames_.size());
@@ -225,6 +225,10 @@ void TerrainLive::next_frame() {
     done_ = w_->finish();
     finished_ = true;
   }
+}
+
+uint32_t TerrainLive::steered_frames() const {
+  return static_cast<uint32_t>(std::count_if(frames_.begin(), frames_.end(), [](const TerrainStreamFrame& f) { return f.steered; }));
 }
 
 bool TerrainLive::produce(uint64_t ms, std::vector<uint8_t>& out) {

@@ -27,6 +27,7 @@
 #include "mesh_md3_check.h"  // encoder/src: the tags a player is joined at
 #include "model_seeds.h"
 #include "seed_corpus.h"
+#include "vds/bytes.h"
 #include "vds/enc/mesh_import.h"
 
 namespace {
@@ -178,7 +179,7 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
 void md3_tags(const uint8_t* data, size_t size, const char* name) {
   try {
     vds::enc::check_md3(data, size, name);
-    const uint32_t frames = data[76] | data[77] << 8 | data[78] << 16 | static_cast<uint32_t>(data[79]) << 24;
+    const uint32_t frames = vds::load_le32(data + 76);
     for (const char* tag : {"tag_torso", "tag_head"})
       for (uint32_t f : {0u, frames == 0 ? 0u : frames - 1}) {
         vds::enc::Md3Tag t;

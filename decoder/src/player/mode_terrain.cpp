@@ -820,10 +820,9 @@ Status draw(Player& p, TerrainPlay& w, const WalkPose& pose) {
 int64_t ground_under(const TerrainPlay& w, Q16_16 x, Q16_16 y) {
   if (!w.coarse_in || w.params.cell_q16 <= 0) return 0;
   const int64_t cell = w.params.cell_q16;
-  int64_t i = (int64_t{x.raw()} + cell / 2) / cell, j = w.params.cells_y - (int64_t{y.raw()} + cell / 2) / cell;
-  i = i < 0 ? 0 : (i > w.params.cells_x ? w.params.cells_x : i);
-  j = j < 0 ? 0 : (j > w.params.cells_y ? w.params.cells_y : j);
-  return int64_t{w.heights[j * w.pw + i]} * w.params.height_step_q16;
+  const int32_t i = clamp_s32(sat_s32((int64_t{x.raw()} + cell / 2) / cell), 0, w.params.cells_x);
+  const int32_t j = clamp_s32(sat_s32(w.params.cells_y - (int64_t{y.raw()} + cell / 2) / cell), 0, w.params.cells_y);
+  return int64_t{w.heights[static_cast<size_t>(j) * w.pw + i]} * w.params.height_step_q16;
 }
 
 // After frame `frame`, drawn from `drawn`: the viewer's controls, if they
@@ -841,10 +840,8 @@ void send_pose(Player& p, TerrainPlay& w, uint32_t frame, const WalkPose& drawn)
     // A quarter of a cell a frame (a cell when fast): about the scripted
     // flyover's speed on a map of 128 cells.
     WalkPose s = terrain::steer_pose(w.steered, in, w.params.cell_q16 / 4);
-    const int64_t xmax = int64_t{w.params.cells_x} * w.params.cell_q16, ymax = int64_t{w.params.cells_y} * w.params.cell_q16;
-    const auto clamp = [](int64_t v, int64_t lo, int64_t hi) { return Q16_16::from_raw(sat_s32(v < lo ? lo : (v > hi ? hi : v))); };
-    s.position.x = clamp(s.position.x.raw(), 0, xmax);
-    s.position.y = clamp(s.position.y.raw(), 0, ymax);
+    s.position.x = Q16_16::from_raw(clamp_s32(s.position.x.raw(), 0, sat_s32(int64_t{w.params.cells_x} * w.params.cell_q16)));
+    s.position.y = Q16_16::from_raw(clamp_s32(s.position.y.raw(), 0, sat_s32(int64_t{w.params.cells_y} * w.params.cell_q16)));
     const int64_t floor = ground_under(w, s.position.x, s.position.y) + w.params.cell_q16;
     if (s.position.z.raw() < floor) s.position.z = Q16_16::from_raw(sat_s32(floor));
     w.steered = s;

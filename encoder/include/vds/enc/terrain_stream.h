@@ -118,7 +118,7 @@ class TerrainLive {
   uint32_t poses_received() const { return poses_; }
   uint32_t poses_refused() const { return refused_; }
   // Frames written with the viewer's steered pose.
-  uint32_t steered_frames() const { return steered_frames_; }
+  uint32_t steered_frames() const;
   // The whole stream (after finished()).
   const std::vector<uint8_t>& bytes() const { return done_; }
 
@@ -141,7 +141,6 @@ class TerrainLive {
   // once one has come.
   bool steered_ = false;
   WalkPose steered_pose_{};
-  uint32_t steered_frames_ = 0;
   bool finished_ = false;
 };
 
