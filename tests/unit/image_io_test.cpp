@@ -160,6 +160,9 @@ TEST(ImageIoHostile, BmpReadAsWrittenAndRefusedWhereItLies) {
       << refusal(bmp(20000, 20000, 24, 0, rows));
   EXPECT_NE(refusal(bmp(2, 2, 8, 1, rows)).find("BMP"), std::string::npos);
   EXPECT_NE(refusal({'B', 'M', 0, 0}).find("f: a BMP file of 4 bytes"), std::string::npos);
+  // Every shorter prefix of the valid file is refused, naming it.
+  for (size_t n = 2; n < f.size(); ++n)
+    EXPECT_EQ(refusal(std::vector<uint8_t>(f.begin(), f.begin() + static_cast<long>(n))).rfind("f: ", 0), 0u) << "prefix " << n;
 }
 
 TEST(ImageIoHostile, DeclaredSizesMustFitTheFile) {

@@ -590,6 +590,12 @@ TEST(MeshColorsImport, Md2CountsOffsetsAndIndicesThatLieAreRefusedNamingTheFile)
     EXPECT_NE(model_refusal(b, "s.md2").find(l.says), std::string::npos) << model_refusal(b, "s.md2");
   }
   EXPECT_NE(model_refusal(good.substr(0, 5000), "s.md2").find("do not fit the file's 5000 bytes"), std::string::npos);
+  // Every prefix (the header's every byte, then every 997th) is refused by the check, naming the file and a byte.
+  for (size_t n = 0; n < good.size(); n += n < 200 ? 1 : 997) {
+    const std::string r = model_refusal(good.substr(0, n), "s.md2");
+    EXPECT_EQ(r.rfind("s.md2: ", 0), 0u) << "prefix " << n << ": " << r;
+    if (n > 0) EXPECT_NE(r.find("(byte "), std::string::npos) << "prefix " << n << ": " << r;
+  }
   EXPECT_NE(model_refusal("IDP2", "s.md2").find("not a Quake II model"), std::string::npos);
 }
 
