@@ -15,7 +15,8 @@
 # Usage: bench/run_model.sh [BUILD_DIR]   (default build/host-release)
 #   MODELS (default: the duck, the milk truck, mrfixit, an OpenArena player: PLAYER=major; Sydney, the jeep);
 #   WORK (default BUILD_DIR/model);
-#   VIEWS=24 SIZE=256 SUPERSAMPLE=3; QUALITIES (mesh colors quality factors); MAX_RES (face resolution cap, 2^r).
+#   VIEWS=24 SIZE=256 SUPERSAMPLE=3; QUALITIES (mesh colors quality factors); MAX_RES (face resolution cap, 2^r);
+#   MC_ARGS (more `vds mesh-colors` options for both passes, e.g. --full-chroma).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=${1:-build/host-release}
@@ -39,6 +40,7 @@ VIEWS=${VIEWS:-24}
 SIZE=${SIZE:-256}
 SS=${SUPERSAMPLE:-3}
 QUALITIES=${QUALITIES:-0.125 0.25 0.5 1 2 4 8 16}
+MC_ARGS=${MC_ARGS:-}
 MAX_RES=${MAX_RES:-8}   # R <= 256: the truck's few larger faces change its figures by under 0.2 dB and double the time
 for tool in cjpeg cwebp dwebp avifenc avifdec; do
   command -v $tool >/dev/null || { echo "run_model: $tool missing (scripts/setup.sh installs it)" >&2; exit 1; }
@@ -52,7 +54,7 @@ for entry in $MODELS; do
   dir="$WORK/$name"
   rm -rf "$dir"; mkdir -p "$dir/tex"
   echo "run_model: $name: mesh colors and the thesis's measure"
-  "$VDS" mesh-colors "$model" --max-res "$MAX_RES" --quality $QUALITIES --csv "$dir/thesis.csv" --dump-textures "$dir/tex" > "$dir/thesis.txt"
+  "$VDS" mesh-colors "$model" $MC_ARGS --max-res "$MAX_RES" --quality $QUALITIES --csv "$dir/thesis.csv" --dump-textures "$dir/tex" > "$dir/thesis.txt"
   textures=$(ls "$dir"/tex/texture*.png | wc -l)
   echo "run_model: $name: $textures texture(s) through cjpeg, cwebp, avifenc"
   : > "$dir/anchors.csv"
@@ -82,7 +84,7 @@ for entry in $MODELS; do
   done
   echo "run_model: $name: $VIEWS rendered views"
   up=y; case " $Z_UP " in *" $name "*) up=z ;; esac
-  "$VDS" mesh-colors "$model" --max-res "$MAX_RES" --up $up --quality $QUALITIES --views "$VIEWS" --size "$SIZE" --supersample "$SS" \
+  "$VDS" mesh-colors "$model" $MC_ARGS --max-res "$MAX_RES" --up $up --quality $QUALITIES --views "$VIEWS" --size "$SIZE" --supersample "$SS" \
     --anchors "$dir/anchors.csv" --rendered-csv "$dir/rendered.csv" --sheet "$RESULTS/model_${name}_sheet.png" > "$dir/rendered.txt"
 done
 

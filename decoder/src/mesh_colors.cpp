@@ -47,6 +47,14 @@ uint8_t to_sample(int32_t q4) {
   return static_cast<uint8_t>(v < 0 ? 0 : (v > 255 ? 255 : v));
 }
 
+// The mean of samples p[0], p[stride], ... (count of them) in Q4, rounded.
+int64_t mean_q4_strided(const uint8_t* p, uint32_t count, int stride) {
+  if (count == 0) return 0;
+  int64_t sum = 0;
+  for (uint32_t i = 0; i < count; ++i) sum += p[i * static_cast<uint32_t>(stride)];
+  return div_round(16 * sum, count);
+}
+
 uint32_t hash_pair(uint32_t lo, uint32_t hi) { return (lo * 0x9E3779B1u) ^ (hi * 0x85EBCA77u) ^ (hi >> 7); }
 
 uint32_t hash_size(uint32_t faces) {
@@ -191,18 +199,21 @@ int face_block_positions(int32_t D) {
 }
 
 void reconstruct_edge_block(const int32_t* q, int len, const uint32_t* step, uint8_t mode, int64_t mean_q4,
-                            uint8_t* dst) {
+                            uint8_t* dst, int stride) {
   int32_t coef[8], x[8];
   for (int k = 0; k < len; ++k) {
     coef[k] = clamp32(int64_t{q[k]} * step[k], kCoefLimit);
     if (mode != kModePaper) coef[k] = rescale(coef[k], len, k);
   }
   inverse_dct(coef, len, x);
-  for (int i = 0; i < len; ++i) dst[i] = to_sample(clamp32(x[i] + mean_q4, kSampleLimit));
+  for (int i = 0; i < len; ++i) dst[i * stride] = to_sample(clamp32(x[i] + mean_q4, kSampleLimit));
 }
 
 int64_t reconstruct_face_block(const int32_t* q, int32_t D, const uint32_t* step, uint8_t mode, int64_t mean_q4,
-                               uint8_t* face, int32_t n, int32_t br, int32_t bc) {
+                               uint8_t* face, int32_t n, int32_t br, int32_t bc, int scale) {
+  // Row gr, column i of the face (lattice point (i + 1, gr + 1)) lies at
+  // (scale (i + 1), scale (gr + 1)) of a lattice of side nf.
+  const int32_t nf = scale * (n + 2) - 2;
   int32_t coef[64], tmp[64], x[8];
   const int rows = D < 8 ? D : 8;
   for (int i = 0; i < 64; ++i) coef[i] = (i >> 3) + (i & 7) < D ? clamp32(int64_t{q[i]} * step[i], kCoefLimit) : 0;
@@ -219,11 +230,12 @@ int64_t reconstruct_face_block(const int32_t* q, int32_t D, const uint32_t* step
     if (mode != kModePaper)
       for (int k = 0; k < len; ++k) tmp[8 * r + k] = rescale(tmp[8 * r + k], len, k);
     inverse_dct(tmp + 8 * r, len, x);
-    const int32_t gr = 8 * br + r;
-    uint8_t* dst = face + static_cast<uint32_t>(gr * n - gr * (gr - 1) / 2 + 8 * bc);
+    const int32_t row = scale * (8 * br + r + 1) - 1;
+    uint8_t* dst = face + static_cast<uint32_t>(row * nf - row * (row - 1) / 2 + scale * (8 * bc + 1) - 1);
     for (int i = 0; i < len; ++i) {
-      dst[i] = to_sample(clamp32(x[i] + mean_q4, kSampleLimit));
-      sum += dst[i];
+      const uint8_t v = to_sample(clamp32(x[i] + mean_q4, kSampleLimit));
+      dst[i * scale] = v;
+      sum += v;
     }
     count += len;
   }
@@ -438,7 +450,8 @@ Status MeshColors::read_header(const uint8_t* data, size_t size, const Planes* v
   const uint32_t vertices = static_cast<uint32_t>(data[6] | (data[7] << 8));
   const uint32_t faces = static_cast<uint32_t>(data[8]) | (static_cast<uint32_t>(data[9]) << 8) |
                          (static_cast<uint32_t>(data[10]) << 16) | (static_cast<uint32_t>(data[11]) << 24);
-  if (max_res > kMaxResLog2 || (data[3] & ~kFlagVertexColours) != 0 || q8 == 0 || vertices != topo_.vertices ||
+  if (max_res > kMaxResLog2 || (data[3] & ~(kFlagVertexColours | kFlagChromaHalf)) != 0 || q8 == 0 ||
+      vertices != topo_.vertices ||
       faces != topo_.faces)
     return Status::malformed;
   const bool paper = data[1] == kModePaper;
@@ -492,10 +505,11 @@ Status MeshColors::read_header(const uint8_t* data, size_t size, const Planes* v
   s = dec.finish();
   if (s != Status::ok) return s;
   if (faces > 0 && top != max_res) return Status::malformed;  // max_res is the largest, exactly
-  return set(face_res_, nullptr, q8, data[1]);
+  return set(face_res_, nullptr, q8, data[1], (data[3] & kFlagChromaHalf) != 0);
 }
 
-Status MeshColors::set(const uint8_t* face_res, const uint8_t* vertex_ycc, uint16_t quality_q8, uint8_t mode) {
+Status MeshColors::set(const uint8_t* face_res, const uint8_t* vertex_ycc, uint16_t quality_q8, uint8_t mode,
+                       bool chroma_half) {
   header_ = false;
   layout_m_ = -1;
   if (face_res_ == nullptr || face_res == nullptr || quality_q8 == 0 || mode > kModeVds) return Status::invalid_argument;
@@ -517,6 +531,7 @@ Status MeshColors::set(const uint8_t* face_res, const uint8_t* vertex_ycc, uint1
   max_res_ = top;
   quality_q8_ = quality_q8;
   mode_ = mode;
+  chroma_half_ = chroma_half;
   make_steps(quality_q8, mode, steps_);
   header_ = true;
   return Status::ok;
@@ -597,20 +612,60 @@ void MeshColors::face_lattice(uint32_t f, LatticeFace* out) const {
   out->face_base = layout_.face_base + layout_.face_offset[f];
 }
 
-int64_t MeshColors::corner_sum_q4(uint32_t f, int m, const uint8_t* plane) const {
+int64_t MeshColors::corner_sum_q4(uint32_t f, int m, const uint8_t* plane, int scale) const {
   int64_t sum = 0;
+  const int shift = scale == 2 ? 1 : 0;
   for (int k = 0; k < 3; k += 2) {
     const uint32_t fe = topo_.face_edge[3 * f + k];
     const uint32_t e = fe >> 1;
-    const uint32_t ne = edge_samples(level_res(edge_res_[e], m));
-    const uint8_t* src = plane + layout_.edge_base + layout_.edge_offset[e];
+    const uint32_t ne = edge_samples(level_res(edge_res_[e], m + shift));
+    // Sample t of the edge's lattice at level m + shift lies at t in level m + shift's plane, or at
+    // scale (t + 1) - 1 of the edge in level m's.
+    const uint8_t* src = plane + layout_.edge_base + layout_.edge_offset[e] + (scale - 1);
     // Corner a is where edge 0 starts and edge 2 ends (in the face's direction).
     const bool at_start = (k == 0) == ((fe & 1u) == 0);
     const uint32_t from = at_start ? 0 : 8 * ((ne - 1) / 8);
     const uint32_t to = at_start ? (ne < 8 ? ne : 8) : ne;
-    sum += mean_q4(src + from, to - from);
+    sum += mean_q4_strided(src + from * static_cast<uint32_t>(scale), to - from, scale);
   }
   return sum;
+}
+
+void MeshColors::fill_edge(uint32_t e, int m, uint8_t* p) const {
+  const uint32_t R = resolution(level_res(edge_res_[e], m));
+  if (R < 2) return;
+  uint8_t* s = p + layout_.edge_base + layout_.edge_offset[e] - 1;  // s[q]: the sample at q = 1 .. R - 1
+  const uint8_t first = p[topo_.edge_vertex[2 * e]], last = p[topo_.edge_vertex[2 * e + 1]];
+  for (uint32_t q = 1; q < R; q += 2) {
+    const uint32_t a = q == 1 ? first : s[q - 1], b = q + 1 == R ? last : s[q + 1];
+    s[q] = static_cast<uint8_t>((a + b + 1) >> 1);
+  }
+}
+
+void MeshColors::fill_face(uint32_t f, int m, uint8_t* p) const {
+  const uint32_t R = resolution(level_res(face_res_[f], m));
+  if (R < 4) return;  // no face samples (R = 2's only point, on an edge, is the edge's)
+  const uint32_t n = R - 2;
+  uint8_t* face = p + layout_.face_base + layout_.face_offset[f];
+  for (uint32_t j = 1; j + 1 < R; ++j) {
+    const uint32_t row = j - 1;
+    uint8_t* dst = face + row * n - row * (row - 1) / 2 - 1;  // dst[i]: lattice point (i, j)
+    for (uint32_t i = 1; i + j < R; ++i) {
+      if ((i & 1u) == 0 && (j & 1u) == 0) continue;  // a point level m + 1 has
+      uint32_t a, b;
+      if ((j & 1u) == 0) {  // between (i - 1, j) and (i + 1, j)
+        a = p[sample_index(f, m, i - 1, j)];
+        b = p[sample_index(f, m, i + 1, j)];
+      } else if ((i & 1u) == 0) {  // between (i, j - 1) and (i, j + 1)
+        a = p[sample_index(f, m, i, j - 1)];
+        b = p[sample_index(f, m, i, j + 1)];
+      } else {  // between (i - 1, j + 1) and (i + 1, j - 1)
+        a = p[sample_index(f, m, i - 1, j + 1)];
+        b = p[sample_index(f, m, i + 1, j - 1)];
+      }
+      dst[i] = static_cast<uint8_t>((a + b + 1) >> 1);
+    }
+  }
 }
 
 Status level_chunk_info(const uint8_t* data, size_t size, LevelChunk* out) {
@@ -651,86 +706,112 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
   uint8_t prev_nz[2][2] = {};
   int32_t lv[64];
 
+  // The component groups of every element, in order: Y', Cb, Cr on the
+  // level's lattice, or (kFlagChromaHalf) Y' on it, then Cb, Cr on the next
+  // level's, whose samples lie at every other lattice point (scale 2).
+  struct Group {
+    int first, end, shift;
+  };
+  const Group whole[1] = {{0, 3, 0}}, split[2] = {{0, 1, 0}, {1, 3, 1}};
+  const Group* groups = chroma_half_ ? split : whole;
+  const int group_count = chroma_half_ ? 2 : 1;
+
   // Edges.
   for (uint32_t e = lc.first; e < edge_end; ++e) {
-    const uint32_t n = edge_samples(level_res(edge_res_[e], m));
     const uint32_t base = layout_.edge_base + layout_.edge_offset[e];
-    int64_t prev_q[3] = {0, 0, 0};
-    for (uint32_t b = 0; 8 * b < n; ++b) {
-      const int len = static_cast<int>(n - 8 * b < 8 ? n - 8 * b : 8);
-      for (int c = 0; c < 3; ++c) {
-        const int cls = c == 0 ? 0 : 1;
-        const uint32_t* step = steps_->edge[cls];
-        uint8_t* dst = out.plane(c) + base + 8 * b;
-        const int64_t vertex_q4 = int64_t{16} * vertex_ycc_[3 * topo_.edge_vertex[2 * e] + c];
-        const uint32_t dc_step = paper ? step[0] : mean_step(step[0]);
-        const int64_t pred = paper && b > 0 ? prev_q[c] : div_round(b == 0 ? vertex_q4 : mean_q4(dst - 8, 8), dc_step);
-        const int64_t q = pred + (paper ? dec.decode_signed(ctx_->dc_zero[c][1], ctx_->dc_mag[c][1], CodecContexts::kDcCtx,
-                                                            kDcCutoff, kDcOrder)
-                                        : dec.decode_signed(bctx_->dc_zero[cls][1], bctx_->dc_mag[cls][1],
-                                                            BlockContexts::kDcCtx, kDcCutoff, kDcOrder));
-        if (q > kMaxQuantised || q < -kMaxQuantised) return Status::malformed;
-        if (paper) {
-          lv[0] = static_cast<int32_t>(q);
-          for (int k = 1; k < len; ++k) lv[k] = next_ac(dec, *ctx_, ac[c][1], c, 1);
-          if (ac[c][1].bad) return Status::malformed;
-        } else if (!read_levels(dec, *bctx_, cls, 1, len, prev_nz[cls][1], lv)) {
-          return dec.ok() ? Status::malformed : dec.status();
+    for (int g = 0; g < group_count; ++g) {
+      const int scale = 1 << groups[g].shift;
+      const uint32_t n = edge_samples(level_res(edge_res_[e], m + groups[g].shift));
+      int64_t prev_q[3] = {0, 0, 0};
+      for (uint32_t b = 0; 8 * b < n; ++b) {
+        const int len = static_cast<int>(n - 8 * b < 8 ? n - 8 * b : 8);
+        for (int c = groups[g].first; c < groups[g].end; ++c) {
+          const int cls = c == 0 ? 0 : 1;
+          const uint32_t* step = steps_->edge[cls];
+          uint8_t* dst = out.plane(c) + base + static_cast<uint32_t>(scale) * (8 * b + 1) - 1;
+          const int64_t vertex_q4 = int64_t{16} * vertex_ycc_[3 * topo_.edge_vertex[2 * e] + c];
+          const uint32_t dc_step = paper ? step[0] : mean_step(step[0]);
+          const int64_t pred =
+              paper && b > 0 ? prev_q[c]
+                             : div_round(b == 0 ? vertex_q4 : mean_q4_strided(dst - 8 * scale, 8, scale), dc_step);
+          const int64_t q = pred + (paper ? dec.decode_signed(ctx_->dc_zero[c][1], ctx_->dc_mag[c][1], CodecContexts::kDcCtx,
+                                                              kDcCutoff, kDcOrder)
+                                          : dec.decode_signed(bctx_->dc_zero[cls][1], bctx_->dc_mag[cls][1],
+                                                              BlockContexts::kDcCtx, kDcCutoff, kDcOrder));
+          if (q > kMaxQuantised || q < -kMaxQuantised) return Status::malformed;
+          if (paper) {
+            lv[0] = static_cast<int32_t>(q);
+            for (int k = 1; k < len; ++k) lv[k] = next_ac(dec, *ctx_, ac[c][1], c, 1);
+            if (ac[c][1].bad) return Status::malformed;
+          } else if (!read_levels(dec, *bctx_, cls, 1, len, prev_nz[cls][1], lv)) {
+            return dec.ok() ? Status::malformed : dec.status();
+          }
+          if (!dec.ok()) return dec.status();
+          reconstruct_edge_block(lv, len, step, mode_, paper ? 0 : q * dc_step, dst, scale);
+          prev_q[c] = q;
         }
-        if (!dec.ok()) return dec.status();
-        reconstruct_edge_block(lv, len, step, mode_, paper ? 0 : q * dc_step, dst);
-        prev_q[c] = q;
       }
+    }
+    if (chroma_half_) {
+      fill_edge(e, m, out.cb);
+      fill_edge(e, m, out.cr);
     }
   }
 
   // Faces.
   for (uint32_t f = face_first; f < face_end; ++f) {
-    const int rf = level_res(face_res_[f], m);
-    if (face_samples(rf) == 0) continue;
-    const int32_t n = static_cast<int32_t>(resolution(rf)) - 2;
     const uint32_t base = layout_.face_base + layout_.face_offset[f];
-    int64_t corner_q4[3];
-    for (int c = 0; c < 3; ++c) corner_q4[c] = corner_sum_q4(f, m, out.plane(c));
-    int64_t left_q[3] = {0, 0, 0}, row_q[3] = {0, 0, 0};
-    int64_t left_mean[3] = {0, 0, 0}, row_mean[3] = {0, 0, 0};
-    for (int32_t br = 0; 8 * br < n; ++br) {
-      for (int32_t bc = 0; n - 8 * (br + bc) >= 1; ++bc) {
-        const int32_t D = n - 8 * (br + bc);
-        for (int c = 0; c < 3; ++c) {
-          const int cls = c == 0 ? 0 : 1;
-          const uint32_t* step = steps_->face[cls];
-          const uint32_t dc_step = paper ? step[0] : mean_step(step[0]);
-          const int64_t pred = paper ? (bc > 0 ? left_q[c] : (br > 0 ? row_q[c] : div_round(corner_q4[c], 2 * dc_step)))
-                                     : div_round(bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : div_round(corner_q4[c], 2)),
-                                                 dc_step);
-          const int64_t q = pred + (paper ? dec.decode_signed(ctx_->dc_zero[c][0], ctx_->dc_mag[c][0],
-                                                              CodecContexts::kDcCtx, kDcCutoff, kDcOrder)
-                                          : dec.decode_signed(bctx_->dc_zero[cls][0], bctx_->dc_mag[cls][0],
-                                                              BlockContexts::kDcCtx, kDcCutoff, kDcOrder));
-          if (q > kMaxQuantised || q < -kMaxQuantised) return Status::malformed;
-          int32_t qn[64] = {};
-          const int positions = face_block_positions(D);
-          if (paper) {
-            qn[0] = static_cast<int32_t>(q);
-            for (int z = 1; z < positions; ++z) qn[image_model::kZigzag[z]] = next_ac(dec, *ctx_, ac[c][0], c, 0);
-            if (ac[c][0].bad) return Status::malformed;
-          } else {
-            if (!read_levels(dec, *bctx_, cls, 0, positions, prev_nz[cls][0], lv))
-              return dec.ok() ? Status::malformed : dec.status();
-            for (int z = 0; z < positions; ++z) qn[image_model::kZigzag[z]] = lv[z];
-          }
-          if (!dec.ok()) return dec.status();
-          const int64_t mean =
-              reconstruct_face_block(qn, D, step, mode_, paper ? 0 : q * dc_step, out.plane(c) + base, n, br, bc);
-          left_q[c] = q;
-          left_mean[c] = mean;
-          if (bc == 0) {
-            row_q[c] = q;
-            row_mean[c] = left_mean[c];
+    for (int g = 0; g < group_count; ++g) {
+      const int scale = 1 << groups[g].shift;
+      const int rf = level_res(face_res_[f], m + groups[g].shift);
+      if (face_samples(rf) == 0) continue;
+      const int32_t n = static_cast<int32_t>(resolution(rf)) - 2;
+      int64_t corner_q4[3] = {0, 0, 0};
+      for (int c = groups[g].first; c < groups[g].end; ++c) corner_q4[c] = corner_sum_q4(f, m, out.plane(c), scale);
+      int64_t left_q[3] = {0, 0, 0}, row_q[3] = {0, 0, 0};
+      int64_t left_mean[3] = {0, 0, 0}, row_mean[3] = {0, 0, 0};
+      for (int32_t br = 0; 8 * br < n; ++br) {
+        for (int32_t bc = 0; n - 8 * (br + bc) >= 1; ++bc) {
+          const int32_t D = n - 8 * (br + bc);
+          for (int c = groups[g].first; c < groups[g].end; ++c) {
+            const int cls = c == 0 ? 0 : 1;
+            const uint32_t* step = steps_->face[cls];
+            const uint32_t dc_step = paper ? step[0] : mean_step(step[0]);
+            const int64_t pred =
+                paper ? (bc > 0 ? left_q[c] : (br > 0 ? row_q[c] : div_round(corner_q4[c], 2 * dc_step)))
+                      : div_round(bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : div_round(corner_q4[c], 2)), dc_step);
+            const int64_t q = pred + (paper ? dec.decode_signed(ctx_->dc_zero[c][0], ctx_->dc_mag[c][0],
+                                                                CodecContexts::kDcCtx, kDcCutoff, kDcOrder)
+                                            : dec.decode_signed(bctx_->dc_zero[cls][0], bctx_->dc_mag[cls][0],
+                                                                BlockContexts::kDcCtx, kDcCutoff, kDcOrder));
+            if (q > kMaxQuantised || q < -kMaxQuantised) return Status::malformed;
+            int32_t qn[64] = {};
+            const int positions = face_block_positions(D);
+            if (paper) {
+              qn[0] = static_cast<int32_t>(q);
+              for (int z = 1; z < positions; ++z) qn[image_model::kZigzag[z]] = next_ac(dec, *ctx_, ac[c][0], c, 0);
+              if (ac[c][0].bad) return Status::malformed;
+            } else {
+              if (!read_levels(dec, *bctx_, cls, 0, positions, prev_nz[cls][0], lv))
+                return dec.ok() ? Status::malformed : dec.status();
+              for (int z = 0; z < positions; ++z) qn[image_model::kZigzag[z]] = lv[z];
+            }
+            if (!dec.ok()) return dec.status();
+            const int64_t mean = reconstruct_face_block(qn, D, step, mode_, paper ? 0 : q * dc_step,
+                                                        out.plane(c) + base, n, br, bc, scale);
+            left_q[c] = q;
+            left_mean[c] = mean;
+            if (bc == 0) {
+              row_q[c] = q;
+              row_mean[c] = left_mean[c];
+            }
           }
         }
       }
+    }
+    if (chroma_half_) {
+      fill_face(f, m, out.cb);
+      fill_face(f, m, out.cr);
     }
   }
   s = dec.finish();

@@ -28,6 +28,8 @@ struct EncodeModelOptions {
   double density = 0;
   std::string up = "+y";
   bool paper = false;
+  std::string chroma = "auto";
+  bool all_faces_fine = false;
   uint32_t max_chunk = 4096;
   bool quiet = false;
   std::string timeline;
@@ -101,6 +103,8 @@ void run_encode_model(const EncodeModelOptions& o) {
     e.fixed_density = true;
   }
   e.codec.paper = o.paper;
+  e.codec.chroma = enc::chroma_from_name(o.chroma);
+  e.rd_faces = !o.all_faces_fine;
   enc::TexturedModel model;
   try {
     model = enc::load_textured_model(o.input);
@@ -179,6 +183,11 @@ void add_encode_model(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0u, 4096u));
   sub->add_flag("--paper", o->paper, "Code the colours as the thesis does (for comparison)");
+  sub->add_flag("--all-faces-fine", o->all_faces_fine,
+                "Every face at the resolution its texels give (no coarser lattice where it predicts the face as well as coding it)");
+  sub->add_option("--chroma", o->chroma,
+                  "Each colour level's chroma from the next level's lattice (half), on its own (full), or half above quality 2 (auto)")
+      ->check(CLI::IsMember({"auto", "half", "full"}));
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes (the client's chunk buffer)")
       ->capture_default_str()
       ->check(CLI::Range(512u, 1u << 24));

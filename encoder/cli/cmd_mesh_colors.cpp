@@ -53,6 +53,8 @@ struct MeshColorsOptions {
   std::vector<std::string> codecs{"vds", "paper"};
   double deadzone = enc::MccOptions{}.deadzone;
   bool no_seam_boost = false;
+  std::string chroma = "auto";
+  bool all_faces_fine = false;
 };
 
 void write_ppm(const std::string& path, const Image& img) {
@@ -82,10 +84,19 @@ void run(const MeshColorsOptions& o) {
   for (size_t i = 0; i < model.textures.size(); ++i)
     std::printf("%s %dx%d", i == 0 ? ":" : ",", model.textures[i].width, model.textures[i].height);
   std::printf("\n");
+  auto options = [&o](const std::string& codec) {
+    enc::MccOptions mo;
+    mo.paper = codec == "paper";
+    mo.deadzone = o.deadzone;
+    mo.chroma = enc::chroma_from_name(o.chroma);
+    return mo;
+  };
   // The mesh colors at each sample density used, converted once each.
-  std::map<double, enc::MeshColorsModel> converted;
-  auto colors = [&](double density) -> const enc::MeshColorsModel& {
-    auto it = converted.find(density);
+  // Keyed by density and, for the vds codec's rate-distortion choice of face
+  // resolutions, the quality (0: none).
+  std::map<std::pair<double, double>, enc::MeshColorsModel> converted;
+  auto colors = [&](double density, double rd_quality = 0) -> const enc::MeshColorsModel& {
+    auto it = converted.find({density, rd_quality});
     if (it != converted.end()) return it->second;
     enc::MeshColorsOptions mo;
     mo.density = density;
@@ -93,11 +104,12 @@ void run(const MeshColorsOptions& o) {
     mo.seam_boost = !o.no_seam_boost;
     enc::MeshColorsModel mcm;
     try {
-      mcm = enc::to_mesh_colors(model, mo);
+      mcm = rd_quality > 0 ? enc::to_mesh_colors_rd(model, mo, rd_quality, options("vds"))
+                           : enc::to_mesh_colors(model, mo);
     } catch (const std::runtime_error& e) {
       throw Failure(kExitBadInput, e.what());
     }
-    std::printf("density %g: resolutions", density);
+    std::printf("density %g%s: resolutions", density, rd_quality > 0 ? (", chosen for quality " + std::to_string(rd_quality)).c_str() : "");
     std::vector<size_t> hist(mc::kMaxResLog2 + 1, 0);
     for (uint8_t r : mcm.face_res) ++hist[r];
     for (int r = 0; r <= mc::kMaxResLog2; ++r)
@@ -105,25 +117,21 @@ void run(const MeshColorsOptions& o) {
     std::printf("; samples per level");
     for (int m = 0; m <= mcm.max_res; ++m) std::printf(" %d: %u", m, mcm.samples(m));
     std::printf("\n");
-    return converted.emplace(density, std::move(mcm)).first->second;
+    return converted.emplace(std::make_pair(density, rd_quality), std::move(mcm)).first->second;
   };
   // The vds codec's density follows the quality unless --density fixes it;
   // the thesis's codec keeps one sample per texel.
   auto density_of = [&](const std::string& codec, double q) {
     return o.density > 0 ? o.density : (codec == "paper" ? 1.0 : enc::density_for_quality(q));
   };
+  // The vds codec chooses its faces' resolutions for the quality.
+  auto rd_of = [&](const std::string& codec, double q) { return codec == "paper" || o.all_faces_fine ? 0.0 : q; };
   std::ofstream csv;
   if (!o.csv.empty()) {
     csv.open(o.csv);
     if (!csv) throw Failure(kExitBadInput, o.csv + ": cannot write");
     csv << "codec,quality,density,level,samples,bytes,ratio,psnr_y,psnr_cb,psnr_cr\n";
   }
-  auto options = [&o](const std::string& codec) {
-    enc::MccOptions mo;
-    mo.paper = codec == "paper";
-    mo.deadzone = o.deadzone;
-    return mo;
-  };
   // Each codec and quality encoded once, for the table and the rendered views.
   std::map<std::pair<std::string, double>, enc::MccEncoded> encoded;
   std::map<std::pair<std::string, double>, size_t> header_bytes;  // by codec and density
@@ -131,7 +139,7 @@ void run(const MeshColorsOptions& o) {
   for (const std::string& codec : o.codecs)
     for (double q : o.quality) {
       const double density = density_of(codec, q);
-      const enc::MeshColorsModel& mcm = colors(density);
+      const enc::MeshColorsModel& mcm = colors(density, rd_of(codec, q));
       const size_t V = mcm.positions.size();
       const enc::MccEncoded& e =
           encoded.emplace(std::make_pair(codec, q), enc::encode_mesh_colors(mcm, q, options(codec))).first->second;
@@ -197,7 +205,7 @@ void run(const MeshColorsOptions& o) {
   size_t coded_rows = 0;
   for (const std::string& codec : o.codecs)
     for (double q : o.quality) {
-      const enc::MeshColorsModel& mcm = colors(density_of(codec, q));
+      const enc::MeshColorsModel& mcm = colors(density_of(codec, q), rd_of(codec, q));
       const enc::MccEncoded& e = encoded.at({codec, q});
       const auto planes = enc::decode_mesh_colors_level(mcm, e, 0);
       auto [p, img] = measure([&](const ref::CameraD& c) { return enc::render_mesh_colors(mcm, planes, 0, c, views); });
@@ -260,6 +268,12 @@ void add_mesh_colors(CLI::App& app) {
   c->add_option("--deadzone", o->deadzone, "vds codec: levels rounded down below 0.5 + this of a step")
       ->check(CLI::Range(0.0, 0.5));
   c->add_flag("--no-seam-boost", o->no_seam_boost, "keep faces on seams whose sides differ at their own resolution");
+  c->add_flag("--all-faces-fine", o->all_faces_fine,
+              "vds codec: every face at the resolution its texels give (no coarser lattice where it predicts the face "
+              "as well as coding it)");
+  c->add_option("--chroma", o->chroma,
+                "each level's chroma from the next level's lattice (half), on its own (full), or half above quality 2 (auto)")
+      ->check(CLI::IsMember({"auto", "half", "full"}));
   c->add_option("--density", o->density,
                  "samples per texel side (default: the vds codec's follows the quality, the thesis's is 1)")
       ->check(kPositive);

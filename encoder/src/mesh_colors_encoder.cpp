@@ -110,15 +110,32 @@ void write_levels(ArithEncoder& enc, mc::BlockContexts& cx, int cls, int kind, i
   }
 }
 
-// Every block of level m, quantised, in the decoder's order.
-std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& layout, const mc::Steps& steps, int m,
-                                uint8_t mode, double deadzone) {
-  layout.layout_level(m);
-  const mc::Layout& l = layout.layout();
+// Every block of level m, quantised, in the decoder's order. `layout` and
+// `next` are set up alike; with chroma_half the chroma is coded from level
+// m + 1's samples on its lattice (`next` holds its layout), and a block's
+// predictions read that lattice's reconstruction, as the client reads
+// those samples where they lie in level m's (vds::mc::kFlagChromaHalf).
+std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& layout, mc::MeshColors& next,
+                                const mc::Steps& steps, int m, uint8_t mode, double deadzone, bool chroma_half) {
   const mc::Topology& topo = layout.topology();
   const bool paper = mode == mc::kModePaper;
-  const auto& planes = model.levels[static_cast<size_t>(m)];
-  std::array<std::vector<uint8_t>, 3> recon = planes;  // every block replaced by its reconstruction in turn
+  struct Group {
+    int first, end, shift;
+  };
+  std::vector<Group> groups;
+  if (chroma_half) {
+    groups = {{0, 1, 0}, {1, 3, 1}};
+  } else {
+    groups = {{0, 3, 0}};
+  }
+  layout.layout_level(m);
+  next.layout_level(m + 1);
+  // Per shift: the layout, the source planes and their reconstruction
+  // (every block replaced by its reconstruction in turn).
+  const mc::MeshColors* lay[2] = {&layout, &next};
+  const std::array<std::vector<uint8_t>, 3>* src[2] = {&model.levels[static_cast<size_t>(m)],
+                                                      &model.levels[static_cast<size_t>(chroma_half ? m + 1 : m)]};
+  std::array<std::vector<uint8_t>, 3> recon[2] = {*src[0], *src[1]};
   std::vector<Block> blocks;
   auto quantise_ac = [&](double coef, uint32_t step_q4) {
     if (paper) return quantise(coef, step_q4);
@@ -127,121 +144,131 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
     return coef < 0 ? -std::max(q, 0) : std::max(q, 0);
   };
 
-  for (uint32_t e = 0; e < topo.edges; ++e) {
-    const uint32_t n = mc::edge_samples(mc::level_res(layout.edge_res()[e], m));
-    const uint32_t base = l.edge_base + l.edge_offset[e];
-    int64_t prev_q[3] = {0, 0, 0};
-    for (uint32_t b = 0; 8 * b < n; ++b) {
-      const int len = static_cast<int>(std::min<uint32_t>(8, n - 8 * b));
-      for (int c = 0; c < 3; ++c) {
-        const uint32_t* step = steps.edge[c == 0 ? 0 : 1];
-        double x[8], X[8];
-        for (int i = 0; i < len; ++i) x[i] = planes[c][base + 8 * b + i];
-        const int64_t vertex_q4 = int64_t{16} * model.vertex_ycc[3 * topo.edge_vertex[2 * e] + c];
-        uint8_t* dst = recon[c].data() + base + 8 * b;
-        const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
-        const int64_t pred = paper && b > 0 ? prev_q[c] : mc::div_round(b == 0 ? vertex_q4 : mc::mean_q4(dst - 8, 8), dc_step);
-        Block blk;
-        blk.element = e;
-        blk.comp = c;
-        blk.kind = 1;
-        blk.positions = len;
-        int32_t q[8];
-        int64_t mean_q4 = 0;
-        if (paper) {
-          forward_dct(x, len, X);
-          q[0] = quantise(X[0], step[0]);
-          blk.dc_diff = static_cast<int32_t>(q[0] - pred);
-          for (int k = 1; k < len; ++k) blk.ac.push_back(q[k] = quantise(X[k], step[k]));
-        } else {
-          double mean = 0;
-          for (int i = 0; i < len; ++i) mean += x[i] / len;
-          const int32_t qm = quantise(mean, dc_step);  // the mean's index
-          blk.dc_diff = static_cast<int32_t>(qm - pred);
-          mean_q4 = int64_t{qm} * dc_step;
-          for (int i = 0; i < len; ++i) x[i] -= mean_q4 / 16.0;
-          forward_orthonormal(x, len, X);
-          for (int k = 0; k < len; ++k) blk.ac.push_back(q[k] = quantise_ac(X[k], step[k]));
-        }
-        const int32_t dc_index = paper ? q[0] : static_cast<int32_t>(blk.dc_diff + pred);
-        mc::reconstruct_edge_block(q, len, step, mode, mean_q4, dst);
-        q[0] = dc_index;
-        prev_q[c] = q[0];
-        blocks.push_back(std::move(blk));
-      }
-    }
-  }
-
-  for (uint32_t f = 0; f < topo.faces; ++f) {
-    const int rf = mc::level_res(model.face_res[f], m);
-    if (mc::face_samples(rf) == 0) continue;
-    const int32_t n = static_cast<int32_t>(mc::resolution(rf)) - 2;
-    const uint32_t base = l.face_base + l.face_offset[f];
-    int64_t corner_q4[3];
-    for (int c = 0; c < 3; ++c) corner_q4[c] = layout.corner_sum_q4(f, m, recon[c].data());
-    int64_t left_q[3] = {0, 0, 0}, row_q[3] = {0, 0, 0}, left_mean[3] = {0, 0, 0}, row_mean[3] = {0, 0, 0};
-    for (int32_t br = 0; 8 * br < n; ++br)
-      for (int32_t bc = 0; n - 8 * (br + bc) >= 1; ++bc) {
-        const int32_t D = n - 8 * (br + bc);
-        const int rows = std::min(D, 8);
-        const int positions = mc::face_block_positions(D);
-        for (int c = 0; c < 3; ++c) {
-          const uint32_t* step = steps.face[c == 0 ? 0 : 1];
-          double x[64] = {}, rowX[64] = {}, Z[64] = {};
+  for (uint32_t e = 0; e < topo.edges; ++e)
+    for (const Group& g : groups) {
+      const int lm = m + g.shift;
+      const mc::Layout& l = lay[g.shift]->layout();
+      const uint32_t n = mc::edge_samples(mc::level_res(layout.edge_res()[e], lm));
+      const uint32_t base = l.edge_base + l.edge_offset[e];
+      int64_t prev_q[3] = {0, 0, 0};
+      for (uint32_t b = 0; 8 * b < n; ++b) {
+        const int len = static_cast<int>(std::min<uint32_t>(8, n - 8 * b));
+        for (int c = g.first; c < g.end; ++c) {
+          const uint32_t* step = steps.edge[c == 0 ? 0 : 1];
+          double x[8], X[8];
+          for (int i = 0; i < len; ++i) x[i] = (*src[g.shift])[c][base + 8 * b + i];
+          const int64_t vertex_q4 = int64_t{16} * model.vertex_ycc[3 * topo.edge_vertex[2 * e] + c];
+          uint8_t* dst = recon[g.shift][c].data() + base + 8 * b;
           const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
           const int64_t pred =
-              paper ? (bc > 0 ? left_q[c] : (br > 0 ? row_q[c] : mc::div_round(corner_q4[c], 2 * dc_step)))
-                    : mc::div_round(bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : mc::div_round(corner_q4[c], 2)), dc_step);
-          double sum = 0;
-          for (int r = 0; r < rows; ++r) {
-            const int32_t gr = 8 * br + r;
-            const int len = std::min(8, D - r);
-            const uint8_t* src = planes[c].data() + base + static_cast<uint32_t>(gr * n - gr * (gr - 1) / 2 + 8 * bc);
-            for (int i = 0; i < len; ++i) sum += x[8 * r + i] = src[i];
-          }
+              paper && b > 0 ? prev_q[c] : mc::div_round(b == 0 ? vertex_q4 : mc::mean_q4(dst - 8, 8), dc_step);
           Block blk;
-          blk.element = topo.edges + f;
+          blk.element = e;
           blk.comp = c;
-          blk.kind = 0;
-          blk.positions = positions;
-          int32_t q[64] = {};
+          blk.kind = 1;
+          blk.positions = len;
+          int32_t q[8];
           int64_t mean_q4 = 0;
           if (paper) {
-            for (int r = 0; r < rows; ++r) forward_dct(x + 8 * r, std::min(8, D - r), rowX + 8 * r);
-            for (int k = 0; k < rows; ++k) forward_dct(rowX + k, std::min(8, D - k), Z + k, 8, 8);
-            q[0] = quantise(Z[0], step[0]);
+            forward_dct(x, len, X);
+            q[0] = quantise(X[0], step[0]);
             blk.dc_diff = static_cast<int32_t>(q[0] - pred);
-            for (int z = 1; z < positions; ++z) {
-              const int pos = image_model::kZigzag[z];
-              blk.ac.push_back(q[pos] = quantise(Z[pos], step[pos]));
-            }
+            for (int k = 1; k < len; ++k) blk.ac.push_back(q[k] = quantise(X[k], step[k]));
           } else {
-            const int32_t qm = quantise(sum / positions, dc_step);
+            double mean = 0;
+            for (int i = 0; i < len; ++i) mean += x[i] / len;
+            const int32_t qm = quantise(mean, dc_step);  // the mean's index
             blk.dc_diff = static_cast<int32_t>(qm - pred);
             mean_q4 = int64_t{qm} * dc_step;
-            for (int r = 0; r < rows; ++r) {
-              const int len = std::min(8, D - r);
-              for (int i = 0; i < len; ++i) x[8 * r + i] -= mean_q4 / 16.0;
-              forward_orthonormal(x + 8 * r, len, rowX + 8 * r);
-            }
-            for (int k = 0; k < rows; ++k) forward_orthonormal(rowX + k, std::min(8, D - k), Z + k, 8, 8);
-            for (int z = 0; z < positions; ++z) {
-              const int pos = image_model::kZigzag[z];
-              blk.ac.push_back(q[pos] = quantise_ac(Z[pos], step[pos]));
-            }
+            for (int i = 0; i < len; ++i) x[i] -= mean_q4 / 16.0;
+            forward_orthonormal(x, len, X);
+            for (int k = 0; k < len; ++k) blk.ac.push_back(q[k] = quantise_ac(X[k], step[k]));
           }
-          const int64_t mean = mc::reconstruct_face_block(q, D, step, mode, mean_q4, recon[c].data() + base, n, br, bc);
-          if (!paper) q[0] = static_cast<int32_t>(blk.dc_diff + pred);
-          left_q[c] = q[0];
-          left_mean[c] = mean;
-          if (bc == 0) {
-            row_q[c] = q[0];
-            row_mean[c] = mean;
-          }
+          const int32_t dc_index = paper ? q[0] : static_cast<int32_t>(blk.dc_diff + pred);
+          mc::reconstruct_edge_block(q, len, step, mode, mean_q4, dst);
+          q[0] = dc_index;
+          prev_q[c] = q[0];
           blocks.push_back(std::move(blk));
         }
       }
-  }
+    }
+
+  for (uint32_t f = 0; f < topo.faces; ++f)
+    for (const Group& g : groups) {
+      const int lm = m + g.shift;
+      const mc::Layout& l = lay[g.shift]->layout();
+      const int rf = mc::level_res(model.face_res[f], lm);
+      if (mc::face_samples(rf) == 0) continue;
+      const int32_t n = static_cast<int32_t>(mc::resolution(rf)) - 2;
+      const uint32_t base = l.face_base + l.face_offset[f];
+      int64_t corner_q4[3] = {0, 0, 0};
+      for (int c = g.first; c < g.end; ++c) corner_q4[c] = lay[g.shift]->corner_sum_q4(f, lm, recon[g.shift][c].data());
+      int64_t left_q[3] = {0, 0, 0}, row_q[3] = {0, 0, 0}, left_mean[3] = {0, 0, 0}, row_mean[3] = {0, 0, 0};
+      for (int32_t br = 0; 8 * br < n; ++br)
+        for (int32_t bc = 0; n - 8 * (br + bc) >= 1; ++bc) {
+          const int32_t D = n - 8 * (br + bc);
+          const int rows = std::min(D, 8);
+          const int positions = mc::face_block_positions(D);
+          for (int c = g.first; c < g.end; ++c) {
+            const uint32_t* step = steps.face[c == 0 ? 0 : 1];
+            double x[64] = {}, rowX[64] = {}, Z[64] = {};
+            const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
+            const int64_t pred =
+                paper ? (bc > 0 ? left_q[c] : (br > 0 ? row_q[c] : mc::div_round(corner_q4[c], 2 * dc_step)))
+                      : mc::div_round(bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : mc::div_round(corner_q4[c], 2)),
+                                      dc_step);
+            double sum = 0;
+            for (int r = 0; r < rows; ++r) {
+              const int32_t gr = 8 * br + r;
+              const int len = std::min(8, D - r);
+              const uint8_t* from =
+                  (*src[g.shift])[c].data() + base + static_cast<uint32_t>(gr * n - gr * (gr - 1) / 2 + 8 * bc);
+              for (int i = 0; i < len; ++i) sum += x[8 * r + i] = from[i];
+            }
+            Block blk;
+            blk.element = topo.edges + f;
+            blk.comp = c;
+            blk.kind = 0;
+            blk.positions = positions;
+            int32_t q[64] = {};
+            int64_t mean_q4 = 0;
+            if (paper) {
+              for (int r = 0; r < rows; ++r) forward_dct(x + 8 * r, std::min(8, D - r), rowX + 8 * r);
+              for (int k = 0; k < rows; ++k) forward_dct(rowX + k, std::min(8, D - k), Z + k, 8, 8);
+              q[0] = quantise(Z[0], step[0]);
+              blk.dc_diff = static_cast<int32_t>(q[0] - pred);
+              for (int z = 1; z < positions; ++z) {
+                const int pos = image_model::kZigzag[z];
+                blk.ac.push_back(q[pos] = quantise(Z[pos], step[pos]));
+              }
+            } else {
+              const int32_t qm = quantise(sum / positions, dc_step);
+              blk.dc_diff = static_cast<int32_t>(qm - pred);
+              mean_q4 = int64_t{qm} * dc_step;
+              for (int r = 0; r < rows; ++r) {
+                const int len = std::min(8, D - r);
+                for (int i = 0; i < len; ++i) x[8 * r + i] -= mean_q4 / 16.0;
+                forward_orthonormal(x + 8 * r, len, rowX + 8 * r);
+              }
+              for (int k = 0; k < rows; ++k) forward_orthonormal(rowX + k, std::min(8, D - k), Z + k, 8, 8);
+              for (int z = 0; z < positions; ++z) {
+                const int pos = image_model::kZigzag[z];
+                blk.ac.push_back(q[pos] = quantise_ac(Z[pos], step[pos]));
+              }
+            }
+            const int64_t mean =
+                mc::reconstruct_face_block(q, D, step, mode, mean_q4, recon[g.shift][c].data() + base, n, br, bc);
+            if (!paper) q[0] = static_cast<int32_t>(blk.dc_diff + pred);
+            left_q[c] = q[0];
+            left_mean[c] = mean;
+            if (bc == 0) {
+              row_q[c] = q[0];
+              row_mean[c] = mean;
+            }
+            blocks.push_back(std::move(blk));
+          }
+        }
+    }
 
   return blocks;
 }
@@ -321,9 +348,9 @@ std::vector<uint8_t> code_chunk(const std::vector<Block>& all, size_t b0, size_t
 // Level m as chunks of at most max_chunk bytes (0: one chunk): each the
 // most elements from where the last ended that fit (found by bisection).
 std::vector<std::vector<uint8_t>> encode_level(const MeshColorsModel& model, mc::MeshColors& layout,
-                                               const mc::Steps& steps, int m, uint8_t mode, double deadzone,
-                                               size_t max_chunk) {
-  const std::vector<Block> blocks = level_blocks(model, layout, steps, m, mode, deadzone);
+                                               mc::MeshColors& next, const mc::Steps& steps, int m, uint8_t mode,
+                                               double deadzone, bool chroma_half, size_t max_chunk) {
+  const std::vector<Block> blocks = level_blocks(model, layout, next, steps, m, mode, deadzone, chroma_half);
   const uint32_t n = layout.topology().edges + layout.topology().faces;
   const bool paper = mode == mc::kModePaper;
   // begin[e]: the first block of element e (blocks come in element order).
@@ -364,29 +391,53 @@ struct Layout {
   mc::MeshColors mc;
 };
 
-void set_up(const MeshColorsModel& model, uint16_t q8, uint8_t mode, Layout& l) {
+void set_up(const MeshColorsModel& model, uint16_t q8, uint8_t mode, bool chroma_half, Layout& l) {
   const uint32_t F = static_cast<uint32_t>(model.face_res.size());
   const uint32_t V = static_cast<uint32_t>(model.positions.size());
   l.work.assign(mc::MeshColors::init_bytes(F, V), 0);
   l.arena = Arena(l.work.data(), l.work.size());
   if (l.mc.init(l.arena, model.triangles.data(), F, V) != Status::ok ||
-      l.mc.set(model.face_res.data(), model.vertex_ycc.data(), q8, mode) != Status::ok)
+      l.mc.set(model.face_res.data(), model.vertex_ycc.data(), q8, mode, chroma_half) != Status::ok)
     throw std::invalid_argument("mesh colors: the model's mesh is not one a client can hold");
 }
 
 }  // namespace
 
+bool chroma_half_for_quality(double quality) { return quality > 2; }
+
+MccOptions::Chroma chroma_from_name(const std::string& name) {
+  if (name == "auto") return MccOptions::Chroma::by_quality;
+  if (name == "half") return MccOptions::Chroma::half;
+  if (name == "full") return MccOptions::Chroma::full;
+  throw std::invalid_argument("chroma: '" + name + "' is not auto, half or full");
+}
+
+namespace {
+// The header and levels of encode_mesh_colors, or (only_level >= 0) the
+// header and that level alone, in one chunk.
+MccEncoded encode_impl(const MeshColorsModel& model, double quality, const MccOptions& o, int only_level);
+}  // namespace
+
 MccEncoded encode_mesh_colors(const MeshColorsModel& model, double quality, const MccOptions& o) {
+  return encode_impl(model, quality, o, -1);
+}
+
+namespace {
+MccEncoded encode_impl(const MeshColorsModel& model, double quality, const MccOptions& o, int only_level) {
+  const bool chroma_half = o.chroma == MccOptions::Chroma::half ||
+                           (o.chroma == MccOptions::Chroma::by_quality && chroma_half_for_quality(quality));
   const uint16_t q8 = static_cast<uint16_t>(std::clamp<long>(std::lround(quality * 256), 1, 65535));
   const uint8_t mode = o.paper ? mc::kModePaper : mc::kModeVds;
-  Layout l;
-  set_up(model, q8, mode, l);
+  Layout l, next;
+  set_up(model, q8, mode, chroma_half, l);
+  set_up(model, q8, mode, chroma_half, next);
   const uint32_t F = static_cast<uint32_t>(model.face_res.size());
   const uint32_t V = static_cast<uint32_t>(model.positions.size());
   MccEncoded out;
   std::vector<uint8_t>& h = out.header;
   const bool outside = o.vertex_colours_outside;
-  h = {mc::kVersion, mode, static_cast<uint8_t>(model.max_res), outside ? mc::kFlagVertexColours : uint8_t{0},
+  const uint8_t flags = static_cast<uint8_t>((outside ? mc::kFlagVertexColours : 0) | (chroma_half ? mc::kFlagChromaHalf : 0));
+  h = {mc::kVersion, mode, static_cast<uint8_t>(model.max_res), flags,
        static_cast<uint8_t>(q8 & 0xFF),
        static_cast<uint8_t>(q8 >> 8), static_cast<uint8_t>(V & 0xFF), static_cast<uint8_t>(V >> 8),
        static_cast<uint8_t>(F & 0xFF), static_cast<uint8_t>((F >> 8) & 0xFF), static_cast<uint8_t>((F >> 16) & 0xFF),
@@ -420,14 +471,24 @@ MccEncoded encode_mesh_colors(const MeshColorsModel& model, double quality, cons
   h.insert(h.end(), body.begin(), body.end());
   mc::Steps steps;
   mc::make_steps(q8, mode, &steps);
+  if (only_level >= 0) {
+    if (only_level < model.max_res) {
+      const std::vector<Block> blocks = level_blocks(model, l.mc, next.mc, steps, only_level, mode, o.deadzone, chroma_half);
+      const uint32_t n = l.mc.topology().edges + l.mc.topology().faces;
+      out.levels.resize(static_cast<size_t>(only_level) + 1);
+      out.levels.back().push_back(code_chunk(blocks, 0, blocks.size(), only_level, 0, n, o.paper));
+    }
+    return out;
+  }
   for (int m = 0; m < model.max_res; ++m)
-    out.levels.push_back(encode_level(model, l.mc, steps, m, mode, o.deadzone, o.max_chunk));
+    out.levels.push_back(encode_level(model, l.mc, next.mc, steps, m, mode, o.deadzone, chroma_half, o.max_chunk));
   return out;
 }
+}  // namespace
 
 std::array<std::vector<uint8_t>, 3> decode_mesh_colors_level(const MeshColorsModel& model, const MccEncoded& enc, int m) {
   Layout l;
-  set_up(model, 256, mc::kModePaper, l);
+  set_up(model, 256, mc::kModePaper, false, l);
   // The vertex colours a client has when they came with the vertices.
   const size_t V = model.positions.size();
   std::array<std::vector<uint8_t>, 3> vc;
@@ -452,6 +513,54 @@ std::array<std::vector<uint8_t>, 3> decode_mesh_colors_level(const MeshColorsMod
   }
   if (!l.mc.level_complete()) throw std::logic_error("mesh colors: a level's chunks do not cover it");
   return planes;
+}
+
+}  // namespace vds::enc
+
+namespace vds::enc {
+
+std::vector<uint8_t> rd_face_resolutions(const MeshColorsModel& model, double quality, const MccOptions& o) {
+  const uint32_t F = static_cast<uint32_t>(model.face_res.size());
+  if (model.max_res == 0) return model.face_res;
+  // Level 0 as the codec codes it: each face's samples as decoded.
+  const MccEncoded coded = encode_impl(model, quality, o, 0);
+  const auto decoded = decode_mesh_colors_level(model, coded, 0);
+  const std::vector<std::vector<double>> coarser = coarser_face_sse(model);
+  Layout l;
+  set_up(model, 256, mc::kModePaper, false, l);
+  l.mc.layout_level(0);
+  const mc::Layout& lay = l.mc.layout();
+  std::vector<uint8_t> out = model.face_res;
+  for (uint32_t f = 0; f < F; ++f) {
+    const int r = model.face_res[f];
+    if (r == 0) continue;
+    const uint32_t from = lay.face_base + lay.face_offset[f], to = lay.face_base + lay.face_offset[f + 1];
+    double code_sse = 0;
+    for (uint32_t i = from; i < to; ++i)
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(decoded[c][i]) - model.levels[0][c][i];
+        code_sse += kComponentWeight[c] * d * d;
+      }
+    // The coarsest lattice whose prediction, with its own coding error
+    // (about 4^-k of the face's), is no worse than coding the face's samples.
+    for (int k = r; k >= 1; --k) {
+      const double keep = 1.0 / double(1u << (2 * k));
+      if (coarser[f][static_cast<size_t>(k)] + code_sse * keep <= code_sse) {
+        out[f] = static_cast<uint8_t>(r - k);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+MeshColorsModel to_mesh_colors_rd(const TexturedModel& textured, const MeshColorsOptions& mo, double quality,
+                                  const MccOptions& o) {
+  const MeshColorsModel whole = to_mesh_colors(textured, mo);
+  MeshColorsOptions again = mo;
+  again.face_max_res = rd_face_resolutions(whole, quality, o);
+  again.vertex_filter_res = whole.face_res;
+  return to_mesh_colors(textured, again);
 }
 
 }  // namespace vds::enc

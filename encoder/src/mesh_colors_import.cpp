@@ -374,6 +374,58 @@ struct Accum {
 
 }  // namespace
 
+std::vector<std::vector<double>> coarser_face_sse(const MeshColorsModel& model) {
+  const uint32_t F = static_cast<uint32_t>(model.face_res.size());
+  const uint32_t V = static_cast<uint32_t>(model.positions.size());
+  std::vector<uint8_t> work0(mc::MeshColors::init_bytes(F, V)), workk(work0.size());
+  Arena arena0(work0.data(), work0.size()), arenak(workk.data(), workk.size());
+  mc::MeshColors l0, lk;
+  if (l0.init(arena0, model.triangles.data(), F, V) != Status::ok ||
+      lk.init(arenak, model.triangles.data(), F, V) != Status::ok ||
+      l0.set(model.face_res.data(), nullptr, 256) != Status::ok || lk.set(model.face_res.data(), nullptr, 256) != Status::ok)
+    throw std::logic_error("mesh colors: layout set-up failed");
+  std::vector<std::vector<double>> out(F);
+  for (uint32_t f = 0; f < F; ++f) out[f].assign(static_cast<size_t>(model.face_res[f]) + 1, 0.0);
+  l0.layout_level(0);
+  const auto& p0 = model.levels[0];
+  for (int k = 1; k <= model.max_res; ++k) {
+    lk.layout_level(k);
+    const auto& pk = model.levels[static_cast<size_t>(k)];
+    for (uint32_t f = 0; f < F; ++f) {
+      if (model.face_res[f] < k) continue;
+      const uint32_t R = mc::resolution(model.face_res[f]);
+      double sum = 0;
+      for (uint32_t j = 1; j + 1 < R; ++j)
+        for (uint32_t i = 1; i + j < R; ++i) {
+          // The point in level k's lattice units and the lattice triangle
+          // holding it (inside the face: i0 + j0 < R >> k).
+          const double u = std::ldexp(static_cast<double>(i), -k), v = std::ldexp(static_cast<double>(j), -k);
+          const uint32_t i0 = static_cast<uint32_t>(u), j0 = static_cast<uint32_t>(v);
+          const double fu = u - i0, fv = v - j0;
+          uint32_t a[3][2];
+          double w[3];
+          if (fu + fv <= 1) {
+            a[0][0] = i0, a[0][1] = j0, a[1][0] = i0 + 1, a[1][1] = j0, a[2][0] = i0, a[2][1] = j0 + 1;
+            w[0] = 1 - fu - fv, w[1] = fu, w[2] = fv;
+          } else {
+            a[0][0] = i0 + 1, a[0][1] = j0 + 1, a[1][0] = i0, a[1][1] = j0 + 1, a[2][0] = i0 + 1, a[2][1] = j0;
+            w[0] = fu + fv - 1, w[1] = 1 - fu, w[2] = 1 - fv;
+          }
+          const uint32_t s = l0.sample_index(f, 0, i, j);
+          for (int c = 0; c < 3; ++c) {
+            double pred = 0;
+            for (int t = 0; t < 3; ++t)
+              if (w[t] != 0) pred += w[t] * pk[c][lk.sample_index(f, k, a[t][0], a[t][1])];
+            const double d = p0[c][s] - pred;
+            sum += kComponentWeight[c] * d * d;
+          }
+        }
+      out[f][static_cast<size_t>(k)] = sum;
+    }
+  }
+  return out;
+}
+
 MeshColorsModel to_mesh_colors(const TexturedModel& model, const MeshColorsOptions& o) {
   if (model.positions.size() > mc::kMaxVertices)
     throw std::runtime_error(model.name + ": " + std::to_string(model.positions.size()) +
@@ -564,8 +616,11 @@ MeshColorsModel to_mesh_colors(const TexturedModel& model, const MeshColorsOptio
   // Vertex samples: level 0's, the mean over the faces around.
   Accum acc;
   acc.reset(V);
+  if (!o.vertex_filter_res.empty() && o.vertex_filter_res.size() != F)
+    throw std::invalid_argument("mesh colors: a vertex filter resolution per face is needed");
   for (uint32_t f = 0; f < F; ++f) {
-    const double spacing = extent[f] / mc::resolution(out.face_res[f]);
+    const int filter_res = o.vertex_filter_res.empty() ? out.face_res[f] : std::min<int>(o.vertex_filter_res[f], mc::kMaxResLog2);
+    const double spacing = extent[f] / mc::resolution(filter_res);
     for (int k = 0; k < 3; ++k) {
       if (!textured(f) && textured_vertex[out.triangles[3 * f + k]]) continue;
       std::array<double, 3> w{0, 0, 0};

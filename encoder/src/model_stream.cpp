@@ -252,10 +252,10 @@ std::vector<uint8_t> display_caps(const TexturedModel& dm, const Quantisation& q
 Colours colours_at(const TexturedModel& dm, const ModelStreamOptions& o, double quality, size_t max_chunk) {
   MeshColorsOptions co = o.colors;
   if (!o.fixed_density) co.density = density_for_quality(quality);
-  Colours c{quality, to_mesh_colors(dm, co), {}};
   MccOptions mo = o.codec;
   mo.max_chunk = max_chunk;
   mo.vertex_colours_outside = o.vertex_colours;  // every vertex's colour came with it (MCVX)
+  Colours c{quality, o.rd_faces && !mo.paper ? to_mesh_colors_rd(dm, co, quality, mo) : to_mesh_colors(dm, co), {}};
   c.coded = encode_mesh_colors(c.mc, quality, mo);
   return c;
 }

@@ -1,7 +1,8 @@
 // libFuzzer: mesh colors, both ends.
 //  - The client's decoder (vds/mesh_colors.h): the input as an MCLH header
 //    for a fixed mesh, or as an MCLV level after a valid header (vds mode
-//    or paper mode). Invariants:
+//    or paper mode, chroma from the next level's lattice; or the vds mode
+//    with chroma on the level's own). Invariants:
 //    no crash, sanitizer report or hang; a refused header leaves no level
 //    decodable; every write stays inside the level's planes (sized exactly).
 //  - The host's textured import from memory and the conversion to mesh
@@ -38,6 +39,7 @@ struct Fixed {
   vds::enc::MeshColorsModel model;
   vds::enc::MccEncoded stream;        // the vds mode
   vds::enc::MccEncoded paper_stream;  // the paper mode
+  vds::enc::MccEncoded full_stream;   // the vds mode, chroma on each level's own lattice
   Fixed() {
     const int n = 3;
     for (int y = 0; y <= n; ++y)
@@ -66,10 +68,15 @@ struct Fixed {
       }
       model.levels.push_back(p);
     }
-    stream = vds::enc::encode_mesh_colors(model, 0.5);
-    vds::enc::MccOptions paper;
+    vds::enc::MccOptions half;
+    half.chroma = vds::enc::MccOptions::Chroma::half;
+    stream = vds::enc::encode_mesh_colors(model, 0.5, half);
+    vds::enc::MccOptions paper = half;
     paper.paper = true;
     paper_stream = vds::enc::encode_mesh_colors(model, 0.5, paper);
+    vds::enc::MccOptions full;
+    full.chroma = vds::enc::MccOptions::Chroma::full;
+    full_stream = vds::enc::encode_mesh_colors(model, 0.5, full);
   }
 };
 const Fixed& fixed() {
@@ -90,6 +97,8 @@ void seed(const std::filesystem::path& dir) {
     write(dir / ("seed_level" + std::to_string(m)), 1, std::string(f.stream.levels[m][0].begin(), f.stream.levels[m][0].end()));
     const auto& p = f.paper_stream.levels[m][0];
     write(dir / ("seed_paper_level" + std::to_string(m)), 2, std::string(p.begin(), p.end()));
+    const auto& q = f.full_stream.levels[m][0];
+    write(dir / ("seed_full_chroma_level" + std::to_string(m)), 4, std::string(q.begin(), q.end()));
   }
   write(dir / "seed_obj", 3, std::string(1, '\0') +
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 3/3 2/2\nf 1/1 2/2 4/3\nf 2/2 3/3 4/1\n");
@@ -106,12 +115,14 @@ void seed(const std::filesystem::path& dir) {
   write(dir / "seed_ms3d", 3, std::string(1, '\10') + vds::test::ms3d_seed());
 }
 
-void decode(const uint8_t* data, size_t size, bool as_level, bool paper) {
+enum class Stream { vds, paper, full_chroma };
+
+void decode(const uint8_t* data, size_t size, bool as_level, Stream which) {
   const Fixed& f0 = fixed();
   struct View {
     const vds::enc::MeshColorsModel& model;
     const vds::enc::MccEncoded& stream;
-  } f{f0.model, paper ? f0.paper_stream : f0.stream};
+  } f{f0.model, which == Stream::paper ? f0.paper_stream : (which == Stream::full_chroma ? f0.full_stream : f0.stream)};
   const uint32_t faces = static_cast<uint32_t>(f.model.triangles.size() / 3);
   std::vector<uint8_t> work(vds::mc::MeshColors::init_bytes(faces, 16));
   vds::Arena arena(work.data(), work.size());
@@ -160,11 +171,13 @@ extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   if (data[0] == 0)
-    decode(data + 1, size - 1, false, false);
+    decode(data + 1, size - 1, false, Stream::vds);
   else if (data[0] == 1)
-    decode(data + 1, size - 1, true, false);
+    decode(data + 1, size - 1, true, Stream::vds);
   else if (data[0] == 2)
-    decode(data + 1, size - 1, true, true);
+    decode(data + 1, size - 1, true, Stream::paper);
+  else if (data[0] == 4)
+    decode(data + 1, size - 1, true, Stream::full_chroma);
   else
     import(data + 1, size - 1);
   return 0;

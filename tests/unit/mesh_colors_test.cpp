@@ -31,9 +31,16 @@ using namespace vds;
 // A tetrahedron: every edge shared by two faces in opposite directions.
 const uint16_t kTetra[] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
 
+// The codec's fidelity to a level's own samples: chroma on the level's lattice.
 vds::enc::MccOptions paper_mode() {
   vds::enc::MccOptions o;
   o.paper = true;
+  o.chroma = vds::enc::MccOptions::Chroma::full;
+  return o;
+}
+vds::enc::MccOptions full_chroma() {
+  vds::enc::MccOptions o;
+  o.chroma = vds::enc::MccOptions::Chroma::full;
   return o;
 }
 
@@ -222,7 +229,7 @@ TEST(MeshColorsCodec, TheVdsModeRoundTripsWithinBoundsAndBeatsThePaperMode) {
   std::vector<std::pair<size_t, double>> vds;
   for (int qi = 0; qi < 7; ++qi) {
     double p;
-    const size_t bytes = level0(quality[qi], enc::MccOptions{}, &p);
+    const size_t bytes = level0(quality[qi], full_chroma(), &p);
     EXPECT_GE(p, min_psnr[qi]) << "quality " << quality[qi];
     if (!vds.empty()) EXPECT_LT(bytes, vds.back().first) << "quality " << quality[qi];
     vds.emplace_back(bytes, p);
@@ -249,16 +256,22 @@ TEST(MeshColorsCodec, AFlatColourCostsAlmostNothingInTheVdsMode) {
   for (auto& level : m.levels)
     for (int c = 0; c < 3; ++c) std::fill(level[c].begin(), level[c].end(), static_cast<uint8_t>(90 + 40 * c));
   for (size_t i = 0; i < m.vertex_ycc.size(); ++i) m.vertex_ycc[i] = static_cast<uint8_t>(90 + 40 * (i % 3));
-  const enc::MccEncoded e = enc::encode_mesh_colors(m, 2);
-  for (int level = 0; level < m.max_res; ++level) {
-    EXPECT_LT(e.level_bytes(level), 40u) << "level " << level;
-    const auto planes = enc::decode_mesh_colors_level(m, e, level);
-    // Flat everywhere, within half the mean's step (4 levels at quality 2) of the colour.
-    for (int c = 0; c < 3; ++c)
-      for (size_t i = m.positions.size(); i < planes[c].size(); ++i) {
-        ASSERT_EQ(planes[c][i], planes[c][m.positions.size()]) << "level " << level << " sample " << i;
-        ASSERT_LE(std::abs(planes[c][i] - m.levels[level][c][i]), 2) << "level " << level << " sample " << i;
-      }
+  for (bool half : {false, true}) {
+    enc::MccOptions o;
+    o.chroma = half ? enc::MccOptions::Chroma::half : enc::MccOptions::Chroma::full;
+    const enc::MccEncoded e = enc::encode_mesh_colors(m, 2, o);
+    for (int level = 0; level < m.max_res; ++level) {
+      EXPECT_LT(e.level_bytes(level), 40u) << "level " << level;
+      const auto planes = enc::decode_mesh_colors_level(m, e, level);
+      // Flat everywhere, within half the mean's step (4 levels at quality 2)
+      // of the colour; chroma from the next level's lattice is filled in
+      // between it and the (exact) vertex samples.
+      for (int c = 0; c < 3; ++c)
+        for (size_t i = m.positions.size(); i < planes[c].size(); ++i) {
+          if (c == 0 || !half) ASSERT_EQ(planes[c][i], planes[c][m.positions.size()]) << "level " << level << " sample " << i;
+          ASSERT_LE(std::abs(planes[c][i] - m.levels[level][c][i]), 2) << "level " << level << " sample " << i;
+        }
+    }
   }
 }
 
@@ -276,6 +289,50 @@ TEST(MeshColorsCodec, TheVdsEncodersSampleDensityFallsWithQualityAndSoDoTheSampl
     EXPECT_LT(samples, previous) << "quality " << q;
     previous = samples;
   }
+}
+
+// The choice of face resolutions: a face takes the coarsest lattice that
+// predicts its samples as well as coding them does. A flat texture needs
+// only the vertex samples; noise coded finely keeps its resolutions; coded
+// coarsely, more faces are made coarser; the conversion keeps the vertex
+// samples of the resolutions it started from.
+TEST(MeshColorsLayout, FacesTakeACoarserLatticeWhereItPredictsThemAsWellAsCodingDoes) {
+  enc::MeshColorsOptions o;
+  o.max_res_log2 = 5;
+  const enc::Image noise = ref::make_noise_texture(128, 11, 0x203040, 0xE0C060);
+  const enc::Image flat = ref::make_noise_texture(128, 11, 0x6080A0, 0x6080A0);
+  const enc::MeshColorsModel full = enc::to_mesh_colors(grid_model(4, noise), o);
+  const enc::MeshColorsModel plain = enc::to_mesh_colors(grid_model(4, flat), o);
+  ASSERT_EQ(full.max_res, 5);
+  const auto flat_sse = enc::coarser_face_sse(plain);
+  for (size_t f = 0; f < flat_sse.size(); ++f) {
+    ASSERT_EQ(flat_sse[f].size(), plain.face_res[f] + 1u);
+    for (double e : flat_sse[f]) EXPECT_LT(e, 1e-9) << "face " << f;
+  }
+  const auto noise_sse = enc::coarser_face_sse(full);
+  for (size_t f = 0; f < noise_sse.size(); ++f) {
+    EXPECT_EQ(noise_sse[f][0], 0.0);
+    EXPECT_GT(noise_sse[f].back(), noise_sse[f][1]) << "face " << f;  // coarser predicts worse
+  }
+  const enc::MccOptions codec;
+  for (uint8_t r : enc::rd_face_resolutions(plain, 1, codec)) EXPECT_EQ(r, 0);
+  auto coarser = [&](double quality) {
+    const std::vector<uint8_t> r = enc::rd_face_resolutions(full, quality, codec);
+    size_t n = 0;
+    for (size_t f = 0; f < r.size(); ++f) {
+      EXPECT_LE(r[f], full.face_res[f]);
+      n += r[f] < full.face_res[f];
+    }
+    return n;
+  };
+  const size_t fine = coarser(0.125), rough = coarser(32);
+  EXPECT_EQ(fine, 0u);
+  EXPECT_GT(rough, fine);
+  // Through the conversion: the chosen resolutions, the vertex samples kept.
+  const enc::MeshColorsModel chosen = enc::to_mesh_colors_rd(grid_model(4, noise), o, 32, codec);
+  EXPECT_EQ(chosen.face_res, enc::rd_face_resolutions(full, 32, codec));
+  EXPECT_LT(chosen.samples(0), full.samples(0));
+  EXPECT_EQ(chosen.vertex_ycc, full.vertex_ycc);
 }
 
 TEST(MeshColorsLayout, FacesOnASeamWhoseSidesDifferGetTwiceTheResolution) {
@@ -427,7 +484,7 @@ TEST_P(MeshColorsModes, VertexSamplesFromTheVertexColours) {
   const enc::MccEncoded inside = enc::encode_mesh_colors(m, 1, o);
   o.vertex_colours_outside = true;
   const enc::MccEncoded outside = enc::encode_mesh_colors(m, 1, o);
-  EXPECT_EQ(outside.header[3], mc::kFlagVertexColours);
+  EXPECT_EQ(outside.header[3] & mc::kFlagVertexColours, mc::kFlagVertexColours);
   EXPECT_LT(outside.header.size(), inside.header.size());
   const size_t V = m.positions.size();
   std::array<std::vector<uint8_t>, 3> vc;
@@ -444,6 +501,100 @@ TEST_P(MeshColorsModes, VertexSamplesFromTheVertexColours) {
     EXPECT_EQ(enc::decode_mesh_colors_level(m, outside, level), enc::decode_mesh_colors_level(m, inside, level)) << level;
   for (size_t n = 0; n < outside.header.size(); ++n)
     EXPECT_TRUE(is_error(h.mc.read_header(outside.header.data(), n, &planes))) << "prefix " << n;
+}
+
+// kFlagChromaHalf: a level's chroma is coded from the next level's samples;
+// the client holds them at their lattice points (2 i, 2 j) and fills every
+// other point with the rounded-up mean of its two neighbours along a
+// lattice edge. The luma is what it is without, the chroma costs fewer
+// bytes, and the points the next level has stay close to its samples.
+TEST_P(MeshColorsModes, ChromaComesFromTheNextLevelsLattice) {
+  // Mixed resolutions (every third face one step coarser), so that faces
+  // sample finer edges.
+  const enc::Image tex = ref::make_noise_texture(128, 11, 0x203040, 0xE0C060);
+  enc::MeshColorsOptions mo;
+  mo.max_res_log2 = 5;
+  const size_t faces = test_colors().face_res.size();
+  for (size_t f = 0; f < faces; ++f) mo.face_max_res.push_back(static_cast<uint8_t>(f % 3 == 0 ? 4 : 5));
+  const enc::MeshColorsModel m = enc::to_mesh_colors(grid_model(4, tex), mo);
+  ASSERT_EQ(m.max_res, 5);
+  enc::MccOptions half, full;
+  half.paper = full.paper = GetParam();
+  full.chroma = vds::enc::MccOptions::Chroma::full;
+  half.chroma = enc::MccOptions::Chroma::half;
+  const double quality = 0.25;
+  const enc::MccEncoded eh = enc::encode_mesh_colors(m, quality, half), ef = enc::encode_mesh_colors(m, quality, full);
+  EXPECT_EQ(eh.header[3] & mc::kFlagChromaHalf, mc::kFlagChromaHalf);
+  EXPECT_EQ(ef.header[3] & mc::kFlagChromaHalf, 0);
+  Held h;
+  ASSERT_EQ(h.init(m.triangles, static_cast<uint32_t>(m.positions.size())), Status::ok);
+  ASSERT_EQ(h.mc.set(m.face_res.data(), m.vertex_ycc.data(), 256), Status::ok);
+  for (int level = 0; level < m.max_res; ++level) {
+    EXPECT_LT(eh.level_bytes(level), ef.level_bytes(level)) << "level " << level;
+    const auto ph = enc::decode_mesh_colors_level(m, eh, level), pf = enc::decode_mesh_colors_level(m, ef, level);
+    EXPECT_EQ(ph[0], pf[0]) << "level " << level;
+    h.mc.layout_level(level + 1);
+    for (int c = 1; c < 3; ++c) {
+      double err = 0;
+      size_t count = 0;
+      // A point the next level has: compared with its sample there.
+      auto next_has = [&](uint32_t s, uint32_t t) {
+        const double d = double(ph[c][s]) - m.levels[level + 1][c][t];
+        err += d * d;
+        ++count;
+      };
+      // Edges, on their own lattice (a face may sample a finer edge).
+      const mc::Topology& topo = h.mc.topology();
+      for (uint32_t e = 0; e < topo.edges; ++e) {
+        const uint32_t R = mc::resolution(mc::level_res(h.mc.edge_res()[e], level));
+        h.mc.layout_level(level + 1);
+        const uint32_t next_base = h.mc.layout().edge_base + h.mc.layout().edge_offset[e] - 1;
+        h.mc.layout_level(level);
+        const uint32_t base = h.mc.layout().edge_base + h.mc.layout().edge_offset[e] - 1;  // + q, q = 1 .. R - 1
+        auto at = [&](uint32_t q) {
+          return q == 0 ? ph[c][topo.edge_vertex[2 * e]] : (q == R ? ph[c][topo.edge_vertex[2 * e + 1]] : ph[c][base + q]);
+        };
+        for (uint32_t q = 1; q < R; ++q) {
+          if (q % 2 == 0) {
+            next_has(base + q, next_base + q / 2);
+          } else {
+            ASSERT_EQ(at(q), (at(q - 1) + at(q + 1) + 1) / 2) << "level " << level << " edge " << e << " q " << q;
+          }
+        }
+      }
+      // Faces' own points.
+      for (uint32_t f = 0; f < topo.faces; ++f) {
+        const uint32_t R = mc::resolution(mc::level_res(m.face_res[f], level));
+        for (uint32_t j = 1; j + 1 < R; ++j)
+          for (uint32_t i = 1; i + j < R; ++i) {
+            h.mc.layout_level(level);
+            const uint32_t s = h.mc.sample_index(f, level, i, j);
+            if (i % 2 == 0 && j % 2 == 0) {
+              h.mc.layout_level(level + 1);
+              next_has(s, h.mc.sample_index(f, level + 1, i / 2, j / 2));
+              continue;
+            }
+            uint32_t a, b;
+            if (j % 2 == 0) {
+              a = h.mc.sample_index(f, level, i - 1, j);
+              b = h.mc.sample_index(f, level, i + 1, j);
+            } else if (i % 2 == 0) {
+              a = h.mc.sample_index(f, level, i, j - 1);
+              b = h.mc.sample_index(f, level, i, j + 1);
+            } else {
+              a = h.mc.sample_index(f, level, i - 1, j + 1);
+              b = h.mc.sample_index(f, level, i + 1, j - 1);
+            }
+            ASSERT_EQ(ph[c][s], (ph[c][a] + ph[c][b] + 1) / 2)
+                << "level " << level << " face " << f << " (" << i << ", " << j << ") component " << c;
+          }
+      }
+      if (level + 1 < m.max_res) ASSERT_GT(count, 0u) << "level " << level;  // the last coded level fills only
+      if (count == 0) continue;
+      const double psnr = 10 * std::log10(255.0 * 255.0 * count / std::max(err, 1e-9));
+      EXPECT_GE(psnr, 40.0) << "level " << level << " component " << c;
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(PaperAndVds, MeshColorsModes, ::testing::Values(true, false),

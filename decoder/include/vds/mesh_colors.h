@@ -57,6 +57,9 @@
 // block minus its reconstructed mean transformed, every position coded;
 // levels as a nonzero count, significance and magnitudes in contexts
 // (BlockContexts); vertex samples coded losslessly in the header.
+// Either mode may code each level's chroma from the next level's samples
+// (kFlagChromaHalf, the thesis's chroma sub-sampling): the client fills
+// the rest of the level's chroma lattice between them.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -156,15 +159,19 @@ void inverse_dct(const int32_t* in, int n, int32_t* out, int in_stride = 1, int 
 // An edge block of `len` samples from its quantised values (paper mode:
 // q[0] the DC, q[1..] the AC; vds mode: every coefficient of the block's
 // residual from its mean), the level's steps, the mode and the block's
-// reconstructed mean (vds mode; 0 for the paper's), into dst[0 .. len - 1].
+// reconstructed mean (vds mode; 0 for the paper's), into dst[0],
+// dst[stride], ... dst[(len - 1) stride].
 void reconstruct_edge_block(const int32_t* q, int len, const uint32_t* step, uint8_t mode, int64_t mean_q4,
-                            uint8_t* dst);
+                            uint8_t* dst, int stride = 1);
 // A face block of diagonal D at block row br, column bc of a face of side n
 // whose samples start at `face`, from its quantised values (natural order,
 // 8 * row + column; as for edges); returns the block's reconstructed mean
-// (of its samples, Q4).
+// (of its samples, Q4). With scale 2 the face's lattice is the one of
+// twice its resolution (side 2 (n + 2) - 2) and the block's samples go to
+// their lattice points there (i, j) -> (2 i, 2 j): chroma on the next
+// level's lattice (kFlagChromaHalf).
 int64_t reconstruct_face_block(const int32_t* q, int32_t D, const uint32_t* step, uint8_t mode, int64_t mean_q4,
-                               uint8_t* face, int32_t n, int32_t br, int32_t bc);
+                               uint8_t* face, int32_t n, int32_t br, int32_t bc, int scale = 1);
 // Positions of a face block of diagonal D (row + column < D, in 8 x 8).
 int face_block_positions(int32_t D);
 // The vds mode's step of a block's mean (Q4): the DC step / 8, so a full
@@ -209,7 +216,7 @@ constexpr uint32_t kNzCutoff = 6;
 constexpr int kNzOrder = 1;
 
 // --- The header chunk (MCLH) ------------------------------------------------
-//   u8 version (1), u8 mode (0 = paper, 1 = vds), u8 max_res_log2 (0..10), u8 flags (kFlagVertexColours or 0),
+//   u8 version (1), u8 mode (0 = paper, 1 = vds), u8 max_res_log2 (0..10), u8 flags (kFlagVertexColours | kFlagChromaHalf),
 //   u16 quality factor x 256 (>= 1), u16 vertices, u32 faces,
 //   paper mode, unless kFlagVertexColours: vertices x 3 bytes, every vertex's Y', Cb, Cr;
 //   arithmetic coded: the faces' resolution exponents, face f's as a
@@ -223,6 +230,13 @@ constexpr uint8_t kVersion = 1;
 // MCLH flags: the vertex samples are the colours that came with the
 // vertices (MCVX, the last one after the single-rate tail), not in MCLH.
 constexpr uint8_t kFlagVertexColours = 1;
+// MCLH flags: each level's chroma (Cb, Cr) is coded on the next level's
+// lattice (its samples are that level's), and the client fills the rest of
+// the level's lattice from them: a point between two of them (along an
+// edge of the lattice; vertex samples count) is their mean, rounded up
+// (Taskin section 2.3: chroma from MIP level 1). Per element the level's
+// luma blocks come first, then the chroma blocks (Cb, Cr each block).
+constexpr uint8_t kFlagChromaHalf = 2;
 constexpr uint8_t kModePaper = 0;
 constexpr uint8_t kModeVds = 1;
 constexpr size_t kHeaderFixedBytes = 12;
@@ -252,7 +266,9 @@ Status decode_vertex_colours(const uint8_t* data, size_t size, const MeshState& 
 //   u8 level (0 .. max_res_log2 - 1), u32 first element, u32 elements
 //   (elements: the edges 0 .. E - 1, then the faces as E + f), then the
 //   arithmetic-coded data of those elements (per block Y', Cb, Cr, each its
-//   DC then its AC), every context starting afresh. A level's chunks come
+//   DC then its AC; with kFlagChromaHalf per element its Y' blocks, then
+//   its Cb, Cr blocks on the next level's lattice), every context starting
+//   afresh. A level's chunks come
 //   in order and cover its elements, so each fits a client's chunk buffer.
 constexpr size_t kLevelHeadBytes = 9;
 struct LevelChunk {
@@ -281,7 +297,8 @@ class MeshColors {
   // exponent (0..kMaxResLog2), the vertex samples (3 per vertex; null
   // leaves them) and the quality factor. invalid_argument for a value out
   // of range or before init.
-  Status set(const uint8_t* face_res, const uint8_t* vertex_ycc, uint16_t quality_q8, uint8_t mode = kModePaper);
+  Status set(const uint8_t* face_res, const uint8_t* vertex_ycc, uint16_t quality_q8, uint8_t mode = kModePaper,
+             bool chroma_half = false);
 
   // Sets `layout` (arrays from init) for level m; returns its total samples.
   uint32_t layout_level(int m);
@@ -315,8 +332,15 @@ class MeshColors {
   // The first block's DC prediction of face f at level m, before halving:
   // the sum of the Q4 means of the reconstructed blocks of its edges 0 and 2
   // at corner a, in `plane` (a level's plane with those edges decoded; the
-  // layout of level m set).
-  int64_t corner_sum_q4(uint32_t f, int m, const uint8_t* plane) const;
+  // layout of level m set). With scale 2, of the blocks of level m + 1's
+  // samples, read where they lie in level m's plane (kFlagChromaHalf).
+  int64_t corner_sum_q4(uint32_t f, int m, const uint8_t* plane, int scale = 1) const;
+  bool chroma_half() const { return chroma_half_; }
+  // kFlagChromaHalf: the points of edge e's (face f's) level-m lattice that
+  // level m + 1 does not have, in plane `p` of level m (layout set), from
+  // those it has (and the vertex samples; a face's from its edges' too).
+  void fill_edge(uint32_t e, int m, uint8_t* p) const;
+  void fill_face(uint32_t f, int m, uint8_t* p) const;
 
  private:
   Arena* arena_ = nullptr;  // for read_header's scratch
@@ -332,6 +356,7 @@ class MeshColors {
   int max_res_ = 0;
   uint16_t quality_q8_ = 0;
   uint8_t mode_ = kModePaper;
+  bool chroma_half_ = false;
   bool header_ = false;
   int decoding_ = -1;           // the level the last chunk decoded belongs to
   uint32_t next_element_ = 0;   // where its next chunk starts

@@ -35,6 +35,9 @@ struct ModelStreamOptions {
   MeshColorsOptions colors;   // conversion; its density is set from the quality unless fixed_density
   bool fixed_density = false;
   MccOptions codec;           // mesh colors codec (max_chunk: the mesh's max_chunk_payload)
+  // Faces made coarser where that costs nothing at the quality (vds codec;
+  // rd_face_resolutions).
+  bool rd_faces = true;
   double quality = 1;         // the codec's quality factor (JPEG tables' multiplier)
   // > 0: the finest quality (of a ladder from 1/8 to 64) whose whole stream
   // takes at most this many bytes; the quality above is then ignored.
