@@ -29,7 +29,7 @@ struct EncodeModelOptions {
   std::string up = "+y";
   bool paper = false;
   std::string chroma = "auto";
-  bool all_faces_fine = false;
+  std::string faces = "auto";
   uint32_t max_chunk = 4096;
   bool quiet = false;
   std::string timeline;
@@ -103,8 +103,10 @@ void run_encode_model(const EncodeModelOptions& o) {
     e.fixed_density = true;
   }
   e.codec.paper = o.paper;
-  e.codec.chroma = enc::chroma_from_name(o.chroma);
-  e.rd_faces = !o.all_faces_fine;
+  // Both auto: the encoder looks (choose_colours); else as given.
+  e.measure_colours = o.chroma == "auto" && o.faces == "auto";
+  e.codec.chroma_half = o.chroma == "half";
+  e.coarser_faces = o.faces == "coarser";
   enc::TexturedModel model;
   try {
     model = enc::load_textured_model(o.input);
@@ -183,11 +185,14 @@ void add_encode_model(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0u, 4096u));
   sub->add_flag("--paper", o->paper, "Code the colours as the thesis does (for comparison)");
-  sub->add_flag("--all-faces-fine", o->all_faces_fine,
-                "Every face at the resolution its texels give (no coarser lattice where it predicts the face as well as coding it)");
   sub->add_option("--chroma", o->chroma,
-                  "Each colour level's chroma from the next level's lattice (half), on its own (full), or half above quality 2 (auto)")
+                  "Each colour level's chroma on the next level's lattice (half) or its own (full); auto (with --faces "
+                  "auto): the encoder draws both and keeps the better")
       ->check(CLI::IsMember({"auto", "half", "full"}));
+  sub->add_option("--faces", o->faces,
+                  "Faces made coarser where a coarser lattice predicts them as well as coding them (coarser), or each at "
+                  "its texels' resolution (fine); auto (with --chroma auto): the encoder draws both and keeps the better")
+      ->check(CLI::IsMember({"auto", "fine", "coarser"}));
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes (the client's chunk buffer)")
       ->capture_default_str()
       ->check(CLI::Range(512u, 1u << 24));

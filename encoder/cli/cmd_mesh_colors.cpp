@@ -54,7 +54,7 @@ struct MeshColorsOptions {
   double deadzone = enc::MccOptions{}.deadzone;
   bool no_seam_boost = false;
   std::string chroma = "auto";
-  bool all_faces_fine = false;
+  std::string faces = "auto";
 };
 
 void write_ppm(const std::string& path, const Image& img) {
@@ -88,7 +88,7 @@ void run(const MeshColorsOptions& o) {
     enc::MccOptions mo;
     mo.paper = codec == "paper";
     mo.deadzone = o.deadzone;
-    mo.chroma = enc::chroma_from_name(o.chroma);
+    mo.chroma_half = o.chroma == "half";
     return mo;
   };
   // The mesh colors at each sample density used, converted once each.
@@ -124,8 +124,19 @@ void run(const MeshColorsOptions& o) {
   auto density_of = [&](const std::string& codec, double q) {
     return o.density > 0 ? o.density : (codec == "paper" ? 1.0 : enc::density_for_quality(q));
   };
-  // The vds codec chooses its faces' resolutions for the quality.
-  auto rd_of = [&](const std::string& codec, double q) { return codec == "paper" || o.all_faces_fine ? 0.0 : q; };
+  // The vds codec's faces made coarser for the quality (--faces coarser).
+  auto rd_of = [&](const std::string& codec, double q) { return codec != "paper" && o.faces == "coarser" ? q : 0.0; };
+  // With --chroma and --faces auto the vds encoder looks: each choice drawn
+  // from 5 views of its own (128x128, 2x2 supersampled), not the ones
+  // measured below.
+  const bool look = o.chroma == "auto" && o.faces == "auto";
+  enc::ModelViews choice_views;
+  std::vector<enc::ModelFrame> choice_reference;
+  if (look && std::find(o.codecs.begin(), o.codecs.end(), "vds") != o.codecs.end()) {
+    choice_views = enc::orbit_views(model.positions, 5, 128, 128, 2, o.up == "z" ? 2 : 1);
+    for (const auto& cam : choice_views.cameras)
+      choice_reference.push_back(enc::render_textured(model, model.textures, cam, choice_views));
+  }
   std::ofstream csv;
   if (!o.csv.empty()) {
     csv.open(o.csv);
@@ -133,16 +144,35 @@ void run(const MeshColorsOptions& o) {
     csv << "codec,quality,density,level,samples,bytes,ratio,psnr_y,psnr_cb,psnr_cr\n";
   }
   // Each codec and quality encoded once, for the table and the rendered views.
-  std::map<std::pair<std::string, double>, enc::MccEncoded> encoded;
+  struct Coded {
+    enc::MeshColorsModel mc;
+    enc::MccEncoded e;
+  };
+  std::map<std::pair<std::string, double>, Coded> encoded;
   std::map<std::pair<std::string, double>, size_t> header_bytes;  // by codec and density
   std::vector<std::string> table;
   for (const std::string& codec : o.codecs)
     for (double q : o.quality) {
       const double density = density_of(codec, q);
-      const enc::MeshColorsModel& mcm = colors(density, rd_of(codec, q));
+      Coded coded;
+      if (look && codec == "vds") {
+        enc::MeshColorsOptions mo;
+        mo.density = density;
+        mo.max_res_log2 = o.max_res;
+        mo.seam_boost = !o.no_seam_boost;
+        enc::ColourChoice choice = enc::choose_colours(model, mo, q, options(codec), choice_views, choice_reference);
+        std::printf("quality %g: chroma %s, faces %s (%.2f dB in %zu bytes on the encoder's views)\n", q,
+                    choice.chroma_half ? "from the next level" : "on its own level",
+                    choice.coarser_faces ? "made coarser" : "at their texels' resolution", choice.psnr, choice.bytes);
+        coded = Coded{std::move(choice.mc), std::move(choice.coded)};
+      } else {
+        coded.mc = colors(density, rd_of(codec, q));
+        coded.e = enc::encode_mesh_colors(coded.mc, q, options(codec));
+      }
+      const Coded& entry = encoded.emplace(std::make_pair(codec, q), std::move(coded)).first->second;
+      const enc::MeshColorsModel& mcm = entry.mc;
+      const enc::MccEncoded& e = entry.e;
       const size_t V = mcm.positions.size();
-      const enc::MccEncoded& e =
-          encoded.emplace(std::make_pair(codec, q), enc::encode_mesh_colors(mcm, q, options(codec))).first->second;
       header_bytes[{codec, density}] = e.header.size();
       for (int m = 0; m < mcm.max_res; ++m) {
         const auto planes = enc::decode_mesh_colors_level(mcm, e, m);
@@ -205,8 +235,8 @@ void run(const MeshColorsOptions& o) {
   size_t coded_rows = 0;
   for (const std::string& codec : o.codecs)
     for (double q : o.quality) {
-      const enc::MeshColorsModel& mcm = colors(density_of(codec, q), rd_of(codec, q));
-      const enc::MccEncoded& e = encoded.at({codec, q});
+      const enc::MeshColorsModel& mcm = encoded.at({codec, q}).mc;
+      const enc::MccEncoded& e = encoded.at({codec, q}).e;
       const auto planes = enc::decode_mesh_colors_level(mcm, e, 0);
       auto [p, img] = measure([&](const ref::CameraD& c) { return enc::render_mesh_colors(mcm, planes, 0, c, views); });
       char param[32];
@@ -268,12 +298,14 @@ void add_mesh_colors(CLI::App& app) {
   c->add_option("--deadzone", o->deadzone, "vds codec: levels rounded down below 0.5 + this of a step")
       ->check(CLI::Range(0.0, 0.5));
   c->add_flag("--no-seam-boost", o->no_seam_boost, "keep faces on seams whose sides differ at their own resolution");
-  c->add_flag("--all-faces-fine", o->all_faces_fine,
-              "vds codec: every face at the resolution its texels give (no coarser lattice where it predicts the face "
-              "as well as coding it)");
   c->add_option("--chroma", o->chroma,
-                "each level's chroma from the next level's lattice (half), on its own (full), or half above quality 2 (auto)")
+                "vds codec: each level's chroma on the next level's lattice (half) or its own (full); auto (with --faces "
+                "auto): the encoder draws both from 5 views of its own and keeps the better (the paper codec: full)")
       ->check(CLI::IsMember({"auto", "half", "full"}));
+  c->add_option("--faces", o->faces,
+                "vds codec: faces made coarser where a coarser lattice predicts them as well as coding them (coarser), or "
+                "each at its texels' resolution (fine); auto: as --chroma")
+      ->check(CLI::IsMember({"auto", "fine", "coarser"}));
   c->add_option("--density", o->density,
                  "samples per texel side (default: the vds codec's follows the quality, the thesis's is 1)")
       ->check(kPositive);

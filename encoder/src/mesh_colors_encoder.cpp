@@ -403,15 +403,6 @@ void set_up(const MeshColorsModel& model, uint16_t q8, uint8_t mode, bool chroma
 
 }  // namespace
 
-bool chroma_half_for_quality(double quality) { return quality > 2; }
-
-MccOptions::Chroma chroma_from_name(const std::string& name) {
-  if (name == "auto") return MccOptions::Chroma::by_quality;
-  if (name == "half") return MccOptions::Chroma::half;
-  if (name == "full") return MccOptions::Chroma::full;
-  throw std::invalid_argument("chroma: '" + name + "' is not auto, half or full");
-}
-
 namespace {
 // The header and levels of encode_mesh_colors, or (only_level >= 0) the
 // header and that level alone, in one chunk.
@@ -424,8 +415,7 @@ MccEncoded encode_mesh_colors(const MeshColorsModel& model, double quality, cons
 
 namespace {
 MccEncoded encode_impl(const MeshColorsModel& model, double quality, const MccOptions& o, int only_level) {
-  const bool chroma_half = o.chroma == MccOptions::Chroma::half ||
-                           (o.chroma == MccOptions::Chroma::by_quality && chroma_half_for_quality(quality));
+  const bool chroma_half = o.chroma_half;
   const uint16_t q8 = static_cast<uint16_t>(std::clamp<long>(std::lround(quality * 256), 1, 65535));
   const uint8_t mode = o.paper ? mc::kModePaper : mc::kModeVds;
   Layout l, next;

@@ -1,6 +1,8 @@
 // A textured model as one model-mode stream (vds/enc/model_stream.h).
 #include "vds/enc/model_stream.h"
 
+#include "vds/enc/model_render.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -249,13 +251,18 @@ std::vector<uint8_t> display_caps(const TexturedModel& dm, const Quantisation& q
   return caps;
 }
 
-Colours colours_at(const TexturedModel& dm, const ModelStreamOptions& o, double quality, size_t max_chunk) {
+Colours colours_at(const TexturedModel& dm, const ModelStreamOptions& o, double quality, size_t max_chunk,
+                   const ModelViews& views, const std::vector<ModelFrame>& reference) {
   MeshColorsOptions co = o.colors;
   if (!o.fixed_density) co.density = density_for_quality(quality);
   MccOptions mo = o.codec;
   mo.max_chunk = max_chunk;
   mo.vertex_colours_outside = o.vertex_colours;  // every vertex's colour came with it (MCVX)
-  Colours c{quality, o.rd_faces && !mo.paper ? to_mesh_colors_rd(dm, co, quality, mo) : to_mesh_colors(dm, co), {}};
+  if (o.measure_colours && !mo.paper) {
+    ColourChoice choice = choose_colours(dm, co, quality, mo, views, reference);
+    return Colours{quality, std::move(choice.mc), std::move(choice.coded)};
+  }
+  Colours c{quality, o.coarser_faces && !mo.paper ? to_mesh_colors_rd(dm, co, quality, mo) : to_mesh_colors(dm, co), {}};
   c.coded = encode_mesh_colors(c.mc, quality, mo);
   return c;
 }
@@ -290,9 +297,19 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
 
   const size_t max_chunk = r.mesh.stream_header.max_chunk_payload;
   std::map<size_t, std::vector<uint8_t>> vertex_chunks;
+  // The views the encoder's colour choices are measured from: 4 round the
+  // model at the client's frame size.
+  ModelViews choice_views;
+  std::vector<ModelFrame> choice_reference;
+  if (o.measure_colours && !o.codec.paper) {
+    choice_views = orbit_views(r.decoded.positions, 4, r.mesh.stream_header.width, r.mesh.stream_header.height, 2,
+                               r.mesh.mesh_header.up == MeshUp::z_plus ? 2 : 1);
+    for (const auto& cam : choice_views.cameras)
+      choice_reference.push_back(render_textured(r.decoded, r.decoded.textures, cam, choice_views));
+  }
   // The colours at quality q, coded (without the schedule: the bytes of every level).
   auto colour = [&](double q) {
-    Colours c = colours_at(r.decoded, oc, q, max_chunk);
+    Colours c = colours_at(r.decoded, oc, q, max_chunk, choice_views, choice_reference);
     vertex_chunks.clear();
     if (o.vertex_colours) vertex_chunks = vertex_colour_chunks(r.mesh.stream, grid, c.mc.vertex_ycc);
     if (c.coded.header.size() > max_chunk)

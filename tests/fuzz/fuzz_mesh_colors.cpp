@@ -69,13 +69,13 @@ struct Fixed {
       model.levels.push_back(p);
     }
     vds::enc::MccOptions half;
-    half.chroma = vds::enc::MccOptions::Chroma::half;
+    half.chroma_half = true;
     stream = vds::enc::encode_mesh_colors(model, 0.5, half);
     vds::enc::MccOptions paper = half;
     paper.paper = true;
     paper_stream = vds::enc::encode_mesh_colors(model, 0.5, paper);
     vds::enc::MccOptions full;
-    full.chroma = vds::enc::MccOptions::Chroma::full;
+    full.chroma_half = false;
     full_stream = vds::enc::encode_mesh_colors(model, 0.5, full);
   }
 };

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "vds/enc/mesh_colors.h"
+#include "vds/enc/model_render.h"
 #include "vds/enc/scene.h"
 #include "vds/enc/stream_writer.h"
 #include "vds/mesh_colors.h"
@@ -35,12 +36,12 @@ const uint16_t kTetra[] = {0, 2, 1, 0, 1, 3, 1, 2, 3, 2, 0, 3};
 vds::enc::MccOptions paper_mode() {
   vds::enc::MccOptions o;
   o.paper = true;
-  o.chroma = vds::enc::MccOptions::Chroma::full;
+  o.chroma_half = false;
   return o;
 }
 vds::enc::MccOptions full_chroma() {
   vds::enc::MccOptions o;
-  o.chroma = vds::enc::MccOptions::Chroma::full;
+  o.chroma_half = false;
   return o;
 }
 
@@ -258,7 +259,7 @@ TEST(MeshColorsCodec, AFlatColourCostsAlmostNothingInTheVdsMode) {
   for (size_t i = 0; i < m.vertex_ycc.size(); ++i) m.vertex_ycc[i] = static_cast<uint8_t>(90 + 40 * (i % 3));
   for (bool half : {false, true}) {
     enc::MccOptions o;
-    o.chroma = half ? enc::MccOptions::Chroma::half : enc::MccOptions::Chroma::full;
+    o.chroma_half = half;
     const enc::MccEncoded e = enc::encode_mesh_colors(m, 2, o);
     for (int level = 0; level < m.max_res; ++level) {
       EXPECT_LT(e.level_bytes(level), 40u) << "level " << level;
@@ -333,6 +334,32 @@ TEST(MeshColorsLayout, FacesTakeACoarserLatticeWhereItPredictsThemAsWellAsCoding
   EXPECT_EQ(chosen.face_res, enc::rd_face_resolutions(full, 32, codec));
   EXPECT_LT(chosen.samples(0), full.samples(0));
   EXPECT_EQ(chosen.vertex_ycc, full.vertex_ycc);
+}
+
+// The encoder's measured choices: a flat texture is drawn as well from the
+// vertex samples alone, so its faces are made coarser; a texture whose
+// detail is all in the chroma (red and green of equal luma) keeps its
+// chroma on each level's own lattice at a fine quality.
+TEST(MeshColorsChoice, TheEncoderKeepsWhatItsViewsShowBest) {
+  enc::MeshColorsOptions mo;
+  mo.max_res_log2 = 5;
+  auto choose = [&](const enc::Image& tex, double quality) {
+    const enc::TexturedModel model = grid_model(4, tex);
+    const enc::ModelViews views = enc::orbit_views(model.positions, 4, 96, 96, 2, 2);
+    std::vector<enc::ModelFrame> reference;
+    for (const auto& cam : views.cameras) reference.push_back(enc::render_textured(model, model.textures, cam, views));
+    return enc::choose_colours(model, mo, quality, enc::MccOptions{}, views, reference);
+  };
+  const enc::ColourChoice flat = choose(ref::make_noise_texture(128, 11, 0x6080A0, 0x6080A0), 1);
+  EXPECT_TRUE(flat.coarser_faces);
+  const enc::MeshColorsModel fine = enc::to_mesh_colors(grid_model(4, ref::make_noise_texture(128, 11, 0x6080A0, 0x6080A0)), mo);
+  const enc::MccEncoded fine_coded = enc::encode_mesh_colors(fine, 1);
+  EXPECT_LT(flat.bytes, fine_coded.header.size() + fine_coded.level_bytes(0));
+  EXPECT_GT(flat.psnr, 40.0);
+  const enc::ColourChoice chroma = choose(ref::make_noise_texture(128, 11, 0xFF0000, 0x008200), 0.25);
+  EXPECT_FALSE(chroma.chroma_half);
+  EXPECT_EQ(chroma.coded.header[3] & mc::kFlagChromaHalf, 0);
+  EXPECT_EQ(chroma.bytes, chroma.coded.header.size() + chroma.coded.level_bytes(0));
 }
 
 TEST(MeshColorsLayout, FacesOnASeamWhoseSidesDifferGetTwiceTheResolution) {
@@ -520,8 +547,8 @@ TEST_P(MeshColorsModes, ChromaComesFromTheNextLevelsLattice) {
   ASSERT_EQ(m.max_res, 5);
   enc::MccOptions half, full;
   half.paper = full.paper = GetParam();
-  full.chroma = vds::enc::MccOptions::Chroma::full;
-  half.chroma = enc::MccOptions::Chroma::half;
+  full.chroma_half = false;
+  half.chroma_half = true;
   const double quality = 0.25;
   const enc::MccEncoded eh = enc::encode_mesh_colors(m, quality, half), ef = enc::encode_mesh_colors(m, quality, full);
   EXPECT_EQ(eh.header[3] & mc::kFlagChromaHalf, mc::kFlagChromaHalf);

@@ -148,19 +148,11 @@ struct MccOptions {
   bool vertex_colours_outside = false;
   // Each level's chroma coded from the next level's samples, on its lattice
   // (vds::mc::kFlagChromaHalf; Taskin section 2.3, chroma from MIP level 1):
-  // about a quarter of the chroma samples. by_quality: so where
-  // chroma_half_for_quality says.
-  enum class Chroma { by_quality, half, full };
-  Chroma chroma = Chroma::by_quality;
+  // about a quarter of the chroma samples (choose_colours measures whether
+  // it pays).
+  bool chroma_half = false;
 };
 
-// Whether chroma from the next level's lattice pays at quality factor q:
-// above 2. Below, the finer chroma is worth its bytes in rendered PSNR (on
-// the duck and mrfixit at quality 1 and 2: 9 to 13 % fewer bytes for 0.4
-// to 1.9 dB less); above, it saves 4 to 7 % at equal or better PSNR.
-bool chroma_half_for_quality(double quality);
-// "auto", "half" or "full" (the command lines' --chroma); std::invalid_argument otherwise.
-MccOptions::Chroma chroma_from_name(const std::string& name);
 
 // Every level of `mc` at quality factor `quality` (the JPEG tables'
 // multiplier, 1/256 .. 255).

@@ -49,4 +49,27 @@ double masked_mse(const ModelFrame& ref, const ModelFrame& test);
 // 10 log10(255^2 / mse) (99 for 0).
 double psnr_of_mse(double mse);
 
+// The vds encoder's measured choices for a model at quality factor q:
+// chroma on each level's own lattice or the next level's (kFlagChromaHalf),
+// and every face at the resolution its texels give or faces made coarser
+// where that costs nothing in their samples (to_mesh_colors_rd). Each of
+// the four is converted and coded, its level 0 drawn from `views` against
+// `reference` (render_textured of the model, one per camera); the one with
+// the most PSNR - kChoiceDbPerDoubling x log2(bytes of the header and level
+// 0) is kept: the sample counts say nothing of what a display shows of
+// lost detail, coding noise or chroma (the milk truck's thin coloured lines
+// lose 2.8 dB to chroma from the next level at quality 4, where the duck
+// gains), so the encoder looks.
+struct ColourChoice {
+  MeshColorsModel mc;
+  MccEncoded coded;
+  bool chroma_half = false;
+  bool coarser_faces = false;
+  double psnr = 0;
+  size_t bytes = 0;
+};
+constexpr double kChoiceDbPerDoubling = 4;
+ColourChoice choose_colours(const TexturedModel& model, const MeshColorsOptions& mo, double quality, const MccOptions& o,
+                            const ModelViews& views, const std::vector<ModelFrame>& reference);
+
 }  // namespace vds::enc

@@ -35,9 +35,12 @@ struct ModelStreamOptions {
   MeshColorsOptions colors;   // conversion; its density is set from the quality unless fixed_density
   bool fixed_density = false;
   MccOptions codec;           // mesh colors codec (max_chunk: the mesh's max_chunk_payload)
-  // Faces made coarser where that costs nothing at the quality (vds codec;
-  // rd_face_resolutions).
-  bool rd_faces = true;
+  // vds codec: chroma lattice and face resolutions chosen by looking
+  // (choose_colours, from 4 orbit views of the client's frame size);
+  // false: codec.chroma_half as given, and faces made coarser where that
+  // costs nothing in their samples (rd_face_resolutions) if coarser_faces.
+  bool measure_colours = true;
+  bool coarser_faces = false;
   double quality = 1;         // the codec's quality factor (JPEG tables' multiplier)
   // > 0: the finest quality (of a ladder from 1/8 to 64) whose whole stream
   // takes at most this many bytes; the quality above is then ignored.
