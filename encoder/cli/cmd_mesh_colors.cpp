@@ -127,13 +127,13 @@ void run(const MeshColorsOptions& o) {
   // The vds codec's faces made coarser for the quality (--faces coarser).
   auto rd_of = [&](const std::string& codec, double q) { return codec != "paper" && o.faces == "coarser" ? q : 0.0; };
   // With --chroma and --faces auto the vds encoder looks: each choice drawn
-  // from 5 views of its own (128x128, 2x2 supersampled), not the ones
-  // measured below.
+  // from 5 views of its own at the display's size (--size, --supersample),
+  // not the ones measured below.
   const bool look = o.chroma == "auto" && o.faces == "auto";
   enc::ModelViews choice_views;
   std::vector<enc::ModelFrame> choice_reference;
   if (look && std::find(o.codecs.begin(), o.codecs.end(), "vds") != o.codecs.end()) {
-    choice_views = enc::orbit_views(model.positions, 5, 128, 128, 2, o.up == "z" ? 2 : 1);
+    choice_views = enc::orbit_views(model.positions, 5, o.size, o.size, o.supersample, o.up == "z" ? 2 : 1);
     for (const auto& cam : choice_views.cameras)
       choice_reference.push_back(enc::render_textured(model, model.textures, cam, choice_views));
   }
