@@ -86,7 +86,10 @@ def main():
     fig.savefig(os.path.join(results, "model_rd.png"), dpi=90)
     head = ["## Summary: BD-rate of the mesh colors codecs on rendered-view PSNR", "",
             "mcc-vds is the improved codec (vds mode; its sample density follows the quality, "
-            "`density_for_quality`), mcc-paper the thesis's (one sample per texel side). Bytes: the header and "
+            "`density_for_quality`; at each quality the encoder draws its four choices of chroma lattice and face "
+            "resolutions from 5 views of its own and keeps the best, `choose_colours`: the choice is printed in "
+            "`rendered.txt`), mcc-paper the thesis's (one sample per texel side, chroma on each level's own "
+            "lattice). Bytes: the header and "
             "level 0, what a client needs to show level 0; the anchors: the texture file(s). Negative: fewer bytes "
             "than the anchor for the same rendered PSNR, over the PSNR range both reach.", "",
             "| model | codec | against | BD-rate |", "|---|---|---|---:|"]
