@@ -731,9 +731,10 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
           uint8_t* dst = out.plane(c) + base + static_cast<uint32_t>(scale) * (8 * b + 1) - 1;
           const int64_t vertex_q4 = int64_t{16} * vertex_ycc_[3 * topo_.edge_vertex[2 * e] + c];
           const uint32_t dc_step = paper ? step[0] : mean_step(step[0]);
+          const int64_t centre = paper ? 0 : kMeanCentreQ4;
           const int64_t pred =
               paper && b > 0 ? prev_q[c]
-                             : div_round(b == 0 ? vertex_q4 : mean_q4_strided(dst - 8 * scale, 8, scale), dc_step);
+                             : div_round((b == 0 ? vertex_q4 : mean_q4_strided(dst - 8 * scale, 8, scale)) - centre, dc_step);
           const int64_t q = pred + (paper ? dec.decode_signed(ctx_->dc_zero[c][1], ctx_->dc_mag[c][1], CodecContexts::kDcCtx,
                                                               kDcCutoff, kDcOrder)
                                           : dec.decode_signed(bctx_->dc_zero[cls][1], bctx_->dc_mag[cls][1],
@@ -747,7 +748,7 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
             return dec.ok() ? Status::malformed : dec.status();
           }
           if (!dec.ok()) return dec.status();
-          reconstruct_edge_block(lv, len, step, mode_, paper ? 0 : q * dc_step, dst, scale);
+          reconstruct_edge_block(lv, len, step, mode_, paper ? 0 : centre + q * dc_step, dst, scale);
           prev_q[c] = q;
         }
       }
@@ -779,7 +780,9 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
             const uint32_t dc_step = paper ? step[0] : mean_step(step[0]);
             const int64_t pred =
                 paper ? (bc > 0 ? left_q[c] : (br > 0 ? row_q[c] : div_round(corner_q4[c], 2 * dc_step)))
-                      : div_round(bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : div_round(corner_q4[c], 2)), dc_step);
+                      : div_round((bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : div_round(corner_q4[c], 2))) -
+                                      kMeanCentreQ4,
+                                  dc_step);
             const int64_t q = pred + (paper ? dec.decode_signed(ctx_->dc_zero[c][0], ctx_->dc_mag[c][0],
                                                                 CodecContexts::kDcCtx, kDcCutoff, kDcOrder)
                                             : dec.decode_signed(bctx_->dc_zero[cls][0], bctx_->dc_mag[cls][0],
@@ -797,7 +800,7 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
               for (int z = 0; z < positions; ++z) qn[image_model::kZigzag[z]] = lv[z];
             }
             if (!dec.ok()) return dec.status();
-            const int64_t mean = reconstruct_face_block(qn, D, step, mode_, paper ? 0 : q * dc_step,
+            const int64_t mean = reconstruct_face_block(qn, D, step, mode_, paper ? 0 : kMeanCentreQ4 + q * dc_step,
                                                         out.plane(c) + base, n, br, bc, scale);
             left_q[c] = q;
             left_mean[c] = mean;

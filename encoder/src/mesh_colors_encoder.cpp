@@ -160,8 +160,10 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
           const int64_t vertex_q4 = int64_t{16} * model.vertex_ycc[3 * topo.edge_vertex[2 * e] + c];
           uint8_t* dst = recon[g.shift][c].data() + base + 8 * b;
           const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
-          const int64_t pred =
-              paper && b > 0 ? prev_q[c] : mc::div_round(b == 0 ? vertex_q4 : mc::mean_q4(dst - 8, 8), dc_step);
+          const int64_t centre = paper ? 0 : mc::kMeanCentreQ4;
+          const int64_t pred = paper && b > 0
+                                   ? prev_q[c]
+                                   : mc::div_round((b == 0 ? vertex_q4 : mc::mean_q4(dst - 8, 8)) - centre, dc_step);
           Block blk;
           blk.element = e;
           blk.comp = c;
@@ -175,11 +177,12 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
             blk.dc_diff = static_cast<int32_t>(q[0] - pred);
             for (int k = 1; k < len; ++k) blk.ac.push_back(q[k] = quantise(X[k], step[k]));
           } else {
-            double mean = 0;
-            for (int i = 0; i < len; ++i) mean += x[i] / len;
-            const int32_t qm = quantise(mean, dc_step);  // the mean's index
+            // The mean's index, from 128, rounded exactly (halves away from 0).
+            int64_t sum = 0;
+            for (int i = 0; i < len; ++i) sum += static_cast<int64_t>(x[i]);
+            const int32_t qm = static_cast<int32_t>(mc::div_round(16 * sum - centre * len, int64_t{len} * dc_step));
             blk.dc_diff = static_cast<int32_t>(qm - pred);
-            mean_q4 = int64_t{qm} * dc_step;
+            mean_q4 = centre + int64_t{qm} * dc_step;
             for (int i = 0; i < len; ++i) x[i] -= mean_q4 / 16.0;
             forward_orthonormal(x, len, X);
             for (int k = 0; k < len; ++k) blk.ac.push_back(q[k] = quantise_ac(X[k], step[k]));
@@ -215,7 +218,8 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
             const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
             const int64_t pred =
                 paper ? (bc > 0 ? left_q[c] : (br > 0 ? row_q[c] : mc::div_round(corner_q4[c], 2 * dc_step)))
-                      : mc::div_round(bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : mc::div_round(corner_q4[c], 2)),
+                      : mc::div_round((bc > 0 ? left_mean[c] : (br > 0 ? row_mean[c] : mc::div_round(corner_q4[c], 2))) -
+                                          mc::kMeanCentreQ4,
                                       dc_step);
             double sum = 0;
             for (int r = 0; r < rows; ++r) {
@@ -242,9 +246,11 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
                 blk.ac.push_back(q[pos] = quantise(Z[pos], step[pos]));
               }
             } else {
-              const int32_t qm = quantise(sum / positions, dc_step);
+              // The mean's index, from 128, rounded exactly (halves away from 0).
+              const int32_t qm = static_cast<int32_t>(mc::div_round(
+                  16 * static_cast<int64_t>(sum) - mc::kMeanCentreQ4 * positions, int64_t{positions} * dc_step));
               blk.dc_diff = static_cast<int32_t>(qm - pred);
-              mean_q4 = int64_t{qm} * dc_step;
+              mean_q4 = mc::kMeanCentreQ4 + int64_t{qm} * dc_step;
               for (int r = 0; r < rows; ++r) {
                 const int len = std::min(8, D - r);
                 for (int i = 0; i < len; ++i) x[8 * r + i] -= mean_q4 / 16.0;

@@ -56,7 +56,8 @@
 // predicted from the reconstructed mean of the block before it) and the
 // block minus its reconstructed mean transformed, every position coded;
 // levels as a nonzero count, significance and magnitudes in contexts
-// (BlockContexts); vertex samples coded losslessly in the header.
+// (BlockContexts); block means as multiples of their step from 128
+// (kMeanCentreQ4); vertex samples coded losslessly in the header.
 // Either mode may code each level's chroma from the next level's samples
 // (kFlagChromaHalf, the thesis's chroma sub-sampling): the client fills
 // the rest of the level's chroma lattice between them.
@@ -177,6 +178,11 @@ int face_block_positions(int32_t D);
 // The vds mode's step of a block's mean (Q4): the DC step / 8, so a full
 // block's mean is quantised as JPEG quantises its DC.
 uint32_t mean_step(uint32_t step0);
+// The vds mode codes a block's mean as a multiple of its step from 128
+// (Q4 here), as JPEG shifts samples by 128 before its DCT: neutral grey
+// and neutral chroma are then exact at any step (from 0 they would land on
+// the nearest multiple of a coarse step, a tint over every white surface).
+constexpr int64_t kMeanCentreQ4 = 128 * 16;
 // The mean of `count` samples in Q4, rounded (0 for none).
 int64_t mean_q4(const uint8_t* samples, uint32_t count);
 // a / b rounded to nearest, halves away from zero (b > 0).
