@@ -47,14 +47,6 @@ uint8_t to_sample(int32_t q4) {
   return static_cast<uint8_t>(v < 0 ? 0 : (v > 255 ? 255 : v));
 }
 
-// The mean of samples p[0], p[stride], ... (count of them) in Q4, rounded.
-int64_t mean_q4_strided(const uint8_t* p, uint32_t count, int stride) {
-  if (count == 0) return 0;
-  int64_t sum = 0;
-  for (uint32_t i = 0; i < count; ++i) sum += p[i * static_cast<uint32_t>(stride)];
-  return div_round(16 * sum, count);
-}
-
 uint32_t hash_pair(uint32_t lo, uint32_t hi) { return (lo * 0x9E3779B1u) ^ (hi * 0x85EBCA77u) ^ (hi >> 7); }
 
 uint32_t hash_size(uint32_t faces) {
@@ -184,10 +176,10 @@ void inverse_dct(const int32_t* in, int n, int32_t* out, int in_stride, int out_
 }
 
 uint32_t mean_step(uint32_t step0) { return step0 < 12 ? 1 : (step0 + 4) / 8; }
-int64_t mean_q4(const uint8_t* samples, uint32_t count) {
+int64_t mean_q4(const uint8_t* samples, uint32_t count, int stride) {
   if (count == 0) return 0;
   int64_t sum = 0;
-  for (uint32_t i = 0; i < count; ++i) sum += samples[i];
+  for (uint32_t i = 0; i < count; ++i) sum += samples[i * static_cast<uint32_t>(stride)];
   return div_round(16 * sum, count);
 }
 
@@ -626,7 +618,7 @@ int64_t MeshColors::corner_sum_q4(uint32_t f, int m, const uint8_t* plane, int s
     const bool at_start = (k == 0) == ((fe & 1u) == 0);
     const uint32_t from = at_start ? 0 : 8 * ((ne - 1) / 8);
     const uint32_t to = at_start ? (ne < 8 ? ne : 8) : ne;
-    sum += mean_q4_strided(src + from * static_cast<uint32_t>(scale), to - from, scale);
+    sum += mean_q4(src + from * static_cast<uint32_t>(scale), to - from, scale);
   }
   return sum;
 }
@@ -709,12 +701,8 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
   // The component groups of every element, in order: Y', Cb, Cr on the
   // level's lattice, or (kFlagChromaHalf) Y' on it, then Cb, Cr on the next
   // level's, whose samples lie at every other lattice point (scale 2).
-  struct Group {
-    int first, end, shift;
-  };
-  const Group whole[1] = {{0, 3, 0}}, split[2] = {{0, 1, 0}, {1, 3, 1}};
-  const Group* groups = chroma_half_ ? split : whole;
-  const int group_count = chroma_half_ ? 2 : 1;
+  const ComponentGroup* groups = nullptr;
+  const int group_count = component_groups(chroma_half_, &groups);
 
   // Edges.
   for (uint32_t e = lc.first; e < edge_end; ++e) {
@@ -734,7 +722,7 @@ Status MeshColors::decode_level(const uint8_t* data, size_t size, const Planes& 
           const int64_t centre = paper ? 0 : kMeanCentreQ4;
           const int64_t pred =
               paper && b > 0 ? prev_q[c]
-                             : div_round((b == 0 ? vertex_q4 : mean_q4_strided(dst - 8 * scale, 8, scale)) - centre, dc_step);
+                             : div_round((b == 0 ? vertex_q4 : mean_q4(dst - 8 * scale, 8, scale)) - centre, dc_step);
           const int64_t q = pred + (paper ? dec.decode_signed(ctx_->dc_zero[c][1], ctx_->dc_mag[c][1], CodecContexts::kDcCtx,
                                                               kDcCutoff, kDcOrder)
                                           : dec.decode_signed(bctx_->dc_zero[cls][1], bctx_->dc_mag[cls][1],

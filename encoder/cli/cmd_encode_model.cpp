@@ -28,8 +28,7 @@ struct EncodeModelOptions {
   double density = 0;
   std::string up = "+y";
   bool paper = false;
-  std::string chroma = "auto";
-  std::string faces = "auto";
+  ColourChoiceArgs colour;
   uint32_t max_chunk = 4096;
   bool quiet = false;
   std::string timeline;
@@ -103,10 +102,9 @@ void run_encode_model(const EncodeModelOptions& o) {
     e.fixed_density = true;
   }
   e.codec.paper = o.paper;
-  // Both auto: the encoder looks (choose_colours); else as given.
-  e.measure_colours = o.chroma == "auto" && o.faces == "auto";
-  e.codec.chroma_half = o.chroma == "half";
-  e.coarser_faces = o.faces == "coarser";
+  e.measure_colours = o.colour.look();
+  e.codec.chroma_half = o.colour.chroma_half();
+  e.coarser_faces = o.colour.coarser_faces();
   enc::TexturedModel model;
   try {
     model = enc::load_textured_model(o.input);
@@ -185,14 +183,7 @@ void add_encode_model(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0u, 4096u));
   sub->add_flag("--paper", o->paper, "Code the colours as the thesis does (for comparison)");
-  sub->add_option("--chroma", o->chroma,
-                  "Each colour level's chroma on the next level's lattice (half) or its own (full); auto (with --faces "
-                  "auto): the encoder draws both and keeps the better")
-      ->check(CLI::IsMember({"auto", "half", "full"}));
-  sub->add_option("--faces", o->faces,
-                  "Faces made coarser where a coarser lattice predicts them as well as coding them (coarser), or each at "
-                  "its texels' resolution (fine); auto (with --chroma auto): the encoder draws both and keeps the better")
-      ->check(CLI::IsMember({"auto", "fine", "coarser"}));
+  add_colour_choice_options(sub, &o->colour);
   sub->add_option("--max-chunk", o->max_chunk, "Largest chunk payload, bytes (the client's chunk buffer)")
       ->capture_default_str()
       ->check(CLI::Range(512u, 1u << 24));

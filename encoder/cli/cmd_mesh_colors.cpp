@@ -53,8 +53,7 @@ struct MeshColorsOptions {
   std::vector<std::string> codecs{"vds", "paper"};
   double deadzone = enc::MccOptions{}.deadzone;
   bool no_seam_boost = false;
-  std::string chroma = "auto";
-  std::string faces = "auto";
+  ColourChoiceArgs colour;
 };
 
 void write_ppm(const std::string& path, const Image& img) {
@@ -88,7 +87,7 @@ void run(const MeshColorsOptions& o) {
     enc::MccOptions mo;
     mo.paper = codec == "paper";
     mo.deadzone = o.deadzone;
-    mo.chroma_half = o.chroma == "half";
+    mo.chroma_half = o.colour.chroma_half();
     return mo;
   };
   // The mesh colors at each sample density used, converted once each.
@@ -125,17 +124,16 @@ void run(const MeshColorsOptions& o) {
     return o.density > 0 ? o.density : (codec == "paper" ? 1.0 : enc::density_for_quality(q));
   };
   // The vds codec's faces made coarser for the quality (--faces coarser).
-  auto rd_of = [&](const std::string& codec, double q) { return codec != "paper" && o.faces == "coarser" ? q : 0.0; };
+  auto rd_of = [&](const std::string& codec, double q) { return codec != "paper" && o.colour.coarser_faces() ? q : 0.0; };
   // With --chroma and --faces auto the vds encoder looks: each choice drawn
   // from 5 views of its own at the display's size (--size, --supersample),
   // not the ones measured below.
-  const bool look = o.chroma == "auto" && o.faces == "auto";
+  const bool look = o.colour.look();
   enc::ModelViews choice_views;
   std::vector<enc::ModelFrame> choice_reference;
   if (look && std::find(o.codecs.begin(), o.codecs.end(), "vds") != o.codecs.end()) {
     choice_views = enc::orbit_views(model.positions, 5, o.size, o.size, o.supersample, o.up == "z" ? 2 : 1);
-    for (const auto& cam : choice_views.cameras)
-      choice_reference.push_back(enc::render_textured(model, model.textures, cam, choice_views));
+    choice_reference = enc::render_references(model, choice_views);
   }
   std::ofstream csv;
   if (!o.csv.empty()) {
@@ -208,8 +206,7 @@ void run(const MeshColorsOptions& o) {
   // Rendered views.
   const std::vector<Anchor> anchors = o.anchors.empty() ? std::vector<Anchor>{} : read_anchors(o.anchors, model.textures.size());
   const enc::ModelViews views = enc::orbit_views(model.positions, o.views, o.size, o.size, o.supersample, o.up == "z" ? 2 : 1);
-  std::vector<enc::ModelFrame> reference;
-  for (const auto& cam : views.cameras) reference.push_back(enc::render_textured(model, model.textures, cam, views));
+  const std::vector<enc::ModelFrame> reference = enc::render_references(model, views);
   struct Row {
     std::string codec, param;
     size_t bytes;
@@ -298,14 +295,7 @@ void add_mesh_colors(CLI::App& app) {
   c->add_option("--deadzone", o->deadzone, "vds codec: levels rounded down below 0.5 + this of a step")
       ->check(CLI::Range(0.0, 0.5));
   c->add_flag("--no-seam-boost", o->no_seam_boost, "keep faces on seams whose sides differ at their own resolution");
-  c->add_option("--chroma", o->chroma,
-                "vds codec: each level's chroma on the next level's lattice (half) or its own (full); auto (with --faces "
-                "auto): the encoder draws both from 5 views of its own and keeps the better (the paper codec: full)")
-      ->check(CLI::IsMember({"auto", "half", "full"}));
-  c->add_option("--faces", o->faces,
-                "vds codec: faces made coarser where a coarser lattice predicts them as well as coding them (coarser), or "
-                "each at its texels' resolution (fine); auto: as --chroma")
-      ->check(CLI::IsMember({"auto", "fine", "coarser"}));
+  add_colour_choice_options(c, &o->colour);
   c->add_option("--density", o->density,
                  "samples per texel side (default: the vds codec's follows the quality, the thesis's is 1)")
       ->check(kPositive);

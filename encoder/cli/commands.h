@@ -31,6 +31,28 @@ inline const CLI::Validator kPositive(
 // over `n` (the first and the last included).
 inline size_t sheet_frame(size_t k, size_t tiles, size_t n) { return tiles < 2 ? 0 : k * (n - 1) / (tiles - 1); }
 
+// --chroma and --faces of the verbs that code mesh colors (encode-model,
+// mesh-colors): both auto, the vds encoder draws its four choices and keeps
+// the best (vds::enc::choose_colours); otherwise they are as given.
+struct ColourChoiceArgs {
+  std::string chroma = "auto";  // auto, half, full
+  std::string faces = "auto";   // auto, fine, coarser
+  bool look() const { return chroma == "auto" && faces == "auto"; }
+  bool chroma_half() const { return chroma == "half"; }
+  bool coarser_faces() const { return faces == "coarser"; }
+};
+inline void add_colour_choice_options(CLI::App* app, ColourChoiceArgs* a) {
+  app->add_option("--chroma", a->chroma,
+                  "each colour level's chroma on the next level's lattice (half) or its own (full); auto (with --faces "
+                  "auto): the vds encoder draws both and keeps the better, the thesis's codec keeps its own")
+      ->check(CLI::IsMember({"auto", "half", "full"}));
+  app->add_option("--faces", a->faces,
+                  "vds codec: faces made coarser where a coarser lattice predicts them as well as coding them "
+                  "(coarser), or each at its texels' resolution (fine); auto (with --chroma auto): the encoder draws "
+                  "both and keeps the better")
+      ->check(CLI::IsMember({"auto", "fine", "coarser"}));
+}
+
 struct Failure : std::runtime_error {
   Failure(int code, const std::string& what) : std::runtime_error(what), exit_code(code) {}
   int exit_code;

@@ -11,10 +11,7 @@ ColourChoice choose_colours(const TexturedModel& model, const MeshColorsOptions&
                             const ModelViews& views, const std::vector<ModelFrame>& reference) {
   if (reference.size() != views.cameras.size()) throw std::invalid_argument("choose_colours: a reference per view");
   const MeshColorsModel fine = to_mesh_colors(model, mo);
-  MeshColorsOptions coarser_mo = mo;
-  coarser_mo.face_max_res = rd_face_resolutions(fine, quality, o);
-  coarser_mo.vertex_filter_res = fine.face_res;
-  const MeshColorsModel coarser = to_mesh_colors(model, coarser_mo);
+  const MeshColorsModel coarser = to_mesh_colors_rd(model, mo, fine, quality, o);
   ColourChoice best;
   double best_score = -1e300;
   for (const bool coarser_faces : {false, true})

@@ -119,15 +119,8 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
                                 const mc::Steps& steps, int m, uint8_t mode, double deadzone, bool chroma_half) {
   const mc::Topology& topo = layout.topology();
   const bool paper = mode == mc::kModePaper;
-  struct Group {
-    int first, end, shift;
-  };
-  std::vector<Group> groups;
-  if (chroma_half) {
-    groups = {{0, 1, 0}, {1, 3, 1}};
-  } else {
-    groups = {{0, 3, 0}};
-  }
+  const mc::ComponentGroup* groups = nullptr;
+  const int group_count = mc::component_groups(chroma_half, &groups);
   layout.layout_level(m);
   next.layout_level(m + 1);
   // Per shift: the layout, the source planes and their reconstruction
@@ -135,7 +128,9 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
   const mc::MeshColors* lay[2] = {&layout, &next};
   const std::array<std::vector<uint8_t>, 3>* src[2] = {&model.levels[static_cast<size_t>(m)],
                                                       &model.levels[static_cast<size_t>(chroma_half ? m + 1 : m)]};
-  std::array<std::vector<uint8_t>, 3> recon[2] = {*src[0], *src[1]};
+  std::array<std::vector<uint8_t>, 3> recon[2];
+  recon[0] = *src[0];
+  if (chroma_half) recon[1] = *src[1];
   std::vector<Block> blocks;
   auto quantise_ac = [&](double coef, uint32_t step_q4) {
     if (paper) return quantise(coef, step_q4);
@@ -145,20 +140,20 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
   };
 
   for (uint32_t e = 0; e < topo.edges; ++e)
-    for (const Group& g : groups) {
-      const int lm = m + g.shift;
-      const mc::Layout& l = lay[g.shift]->layout();
+    for (const mc::ComponentGroup* g = groups; g != groups + group_count; ++g) {
+      const int lm = m + g->shift;
+      const mc::Layout& l = lay[g->shift]->layout();
       const uint32_t n = mc::edge_samples(mc::level_res(layout.edge_res()[e], lm));
       const uint32_t base = l.edge_base + l.edge_offset[e];
       int64_t prev_q[3] = {0, 0, 0};
       for (uint32_t b = 0; 8 * b < n; ++b) {
         const int len = static_cast<int>(std::min<uint32_t>(8, n - 8 * b));
-        for (int c = g.first; c < g.end; ++c) {
+        for (int c = g->first; c < g->end; ++c) {
           const uint32_t* step = steps.edge[c == 0 ? 0 : 1];
           double x[8], X[8];
-          for (int i = 0; i < len; ++i) x[i] = (*src[g.shift])[c][base + 8 * b + i];
+          for (int i = 0; i < len; ++i) x[i] = (*src[g->shift])[c][base + 8 * b + i];
           const int64_t vertex_q4 = int64_t{16} * model.vertex_ycc[3 * topo.edge_vertex[2 * e] + c];
-          uint8_t* dst = recon[g.shift][c].data() + base + 8 * b;
+          uint8_t* dst = recon[g->shift][c].data() + base + 8 * b;
           const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
           const int64_t centre = paper ? 0 : mc::kMeanCentreQ4;
           const int64_t pred = paper && b > 0
@@ -197,22 +192,22 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
     }
 
   for (uint32_t f = 0; f < topo.faces; ++f)
-    for (const Group& g : groups) {
-      const int lm = m + g.shift;
-      const mc::Layout& l = lay[g.shift]->layout();
+    for (const mc::ComponentGroup* g = groups; g != groups + group_count; ++g) {
+      const int lm = m + g->shift;
+      const mc::Layout& l = lay[g->shift]->layout();
       const int rf = mc::level_res(model.face_res[f], lm);
       if (mc::face_samples(rf) == 0) continue;
       const int32_t n = static_cast<int32_t>(mc::resolution(rf)) - 2;
       const uint32_t base = l.face_base + l.face_offset[f];
       int64_t corner_q4[3] = {0, 0, 0};
-      for (int c = g.first; c < g.end; ++c) corner_q4[c] = lay[g.shift]->corner_sum_q4(f, lm, recon[g.shift][c].data());
+      for (int c = g->first; c < g->end; ++c) corner_q4[c] = lay[g->shift]->corner_sum_q4(f, lm, recon[g->shift][c].data());
       int64_t left_q[3] = {0, 0, 0}, row_q[3] = {0, 0, 0}, left_mean[3] = {0, 0, 0}, row_mean[3] = {0, 0, 0};
       for (int32_t br = 0; 8 * br < n; ++br)
         for (int32_t bc = 0; n - 8 * (br + bc) >= 1; ++bc) {
           const int32_t D = n - 8 * (br + bc);
           const int rows = std::min(D, 8);
           const int positions = mc::face_block_positions(D);
-          for (int c = g.first; c < g.end; ++c) {
+          for (int c = g->first; c < g->end; ++c) {
             const uint32_t* step = steps.face[c == 0 ? 0 : 1];
             double x[64] = {}, rowX[64] = {}, Z[64] = {};
             const uint32_t dc_step = paper ? step[0] : mc::mean_step(step[0]);
@@ -226,7 +221,7 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
               const int32_t gr = 8 * br + r;
               const int len = std::min(8, D - r);
               const uint8_t* from =
-                  (*src[g.shift])[c].data() + base + static_cast<uint32_t>(gr * n - gr * (gr - 1) / 2 + 8 * bc);
+                  (*src[g->shift])[c].data() + base + static_cast<uint32_t>(gr * n - gr * (gr - 1) / 2 + 8 * bc);
               for (int i = 0; i < len; ++i) sum += x[8 * r + i] = from[i];
             }
             Block blk;
@@ -263,7 +258,7 @@ std::vector<Block> level_blocks(const MeshColorsModel& model, mc::MeshColors& la
               }
             }
             const int64_t mean =
-                mc::reconstruct_face_block(q, D, step, mode, mean_q4, recon[g.shift][c].data() + base, n, br, bc);
+                mc::reconstruct_face_block(q, D, step, mode, mean_q4, recon[g->shift][c].data() + base, n, br, bc);
             if (!paper) q[0] = static_cast<int32_t>(blk.dc_diff + pred);
             left_q[c] = q[0];
             left_mean[c] = mean;
@@ -552,10 +547,14 @@ std::vector<uint8_t> rd_face_resolutions(const MeshColorsModel& model, double qu
 
 MeshColorsModel to_mesh_colors_rd(const TexturedModel& textured, const MeshColorsOptions& mo, double quality,
                                   const MccOptions& o) {
-  const MeshColorsModel whole = to_mesh_colors(textured, mo);
+  return to_mesh_colors_rd(textured, mo, to_mesh_colors(textured, mo), quality, o);
+}
+
+MeshColorsModel to_mesh_colors_rd(const TexturedModel& textured, const MeshColorsOptions& mo, const MeshColorsModel& fine,
+                                  double quality, const MccOptions& o) {
   MeshColorsOptions again = mo;
-  again.face_max_res = rd_face_resolutions(whole, quality, o);
-  again.vertex_filter_res = whole.face_res;
+  again.face_max_res = rd_face_resolutions(fine, quality, o);
+  again.vertex_filter_res = fine.face_res;
   return to_mesh_colors(textured, again);
 }
 

@@ -138,6 +138,12 @@ ModelFrame render_textured(const TexturedModel& model, const std::vector<Image>&
       });
 }
 
+std::vector<ModelFrame> render_references(const TexturedModel& model, const ModelViews& v) {
+  std::vector<ModelFrame> out;
+  for (const auto& cam : v.cameras) out.push_back(render_textured(model, model.textures, cam, v));
+  return out;
+}
+
 ModelFrame render_mesh_colors(const MeshColorsModel& mc, const std::array<std::vector<uint8_t>, 3>& planes, int m,
                               const ref::CameraD& cam, const ModelViews& v) {
   const uint32_t F = static_cast<uint32_t>(mc.face_res.size()), V = static_cast<uint32_t>(mc.positions.size());

@@ -304,8 +304,7 @@ ModelStreamResult encode_model_stream(const TexturedModel& model, const ModelStr
   if (o.measure_colours && !o.codec.paper) {
     choice_views = orbit_views(r.decoded.positions, 4, r.mesh.stream_header.width, r.mesh.stream_header.height, 2,
                                r.mesh.mesh_header.up == MeshUp::z_plus ? 2 : 1);
-    for (const auto& cam : choice_views.cameras)
-      choice_reference.push_back(render_textured(r.decoded, r.decoded.textures, cam, choice_views));
+    choice_reference = render_references(r.decoded, choice_views);
   }
   // The colours at quality q, coded (without the schedule: the bytes of every level).
   auto colour = [&](double q) {

@@ -346,9 +346,7 @@ TEST(MeshColorsChoice, TheEncoderKeepsWhatItsViewsShowBest) {
   auto choose = [&](const enc::Image& tex, double quality) {
     const enc::TexturedModel model = grid_model(4, tex);
     const enc::ModelViews views = enc::orbit_views(model.positions, 4, 96, 96, 2, 2);
-    std::vector<enc::ModelFrame> reference;
-    for (const auto& cam : views.cameras) reference.push_back(enc::render_textured(model, model.textures, cam, views));
-    return enc::choose_colours(model, mo, quality, enc::MccOptions{}, views, reference);
+    return enc::choose_colours(model, mo, quality, enc::MccOptions{}, views, enc::render_references(model, views));
   };
   const enc::ColourChoice flat = choose(ref::make_noise_texture(128, 11, 0x6080A0, 0x6080A0), 1);
   EXPECT_TRUE(flat.coarser_faces);

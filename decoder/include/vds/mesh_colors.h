@@ -183,8 +183,9 @@ uint32_t mean_step(uint32_t step0);
 // and neutral chroma are then exact at any step (from 0 they would land on
 // the nearest multiple of a coarse step, a tint over every white surface).
 constexpr int64_t kMeanCentreQ4 = 128 * 16;
-// The mean of `count` samples in Q4, rounded (0 for none).
-int64_t mean_q4(const uint8_t* samples, uint32_t count);
+// The mean of `count` samples samples[0], samples[stride], ... in Q4,
+// rounded (0 for none).
+int64_t mean_q4(const uint8_t* samples, uint32_t count, int stride = 1);
 // a / b rounded to nearest, halves away from zero (b > 0).
 int64_t div_round(int64_t a, int64_t b);
 
@@ -243,6 +244,18 @@ constexpr uint8_t kFlagVertexColours = 1;
 // (Taskin section 2.3: chroma from MIP level 1). Per element the level's
 // luma blocks come first, then the chroma blocks (Cb, Cr each block).
 constexpr uint8_t kFlagChromaHalf = 2;
+// The components of each element of a level in MCLV order, group by group:
+// components [first, end) on the lattice `shift` levels coarser.
+struct ComponentGroup {
+  int first, end, shift;
+};
+constexpr ComponentGroup kComponentsTogether[1] = {{0, 3, 0}};     // Y', Cb, Cr each block
+constexpr ComponentGroup kChromaFromNextLevel[2] = {{0, 1, 0}, {1, 3, 1}};  // kFlagChromaHalf
+// The groups of a level with or without kFlagChromaHalf in *out; returns their count.
+inline int component_groups(bool chroma_half, const ComponentGroup** out) {
+  *out = chroma_half ? kChromaFromNextLevel : kComponentsTogether;
+  return chroma_half ? 2 : 1;
+}
 constexpr uint8_t kModePaper = 0;
 constexpr uint8_t kModeVds = 1;
 constexpr size_t kHeaderFixedBytes = 12;
@@ -341,7 +354,6 @@ class MeshColors {
   // layout of level m set). With scale 2, of the blocks of level m + 1's
   // samples, read where they lie in level m's plane (kFlagChromaHalf).
   int64_t corner_sum_q4(uint32_t f, int m, const uint8_t* plane, int scale = 1) const;
-  bool chroma_half() const { return chroma_half_; }
   // kFlagChromaHalf: the points of edge e's (face f's) level-m lattice that
   // level m + 1 does not have, in plane `p` of level m (layout set), from
   // those it has (and the vertex samples; a face's from its edges' too).

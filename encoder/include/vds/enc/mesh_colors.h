@@ -173,8 +173,11 @@ std::array<std::vector<uint8_t>, 3> decode_mesh_colors_level(const MeshColorsMod
 // nothing, not traded against its bits.
 std::vector<uint8_t> rd_face_resolutions(const MeshColorsModel& mc, double quality, const MccOptions& o);
 // to_mesh_colors, then again with rd_face_resolutions' exponents as the
-// faces' caps (the vertex samples kept).
+// faces' caps (the vertex samples kept); the second from `fine`, the first
+// already made.
 MeshColorsModel to_mesh_colors_rd(const TexturedModel& model, const MeshColorsOptions& mo, double quality,
                                   const MccOptions& o);
+MeshColorsModel to_mesh_colors_rd(const TexturedModel& model, const MeshColorsOptions& mo, const MeshColorsModel& fine,
+                                  double quality, const MccOptions& o);
 
 }  // namespace vds::enc

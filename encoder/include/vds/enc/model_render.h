@@ -40,6 +40,9 @@ struct ModelFrame {
 ModelFrame render_textured(const TexturedModel& model, const std::vector<Image>& textures, const ref::CameraD& cam,
                            const ModelViews& v);
 
+// The reference of each camera of `v`: the model through its UV map with its own textures.
+std::vector<ModelFrame> render_references(const TexturedModel& model, const ModelViews& v);
+
 // The model's mesh colors at level m, from the planes of that level.
 ModelFrame render_mesh_colors(const MeshColorsModel& mc, const std::array<std::vector<uint8_t>, 3>& planes, int m,
                               const ref::CameraD& cam, const ModelViews& v);
