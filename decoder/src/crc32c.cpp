@@ -51,30 +51,41 @@ constexpr CrcTable<16> kTable = make_table<16, 4>();
 
 uint32_t crc32c_update(uint32_t crc, const void* data, size_t size) {
   const uint8_t* p = static_cast<const uint8_t*>(data);
+  const uint8_t* const end = p + size;
   uint32_t c = ~crc;
-  size_t i = 0;
 #if VDS_CONFIG_CRC32C_TABLE == 1024
-  for (; i + 4 <= size; i += 4) {
+  // Each table through a pointer of its own, opaque to the optimiser: it
+  // would otherwise address all four from one base, an addition more for
+  // each lookup (on a Cortex-M4 the loop is then 15 instructions for 4
+  // bytes instead of 20).
+  const uint32_t* t0 = kSlices.t[0];
+  const uint32_t* t1 = kSlices.t[1];
+  const uint32_t* t2 = kSlices.t[2];
+  const uint32_t* t3 = kSlices.t[3];
+#if defined(__GNUC__)
+  __asm__("" : "+r"(t0), "+r"(t1), "+r"(t2), "+r"(t3));
+#endif
+  for (const uint8_t* const end4 = p + (size & ~size_t{3}); p != end4; p += 4) {
     // The bytes in stream order, first byte lowest (the reflected CRC's order):
     // one word load on a little-endian machine.
 #if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
     uint32_t w;
-    __builtin_memcpy(&w, p + i, 4);  // -ffreestanding: ask for the inline load explicitly
+    __builtin_memcpy(&w, p, 4);  // -ffreestanding: ask for the inline load explicitly
     c ^= w;
 #else
-    c ^= static_cast<uint32_t>(p[i]) | static_cast<uint32_t>(p[i + 1]) << 8 | static_cast<uint32_t>(p[i + 2]) << 16 |
-         static_cast<uint32_t>(p[i + 3]) << 24;
+    c ^= static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 | static_cast<uint32_t>(p[2]) << 16 |
+         static_cast<uint32_t>(p[3]) << 24;
 #endif
-    c = kSlices.t[3][c & 0xFFu] ^ kSlices.t[2][(c >> 8) & 0xFFu] ^ kSlices.t[1][(c >> 16) & 0xFFu] ^ kSlices.t[0][c >> 24];
+    c = t3[c & 0xFFu] ^ t2[(c >> 8) & 0xFFu] ^ t1[(c >> 16) & 0xFFu] ^ t0[c >> 24];
   }
 #endif
-  for (; i < size; ++i) {
+  for (; p != end; ++p) {
 #if VDS_CONFIG_CRC32C_TABLE == 1024
-    c = kSlices.t[0][(c ^ p[i]) & 0xFFu] ^ (c >> 8);
+    c = kSlices.t[0][(c ^ *p) & 0xFFu] ^ (c >> 8);
 #elif VDS_CONFIG_CRC32C_TABLE == 256
-    c = kTable.v[(c ^ p[i]) & 0xFFu] ^ (c >> 8);
+    c = kTable.v[(c ^ *p) & 0xFFu] ^ (c >> 8);
 #else
-    c ^= p[i];
+    c ^= *p;
     c = kTable.v[c & 0x0Fu] ^ (c >> 4);
     c = kTable.v[c & 0x0Fu] ^ (c >> 4);
 #endif

@@ -70,8 +70,13 @@ constexpr ChromaTables make_chroma_tables() {
   return t;
 }
 constexpr ChromaTables kChroma = make_chroma_tables();
+// The chroma terms of a chroma sample: each channel is Y' plus its term.
+inline Channels chroma_terms(uint32_t cb, uint32_t cr) {
+  return {kChroma.r[cr], (kChroma.g_cb[cb] + kChroma.g_cr[cr]) >> colour::kFracBits, kChroma.b[cb]};
+}
 inline Channels ycbcr_channels(int32_t y, uint32_t cb, uint32_t cr) {
-  return {y + kChroma.r[cr], y + ((kChroma.g_cb[cb] + kChroma.g_cr[cr]) >> colour::kFracBits), y + kChroma.b[cb]};
+  const Channels t = chroma_terms(cb, cr);
+  return {y + t.r, y + t.g, y + t.b};
 }
 inline uint32_t ycbcr_to_rgb(int32_t y, uint32_t cb, uint32_t cr) {
   const Channels c = ycbcr_channels(y, cb, cr);
@@ -83,23 +88,25 @@ inline uint32_t ycbcr_to_rgb(int32_t y, uint32_t cb, uint32_t cr) {
 // holding it clamped, rounded to 5 or 6 bits (pack565's rounding) and in
 // place. Exactly pack565(ycbcr_to_rgb(...)), in about 20 instructions less
 // on a Cortex-M4.
+// Entry c is red's, kPack565Channel + c green's, 2 kPack565Channel + c blue's.
+constexpr int kPack565Channel = 768;
 struct Pack565Table {
-  uint16_t r[768], g[768], b[768];
+  uint16_t v[3 * kPack565Channel];
 };
 constexpr Pack565Table make_pack565_table() {
   Pack565Table t{};
   for (int i = 0; i < 768; ++i) {
     const uint32_t v = static_cast<uint32_t>(i < kChannelBias ? 0 : (i > kChannelBias + 255 ? 255 : i - kChannelBias));
-    t.r[i] = static_cast<uint16_t>(((v * 249 + 1014) >> 11) << 11);
-    t.g[i] = static_cast<uint16_t>(((v * 253 + 505) >> 10) << 5);
-    t.b[i] = static_cast<uint16_t>((v * 249 + 1014) >> 11);
+    t.v[i] = static_cast<uint16_t>(((v * 249 + 1014) >> 11) << 11);
+    t.v[kPack565Channel + i] = static_cast<uint16_t>(((v * 253 + 505) >> 10) << 5);
+    t.v[2 * kPack565Channel + i] = static_cast<uint16_t>((v * 249 + 1014) >> 11);
   }
   return t;
 }
 constexpr Pack565Table kPack565 = make_pack565_table();
 inline uint16_t ycbcr_to_565(int32_t y, uint32_t cb, uint32_t cr) {
   const Channels c = ycbcr_channels(y, cb, cr);
-  return static_cast<uint16_t>(kPack565.r[c.r] | kPack565.g[c.g] | kPack565.b[c.b]);
+  return static_cast<uint16_t>(kPack565.v[c.r] | kPack565.v[kPack565Channel + c.g] | kPack565.v[2 * kPack565Channel + c.b]);
 }
 
 // Blend of two 0x00RR00BB (or 0x0000GG00) words with an 8-bit weight f of b:
@@ -115,7 +122,14 @@ inline uint32_t bilerp8888(uint32_t c00, uint32_t c01, uint32_t c10, uint32_t c1
   const uint32_t g1 = lerp_g(c10 & 0xFF00u, c11 & 0xFF00u, fu);
   return lerp_rb(rb0, rb1, fv) | lerp_g(g0, g1, fv);
 }
-inline uint32_t lerp8(uint32_t a, uint32_t b, uint32_t f) { return ((a << 8) + (b - a) * f + 128) >> 8 & 0xFFu; }
+// Bilinear blend of four 8-bit samples (a b above, c d below) with 8-bit
+// weights, rounded once: the rows' blends are kept in Q8 (below 2^16), the
+// column's in Q16. Every term stays within int32; the result is 0..255.
+inline uint32_t bilerp8(int32_t a, int32_t b, int32_t c, int32_t d, int32_t fu, int32_t fv) {
+  const int32_t top = a * 256 + (b - a) * fu;
+  const int32_t bot = c * 256 + (d - c) * fu;
+  return static_cast<uint32_t>(top * 256 + (bot - top) * fv + 32768) >> 16;
+}
 
 // RGB565 spread to 0b00000GGGGGG00000RRRRR000000BBBBB: every channel gets 5
 // spare bits above it, enough for a blend with a 5-bit weight (0..32).
@@ -135,6 +149,12 @@ inline OutColor<O> from8888(uint32_t c) {
   } else {
     return c & 0xFFFFFFu;
   }
+}
+
+// Y' and the chroma terms as 0x00RRGGBB.
+inline uint32_t terms_to_8888(int32_t y, const Channels& t) {
+  return (static_cast<uint32_t>(sat_u8(y + t.r - kChannelBias)) << 16) | (static_cast<uint32_t>(sat_u8(y + t.g - kChannelBias)) << 8) |
+         sat_u8(y + t.b - kChannelBias);
 }
 
 // Y'CbCr to the output format.
@@ -226,6 +246,40 @@ struct BilinearBlend : TexSampler {
     }
     return b;
   }
+  // Nearest chroma read once for a run of samples in the same chroma
+  // texel (a magnified view's chroma texel covers several pixels): the
+  // texel's index and its chroma terms, each with its place in kPack565
+  // (rgb565 output). The sample point (u, v) comes with 8 more fraction
+  // bits (Q16: the affine runs' steps); the same texels and weights as
+  // sample(t, u >> 8, v >> 8).
+  static constexpr bool kChromaMemo = TF == TexFormat::ycbcr420 && kNearestChroma && A == Addr::inside;
+  struct ChromaMemo {
+    uint32_t ci = ~0u;
+    Channels terms{};
+  };
+  static OutColor<O> sample_q16(const TexCtx& t, ChromaMemo& m, int32_t u, int32_t v)
+    requires kChromaMemo
+  {
+    const int32_t i0 = u >> 16, j0 = v >> 16;
+    const int32_t fu = (u >> 8) & 255, fv = (v >> 8) & 255;
+    const uint8_t* y = t.base + static_cast<uint32_t>(j0) * t.stride + static_cast<uint32_t>(i0);
+    const int32_t yy = static_cast<int32_t>(bilerp8(y[0], y[1], y[t.stride], y[t.stride + 1], fu, fv));
+    // The point in chroma texels: (u_q8 + 128) / 512 = (u_q16 + 2^15) / 2^17.
+    const uint32_t ci = static_cast<uint32_t>((v + 32768) >> 17) * t.cstride + static_cast<uint32_t>((u + 32768) >> 17);
+    if (ci != m.ci) {
+      m.ci = ci;
+      m.terms = chroma_terms(t.cb[ci], t.cr[ci]);
+      if constexpr (O == PixelFormat::rgb565) {
+        m.terms.g += kPack565Channel;
+        m.terms.b += 2 * kPack565Channel;
+      }
+    }
+    if constexpr (O == PixelFormat::rgb565) {
+      return static_cast<uint16_t>(kPack565.v[yy + m.terms.r] | kPack565.v[yy + m.terms.g] | kPack565.v[yy + m.terms.b]);
+    } else {
+      return from8888<O>(terms_to_8888(yy, m.terms));
+    }
+  }
   // (u, v): the sample point minus half a texel, kFracBits fraction bits.
   static OutColor<O> sample(const TexCtx& t, int32_t u, int32_t v) {
     const int32_t i0 = u >> kFracBits, j0 = v >> kFracBits;
@@ -236,7 +290,7 @@ struct BilinearBlend : TexSampler {
     const uint32_t r1 = static_cast<uint32_t>(tx<A>(j0 + 1, t.hmask, t.hmax)) * t.stride;
     if constexpr (TF == TexFormat::ycbcr420) {
       const uint8_t* y = t.base;
-      const uint32_t yy = lerp8(lerp8(y[r0 + c0], y[r0 + c1], fu), lerp8(y[r1 + c0], y[r1 + c1], fu), fv);
+      const uint32_t yy = bilerp8(y[r0 + c0], y[r0 + c1], y[r1 + c0], y[r1 + c1], static_cast<int32_t>(fu), static_cast<int32_t>(fv));
       if constexpr (kNearestChroma) {
         // The point in chroma texels: (u_q8 + 128) / 512.
         const uint32_t k = static_cast<uint32_t>(tx<A>((u + 128) >> 9, t.cwmask, t.cwmax));
@@ -251,8 +305,9 @@ struct BilinearBlend : TexSampler {
         const uint32_t k1 = static_cast<uint32_t>(tx<A>((cu >> 8) + 1, t.cwmask, t.cwmax));
         const uint32_t s0 = static_cast<uint32_t>(tx<A>(cv >> 8, t.chmask, t.chmax)) * t.cstride;
         const uint32_t s1 = static_cast<uint32_t>(tx<A>((cv >> 8) + 1, t.chmask, t.chmax)) * t.cstride;
-        const uint32_t cb = lerp8(lerp8(t.cb[s0 + k0], t.cb[s0 + k1], gu), lerp8(t.cb[s1 + k0], t.cb[s1 + k1], gu), gv);
-        const uint32_t cr = lerp8(lerp8(t.cr[s0 + k0], t.cr[s0 + k1], gu), lerp8(t.cr[s1 + k0], t.cr[s1 + k1], gu), gv);
+        const int32_t su = static_cast<int32_t>(gu), sv = static_cast<int32_t>(gv);
+        const uint32_t cb = bilerp8(t.cb[s0 + k0], t.cb[s0 + k1], t.cb[s1 + k0], t.cb[s1 + k1], su, sv);
+        const uint32_t cr = bilerp8(t.cr[s0 + k0], t.cr[s0 + k1], t.cr[s1 + k0], t.cr[s1 + k1], su, sv);
         return from_ycbcr<O>(static_cast<int32_t>(yy), cb, cr);
       }
     } else if constexpr (TF == TexFormat::rgb565 && O == PixelFormat::rgb565) {
@@ -708,15 +763,17 @@ inline uint8_t* pixel_at(uint8_t* oe, DT* ze, uintptr_t delta, int32_t i) {
   *v = scaled(nv, yr, sh);
 }
 
-// The pixels of one span piece: i = -len .. -1 from the piece end (ze, oe).
-template <class Sampler, bool kProj, PixelFormat O, DepthFormat D>
+// The pixels of one span piece whose divisor is the depth plane (the
+// texture mappings; view-mapped pieces: affine_pixels below): i = -len ..
+// -1 from the piece end (ze, oe).
+template <class Sampler, PixelFormat O, DepthFormat D>
 [[gnu::always_inline]] inline void span_pixels(typename Depth<D>::T* ze, uint8_t* oe, int32_t len, const RowState& r,
                                                const typename Sampler::Ctx& tex) {
   using DT = typename Depth<D>::T;
   const uintptr_t delta = reinterpret_cast<uintptr_t>(oe) -
                           (reinterpret_cast<uintptr_t>(ze) >> (sizeof(DT) == 2 * Store<O>::kBytes ? 1 : 0));
-  int32_t q = r.q, w = r.w, u = r.n[0], v = r.n[1];
-  const int32_t dq = r.dq, dw = r.dw, du = r.dn[0], dv = r.dn[1];
+  int32_t q = r.q, u = r.n[0], v = r.n[1];
+  const int32_t dq = r.dq, du = r.dn[0], dv = r.dn[1];
   const int32_t shb = r.sh_base;
   int32_t i = -len;
   do {
@@ -724,11 +781,10 @@ template <class Sampler, bool kProj, PixelFormat O, DepthFormat D>
     if (d > ze[i]) {
       ze[i] = d;
       int32_t su, sv;
-      sample_uv(u, v, kProj ? w : q, shb, &su, &sv);
+      sample_uv(u, v, q, shb, &su, &sv);
       Store<O>::put(pixel_at<O, DT>(oe, ze, delta, i), Sampler::sample(tex, su, sv));
     }
     q = wrap_add32(q, dq);
-    if constexpr (kProj) w = wrap_add32(w, dw);
     u = wrap_add32(u, du);
     v = wrap_add32(v, dv);
   } while (++i != 0);
@@ -761,6 +817,129 @@ inline bool piece_inside(const RowState& r, int32_t len, const UvBox& b) {
   return in(u0, b.ulo, b.uhi) && in(u1, b.ulo, b.uhi) && in(v0, b.vlo, b.vhi) && in(v1, b.vlo, b.vhi);
 }
 
+// Whether a sampler keeps its last chroma texel between the pixels of a run.
+template <class S>
+constexpr bool chroma_memo() {
+  if constexpr (requires { S::kChromaMemo; }) {
+    return S::kChromaMemo;
+  } else {
+    return false;
+  }
+}
+template <class S, bool kMemo>
+struct MemoOf {
+  struct T {};
+};
+template <class S>
+struct MemoOf<S, true> {
+  using T = typename S::ChromaMemo;
+};
+
+// The pixels of one piece of a view-mapped span (the screen -> view
+// homography): the sample coordinates exact every kAffineRun pixels and at
+// the piece's last pixel, and linear between (the pixels between two exact
+// points step by their difference over the distance, carried with 8 more
+// fraction bits). A reciprocal per run instead of per pixel. Between two
+// points 8 pixels apart the homography's curvature moves a sample by a
+// small part of a texel except on surfaces seen nearly edge-on. The steps
+// need both points within +-kAffineLimit (the differences times 2^8 then
+// stay within int32): so is every point inside a texture (below
+// kTextureMaxSize 2^8 = 2^20 with 8 fraction bits); a point beyond it (far
+// outside the texture, where its clamps give the edge's texels; a
+// repeating texture's 8,192nd copy) is held at the limit.
+constexpr int32_t kAffineRun = 8;
+constexpr int32_t kAffineLimit = 1 << 21;
+// The homography's numerators and divisor where a run starts, and the
+// exact point there.
+struct AffineRun {
+  int32_t nu, nv, w;
+  int32_t u, v;
+};
+inline int32_t hold_affine(int32_t x) { return x < -kAffineLimit ? -kAffineLimit : (x > kAffineLimit ? kAffineLimit : x); }
+// The piece's first exact point.
+[[gnu::noinline]] AffineRun first_run(const RowState& r) {
+  AffineRun a{r.n[0], r.n[1], r.w, 0, 0};
+  sample_uv(a.nu, a.nv, a.w, r.sh_base, &a.u, &a.v);
+  a.u = hold_affine(a.u);
+  a.v = hold_affine(a.v);
+  return a;
+}
+// The run of n >= 1 pixels from a's point: the first pixel's coordinates
+// (su, sv) and their steps (du, dv) in Q16, and a moved to the next run's
+// start, n pixels on.
+[[gnu::always_inline]] inline void run_steps(const RowState& r, int32_t n, AffineRun* a, int32_t* su, int32_t* sv,
+                                             int32_t* du, int32_t* dv) {
+  const uint32_t un = static_cast<uint32_t>(n);
+  a->nu = wrap_add32(a->nu, static_cast<int32_t>(un * static_cast<uint32_t>(r.dn[0])));
+  a->nv = wrap_add32(a->nv, static_cast<int32_t>(un * static_cast<uint32_t>(r.dn[1])));
+  a->w = wrap_add32(a->w, static_cast<int32_t>(un * static_cast<uint32_t>(r.dw)));
+  int32_t u1, v1;
+  sample_uv(a->nu, a->nv, a->w, r.sh_base, &u1, &v1);
+  u1 = hold_affine(u1);
+  v1 = hold_affine(v1);
+  *su = a->u * 256;
+  *sv = a->v * 256;
+  if (n == kAffineRun) {
+    *du = (u1 - a->u) * (256 / kAffineRun);
+    *dv = (v1 - a->v) * (256 / kAffineRun);
+  } else {
+    *du = (u1 - a->u) * 256 / n;
+    *dv = (v1 - a->v) * 256 / n;
+  }
+  a->u = u1;
+  a->v = v1;
+}
+// The same, called (once a run): inlined only into the walkthrough's loop
+// (Y'CbCr views, bilinear luma, inside the view), the rest stay small.
+[[gnu::noinline]] void next_run(const RowState& r, int32_t n, AffineRun* a, int32_t* su, int32_t* sv, int32_t* du,
+                                int32_t* dv) {
+  run_steps(r, n, a, su, sv, du, dv);
+}
+
+template <class Sampler, PixelFormat O, DepthFormat D>
+[[gnu::always_inline]] inline void affine_pixels(typename Depth<D>::T* ze, uint8_t* oe, int32_t len, const RowState& r,
+                                                 const typename Sampler::Ctx& tex) {
+  using DT = typename Depth<D>::T;
+  constexpr bool kMemo = chroma_memo<Sampler>();
+  const uintptr_t delta = reinterpret_cast<uintptr_t>(oe) -
+                          (reinterpret_cast<uintptr_t>(ze) >> (sizeof(DT) == 2 * Store<O>::kBytes ? 1 : 0));
+  int32_t q = r.q;
+  const int32_t dq = r.dq;
+  [[maybe_unused]] typename MemoOf<Sampler, kMemo>::T memo{};
+  AffineRun a = first_run(r);
+  int32_t i = -len;  // pixel len + i of the piece
+  for (;;) {
+    // The run: pixels i .. stop - 1, stepped from the exact points at i
+    // and stop; the piece's last pixel alone at its exact point.
+    const int32_t stop = i + kAffineRun < -1 ? i + kAffineRun : (i < -1 ? -1 : 0);
+    int32_t su = a.u * 256, sv = a.v * 256, du = 0, dv = 0;
+    if (stop != 0) {
+      if constexpr (kMemo) {
+        run_steps(r, stop - i, &a, &su, &sv, &du, &dv);
+      } else {
+        next_run(r, stop - i, &a, &su, &sv, &du, &dv);
+      }
+    }
+    do {
+      const DT d = Depth<D>::value(q);
+      if (d > ze[i]) {
+        ze[i] = d;
+        OutColor<O> c;
+        if constexpr (kMemo) {
+          c = Sampler::sample_q16(tex, memo, su, sv);
+        } else {
+          c = Sampler::sample(tex, su >> 8, sv >> 8);
+        }
+        Store<O>::put(pixel_at<O, DT>(oe, ze, delta, i), c);
+      }
+      q = wrap_add32(q, dq);
+      su += du;
+      sv += dv;
+    } while (++i != stop);
+    if (i == 0) break;
+  }
+}
+
 template <class Sampler, bool kProj, PixelFormat O, DepthFormat D>
 void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa, int32_t xb) {
   using DT = typename Depth<D>::T;
@@ -790,12 +969,20 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
     // a pixel less for bilinear 4:2:0).
     if constexpr (Sampler::kHasInside) {
       if (piece_inside<kProj>(r, len, Sampler::inside_box(tex))) {
-        span_pixels<typename Sampler::Inside, kProj, O, D>(ze, oe, len, r, tex);
+        if constexpr (kProj) {
+          affine_pixels<typename Sampler::Inside, O, D>(ze, oe, len, r, tex);
+        } else {
+          span_pixels<typename Sampler::Inside, O, D>(ze, oe, len, r, tex);
+        }
         xa += len;
         continue;
       }
     }
-    span_pixels<Sampler, kProj, O, D>(ze, oe, len, r, tex);
+    if constexpr (kProj) {
+      affine_pixels<Sampler, O, D>(ze, oe, len, r, tex);
+    } else {
+      span_pixels<Sampler, O, D>(ze, oe, len, r, tex);
+    }
     xa += len;
   }
 }
