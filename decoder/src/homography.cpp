@@ -30,10 +30,7 @@ int64_t shift_round(int64_t v, int s) {
 }
 
 using BMat = HomographyCameras::BlockMatrix;
-struct BVec {
-  int64_t v[3];
-  int e;
-};
+using BVec = HomographyCameras::BlockVector;
 
 // Renormalises so that max |entry| is in [2^29, 2^30) (or all zero).
 void normalise(BMat& a) {
@@ -153,16 +150,34 @@ int32_t ratio_sat(int64_t num, int64_t den, int frac) {
   return neg ? -r : r;
 }
 
+// m v, or v^T m (transposed), renormalised. Entries of both below 2^30:
+// 32 x 32-bit products.
+
+BVec mul_vec(const BMat& m, const BVec& v, bool transposed) {
+  BVec r;
+  for (int i = 0; i < 3; ++i) {
+    int64_t acc = 0;
+    for (int k = 0; k < 3; ++k) {
+      acc += mul32x32_64(static_cast<int32_t>(transposed ? m.m[k][i] : m.m[i][k]), static_cast<int32_t>(v.v[k]));  // < 3 x 2^60
+    }
+    r.v[i] = acc;
+  }
+  r.e = m.e + v.e;
+  normalise(r);
+  return r;
+}
+
 }  // namespace
 
 Status homography_cameras(const Camera& from, const Camera& to, HomographyCameras* out) {
   if (!out) return Status::invalid_argument;
   if (validate_camera(from) != Status::ok || validate_camera(to) != Status::ok) return Status::invalid_argument;
-  out->left = mul(intrinsics_scaled(to), rotation(to, false));
-  out->rot_from = rotation(from, true);
-  out->kinv_from = inverse_intrinsics_scaled(from);
+  const BMat left = mul(intrinsics_scaled(to), rotation(to, false));
+  out->r = mul(rotation(from, true), inverse_intrinsics_scaled(from));
+  out->lr = mul(left, out->r);
+  const BVec c = vec_diff(from.position, to.position);
+  out->lc = c.v[0] == 0 && c.v[1] == 0 && c.v[2] == 0 ? BVec{{0, 0, 0}, 0} : mul_vec(left, c, false);
   out->from_position = from.position;
-  out->to_position = to.position;
   return Status::ok;
 }
 
@@ -175,8 +190,6 @@ Status plane_homography(const Camera& from, const Camera& to, const Vec3<Q16_16>
 Status plane_homography(const HomographyCameras& cams, const Vec3<Q16_16> plane[3], Homography* out) {
   if (!out || !plane) return Status::invalid_argument;
 
-  // Plane normal n = (P1 - P0) x (P2 - P0); its scale cancels in the
-  // homography, so each edge is normalised on its own.
   const BVec e1 = vec_diff(plane[1], plane[0]);
   const BVec e2 = vec_diff(plane[2], plane[0]);
   BVec n{{e1.v[1] * e2.v[2] - e1.v[2] * e2.v[1], e1.v[2] * e2.v[0] - e1.v[0] * e2.v[2],
@@ -185,40 +198,38 @@ Status plane_homography(const HomographyCameras& cams, const Vec3<Q16_16> plane[
   normalise(n);
   if (n.v[0] == 0 && n.v[1] == 0 && n.v[2] == 0) return Status::invalid_argument;
 
-  // delta = n . (P0 - C_from): distance of the plane from the `from` centre
-  // (times |n|). Zero means the plane contains that centre.
-  const BVec d = vec_diff(plane[0], cams.from_position);
-  const int64_t delta = n.v[0] * d.v[0] + n.v[1] * d.v[1] + n.v[2] * d.v[2];  // < 3 * 2^58
-  const int delta_e = n.e + d.e;
+  // d = n . (P0 - C_from), below 2^30 with its exponent.
+  const BVec p = vec_diff(plane[0], cams.from_position);
+  int64_t delta = n.v[0] * p.v[0] + n.v[1] * p.v[1] + n.v[2] * p.v[2];  // < 3 * 2^58
   if (delta == 0) return Status::invalid_argument;
+  int delta_e = n.e + p.e;
+  const int ds = bitlen64(abs64(delta)) - kNormBits;
+  if (ds > 0) {
+    delta = shift_round(delta, ds);
+    delta_e += ds;
+  }
 
-  // M = delta I + (C_from - C_to) n^T, both terms in units of n x world.
-  const BVec c = vec_diff(cams.from_position, cams.to_position);
-  const bool same_centre = c.v[0] == 0 && c.v[1] == 0 && c.v[2] == 0;  // a pure rotation
-  BMat m{};
-  const int cn_e = c.e + n.e;
-  const int e = (same_centre || delta_e > cn_e) ? delta_e : cn_e;
+  // H = d (L R) + (L c)(n^T R): every product of two entries below 2^30.
+  const BVec b = mul_vec(cams.r, n, true);
+  const bool rotation_only = cams.lc.v[0] == 0 && cams.lc.v[1] == 0 && cams.lc.v[2] == 0;
+  const int e_d = delta_e + cams.lr.e, e_c = cams.lc.e + b.e;
+  const int e = (rotation_only || e_d > e_c) ? e_d : e_c;
+  BMat h;
+  h.e = e;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
-      int64_t v = same_centre ? 0 : shift_round(c.v[i] * n.v[j], e - cn_e);  // |c_i n_j| < 2^58
-      if (i == j) v += shift_round(delta, e - delta_e);
-      m.m[i][j] = v;
+      int64_t v = shift_round(mul32x32_64(static_cast<int32_t>(delta), static_cast<int32_t>(cams.lr.m[i][j])), e - e_d);
+      if (!rotation_only) {
+        v += shift_round(mul32x32_64(static_cast<int32_t>(cams.lc.v[i]), static_cast<int32_t>(b.v[j])), e - e_c);
+      }
+      h.m[i][j] = v;
     }
-  m.e = e;
-  normalise(m);
+  normalise(h);
 
-  // S^-1 H S = (S^-1 K_to) R_to M R_from^T (K_from^-1 S), in that order.
-  BMat h = mul(cams.left, m);
-  h = mul(h, cams.rot_from);
-  h = mul(h, cams.kinv_from);
-
-  Homography r{};
+  Homography r;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) r.m[i][j] = static_cast<int32_t>(h.m[i][j]);  // < 2^30 after normalise
 
-  // Sign: along the ray d of a `from` pixel the result is (n . d) times the
-  // point in `to` camera space, and n . d has the sign of delta for points in
-  // front of `from`. So with delta > 0, W > 0 exactly where `to` sees the point.
   if (delta < 0) {
     for (auto& row : r.m)
       for (int32_t& v : row) v = -v;

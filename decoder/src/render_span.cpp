@@ -806,15 +806,26 @@ inline void piece_uv(const RowState& r, int32_t k, int32_t* u, int32_t* v) {
 // is N / W times (1 + e) rounded down, |e| < 2^-18 (recip_y), so it lies
 // within |N / W| 2^-18 + 1 of it. Both ends at least a margin m > 2 (that
 // + 1) inside the box therefore keep every pixel between them inside.
+// The exact sample points at a piece's first and last pixels.
+struct PieceEnds {
+  int32_t u0, v0, u1, v1;
+};
 template <bool kProj>
-inline bool piece_inside(const RowState& r, int32_t len, const UvBox& b) {
+[[gnu::noinline]] PieceEnds piece_ends(const RowState& r, int32_t len) {
+  PieceEnds p;
+  piece_uv<kProj>(r, 0, &p.u0, &p.v0);
+  piece_uv<kProj>(r, len - 1, &p.u1, &p.v1);
+  return p;
+}
+inline bool ends_inside(const PieceEnds& p, const UvBox& b) {
   const int32_t far = (b.uhi > b.vhi ? b.uhi : b.vhi);
   const int32_t m = (far >> 16) + 8;
-  int32_t u0, v0, u1, v1;
-  piece_uv<kProj>(r, 0, &u0, &v0);
-  piece_uv<kProj>(r, len - 1, &u1, &v1);
   const auto in = [m](int32_t x, int32_t lo, int32_t hi) { return x >= lo + m && x < hi - m; };
-  return in(u0, b.ulo, b.uhi) && in(u1, b.ulo, b.uhi) && in(v0, b.vlo, b.vhi) && in(v1, b.vlo, b.vhi);
+  return in(p.u0, b.ulo, b.uhi) && in(p.u1, b.ulo, b.uhi) && in(p.v0, b.vlo, b.vhi) && in(p.v1, b.vlo, b.vhi);
+}
+template <bool kProj>
+inline bool piece_inside(const RowState& r, int32_t len, const UvBox& b) {
+  return ends_inside(piece_ends<kProj>(r, len), b);
 }
 
 // Whether a sampler keeps its last chroma texel between the pixels of a run.
@@ -856,27 +867,10 @@ struct AffineRun {
   int32_t u, v;
 };
 inline int32_t hold_affine(int32_t x) { return x < -kAffineLimit ? -kAffineLimit : (x > kAffineLimit ? kAffineLimit : x); }
-// The piece's first exact point.
-[[gnu::noinline]] AffineRun first_run(const RowState& r) {
-  AffineRun a{r.n[0], r.n[1], r.w, 0, 0};
-  sample_uv(a.nu, a.nv, a.w, r.sh_base, &a.u, &a.v);
-  a.u = hold_affine(a.u);
-  a.v = hold_affine(a.v);
-  return a;
-}
-// The run of n >= 1 pixels from a's point: the first pixel's coordinates
-// (su, sv) and their steps (du, dv) in Q16, and a moved to the next run's
-// start, n pixels on.
-[[gnu::always_inline]] inline void run_steps(const RowState& r, int32_t n, AffineRun* a, int32_t* su, int32_t* sv,
-                                             int32_t* du, int32_t* dv) {
-  const uint32_t un = static_cast<uint32_t>(n);
-  a->nu = wrap_add32(a->nu, static_cast<int32_t>(un * static_cast<uint32_t>(r.dn[0])));
-  a->nv = wrap_add32(a->nv, static_cast<int32_t>(un * static_cast<uint32_t>(r.dn[1])));
-  a->w = wrap_add32(a->w, static_cast<int32_t>(un * static_cast<uint32_t>(r.dw)));
-  int32_t u1, v1;
-  sample_uv(a->nu, a->nv, a->w, r.sh_base, &u1, &v1);
-  u1 = hold_affine(u1);
-  v1 = hold_affine(v1);
+// The run of n >= 1 pixels from a's point to (u1, v1): the first pixel's
+// coordinates (su, sv) and their steps (du, dv) in Q16; a's point moves on.
+[[gnu::always_inline]] inline void run_to(AffineRun* a, int32_t n, int32_t u1, int32_t v1, int32_t* su, int32_t* sv,
+                                          int32_t* du, int32_t* dv) {
   *su = a->u * 256;
   *sv = a->v * 256;
   if (n == kAffineRun) {
@@ -889,16 +883,32 @@ inline int32_t hold_affine(int32_t x) { return x < -kAffineLimit ? -kAffineLimit
   a->u = u1;
   a->v = v1;
 }
-// The same, called (once a run): inlined only into the walkthrough's loop
-// (Y'CbCr views, bilinear luma, inside the view), the rest stay small.
+// The same to the exact point n pixels on, and a's numerators and divisor
+// moved there.
+[[gnu::always_inline]] inline void run_steps(const RowState& r, int32_t n, AffineRun* a, int32_t* su, int32_t* sv,
+                                             int32_t* du, int32_t* dv) {
+  const uint32_t un = static_cast<uint32_t>(n);
+  a->nu = wrap_add32(a->nu, static_cast<int32_t>(un * static_cast<uint32_t>(r.dn[0])));
+  a->nv = wrap_add32(a->nv, static_cast<int32_t>(un * static_cast<uint32_t>(r.dn[1])));
+  a->w = wrap_add32(a->w, static_cast<int32_t>(un * static_cast<uint32_t>(r.dw)));
+  int32_t u1, v1;
+  sample_uv(a->nu, a->nv, a->w, r.sh_base, &u1, &v1);
+  run_to(a, n, hold_affine(u1), hold_affine(v1), su, sv, du, dv);
+}
+// The same two, called (once a run): inlined only into the walkthrough's
+// loop (Y'CbCr views, bilinear luma, inside the view), the rest stay small.
 [[gnu::noinline]] void next_run(const RowState& r, int32_t n, AffineRun* a, int32_t* su, int32_t* sv, int32_t* du,
                                 int32_t* dv) {
   run_steps(r, n, a, su, sv, du, dv);
 }
+[[gnu::noinline]] void last_run(AffineRun* a, int32_t n, int32_t u1, int32_t v1, int32_t* su, int32_t* sv, int32_t* du,
+                                int32_t* dv) {
+  run_to(a, n, u1, v1, su, sv, du, dv);
+}
 
 template <class Sampler, PixelFormat O, DepthFormat D>
 [[gnu::always_inline]] inline void affine_pixels(typename Depth<D>::T* ze, uint8_t* oe, int32_t len, const RowState& r,
-                                                 const typename Sampler::Ctx& tex) {
+                                                 const typename Sampler::Ctx& tex, const PieceEnds& ends) {
   using DT = typename Depth<D>::T;
   constexpr bool kMemo = chroma_memo<Sampler>();
   const uintptr_t delta = reinterpret_cast<uintptr_t>(oe) -
@@ -906,14 +916,22 @@ template <class Sampler, PixelFormat O, DepthFormat D>
   int32_t q = r.q;
   const int32_t dq = r.dq;
   [[maybe_unused]] typename MemoOf<Sampler, kMemo>::T memo{};
-  AffineRun a = first_run(r);
+  // The piece's end points (exact, as piece_ends computed them).
+  AffineRun a{r.n[0], r.n[1], r.w, hold_affine(ends.u0), hold_affine(ends.v0)};
+  const int32_t ue = hold_affine(ends.u1), ve = hold_affine(ends.v1);
   int32_t i = -len;  // pixel len + i of the piece
   for (;;) {
     // The run: pixels i .. stop - 1, stepped from the exact points at i
     // and stop; the piece's last pixel alone at its exact point.
     const int32_t stop = i + kAffineRun < -1 ? i + kAffineRun : (i < -1 ? -1 : 0);
     int32_t su = a.u * 256, sv = a.v * 256, du = 0, dv = 0;
-    if (stop != 0) {
+    if (stop == -1) {  // the run to the last pixel
+      if constexpr (kMemo) {
+        run_to(&a, stop - i, ue, ve, &su, &sv, &du, &dv);
+      } else {
+        last_run(&a, stop - i, ue, ve, &su, &sv, &du, &dv);
+      }
+    } else if (stop != 0) {
       if constexpr (kMemo) {
         run_steps(r, stop - i, &a, &su, &sv, &du, &dv);
       } else {
@@ -967,20 +985,24 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
     // A clamping sampler whose piece lies inside the texture samples it
     // without the clamps (the same texels: about 20 Cortex-M4 instructions
     // a pixel less for bilinear 4:2:0).
-    if constexpr (Sampler::kHasInside) {
-      if (piece_inside<kProj>(r, len, Sampler::inside_box(tex))) {
-        if constexpr (kProj) {
-          affine_pixels<typename Sampler::Inside, O, D>(ze, oe, len, r, tex);
-        } else {
-          span_pixels<typename Sampler::Inside, O, D>(ze, oe, len, r, tex);
-        }
-        xa += len;
-        continue;
-      }
-    }
     if constexpr (kProj) {
-      affine_pixels<Sampler, O, D>(ze, oe, len, r, tex);
+      const PieceEnds ends = piece_ends<true>(r, len);
+      if constexpr (Sampler::kHasInside) {
+        if (ends_inside(ends, Sampler::inside_box(tex))) {
+          affine_pixels<typename Sampler::Inside, O, D>(ze, oe, len, r, tex, ends);
+          xa += len;
+          continue;
+        }
+      }
+      affine_pixels<Sampler, O, D>(ze, oe, len, r, tex, ends);
     } else {
+      if constexpr (Sampler::kHasInside) {
+        if (piece_inside<false>(r, len, Sampler::inside_box(tex))) {
+          span_pixels<typename Sampler::Inside, O, D>(ze, oe, len, r, tex);
+          xa += len;
+          continue;
+        }
+      }
       span_pixels<Sampler, O, D>(ze, oe, len, r, tex);
     }
     xa += len;

@@ -48,19 +48,26 @@ struct Homography {
 // collinear, or the plane passes through the centre of `from` (seen edge-on).
 Status plane_homography(const Camera& from, const Camera& to, const Vec3<Q16_16> plane[3], Homography* out);
 
-// What plane_homography() computes of the two cameras alone (their
-// intrinsics and rotations in block floating point), for the many planes
-// drawn between the same two cameras: plane_homography(pair, plane) gives
-// plane_homography(from, to, plane) bit for bit, at about half the cost.
+// What plane_homography() computes of the two cameras alone, for the many
+// planes drawn between the same two cameras. With L = (S^-1 K_to) R_to and
+// R = R_from^T (K_from^-1 S), the homography is a rank-one update of one
+// matrix: H = L (d I + c n^T) R = d (L R) + (L c)(n^T R), c = C_from - C_to;
+// so a plane costs a 3-vector n^T R and an outer product, not three
+// matrix products. plane_homography(pair, plane) gives
+// plane_homography(from, to, plane) bit for bit.
 struct HomographyCameras {
   struct BlockMatrix {
     int64_t m[3][3];
     int e;  // value = m * 2^e
   };
-  BlockMatrix left;       // (S^-1 K_to) R_to
-  BlockMatrix rot_from;   // R_from^T
-  BlockMatrix kinv_from;  // K_from^-1 S (scale-free)
-  Vec3<Q16_16> from_position, to_position;
+  struct BlockVector {
+    int64_t v[3];
+    int e;  // value = v * 2^e
+  };
+  BlockMatrix lr;        // L R
+  BlockMatrix r;         // R_from^T K_from^-1 S (scale-free)
+  BlockVector lc;        // L (C_from - C_to); zero for a pure rotation
+  Vec3<Q16_16> from_position;
 };
 // invalid_argument: a camera fails validate_camera().
 Status homography_cameras(const Camera& from, const Camera& to, HomographyCameras* out);

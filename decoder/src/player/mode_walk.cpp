@@ -176,7 +176,8 @@ Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
     m.num_triangles = 0;
   }
   // Each view's triangles, with what the screen's and the view's cameras
-  // alone give computed once (the same homographies, half the work).
+  // alone give computed once (the same homographies; a triangle then
+  // costs a rank-one update of a matrix, vds/homography.h).
   for (uint8_t v = 0; v < kWalkMaxViews; ++v) {
     if (!w.view_ready[v]) continue;
     HomographyCameras pair;
