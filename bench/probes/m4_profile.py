@@ -45,7 +45,11 @@ def main():
 
     syms = symbols(a.elf)
     starts = [s[0] for s in syms]
-    log = a.log or tempfile.mktemp(suffix=".qemu.log")
+    if a.log:
+        log = a.log
+    else:
+        fd, log = tempfile.mkstemp(suffix=".qemu.log")
+        os.close(fd)
     cmd = ["qemu-system-arm", "-M", "mps2-an386", "-cpu", "cortex-m4", "-nographic", "-monitor", "none", "-serial",
            "null", "-semihosting-config", "enable=on,target=native", "-icount", "shift=0", "-d",
            "in_asm,exec,nochain", "-D", log, "-kernel", os.path.abspath(a.elf)]

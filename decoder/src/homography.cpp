@@ -152,7 +152,6 @@ int32_t ratio_sat(int64_t num, int64_t den, int frac) {
 
 // m v, or v^T m (transposed), renormalised. Entries of both below 2^30:
 // 32 x 32-bit products.
-
 BVec mul_vec(const BMat& m, const BVec& v, bool transposed) {
   BVec r;
   for (int i = 0; i < 3; ++i) {
@@ -190,6 +189,8 @@ Status plane_homography(const Camera& from, const Camera& to, const Vec3<Q16_16>
 Status plane_homography(const HomographyCameras& cams, const Vec3<Q16_16> plane[3], Homography* out) {
   if (!out || !plane) return Status::invalid_argument;
 
+  // Plane normal n = (P1 - P0) x (P2 - P0); its scale cancels in the
+  // homography, so each edge is normalised on its own.
   const BVec e1 = vec_diff(plane[1], plane[0]);
   const BVec e2 = vec_diff(plane[2], plane[0]);
   BVec n{{e1.v[1] * e2.v[2] - e1.v[2] * e2.v[1], e1.v[2] * e2.v[0] - e1.v[0] * e2.v[2],
@@ -198,7 +199,9 @@ Status plane_homography(const HomographyCameras& cams, const Vec3<Q16_16> plane[
   normalise(n);
   if (n.v[0] == 0 && n.v[1] == 0 && n.v[2] == 0) return Status::invalid_argument;
 
-  // d = n . (P0 - C_from), below 2^30 with its exponent.
+  // d = n . (P0 - C_from): distance of the plane from the `from` centre
+  // (times |n|). Zero means the plane contains that centre. Kept below
+  // 2^30 with its exponent.
   const BVec p = vec_diff(plane[0], cams.from_position);
   int64_t delta = n.v[0] * p.v[0] + n.v[1] * p.v[1] + n.v[2] * p.v[2];  // < 3 * 2^58
   if (delta == 0) return Status::invalid_argument;
@@ -230,6 +233,9 @@ Status plane_homography(const HomographyCameras& cams, const Vec3<Q16_16> plane[
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) r.m[i][j] = static_cast<int32_t>(h.m[i][j]);  // < 2^30 after normalise
 
+  // Sign: along the ray d of a `from` pixel the result is (n . d) times the
+  // point in `to` camera space, and n . d has the sign of delta for points in
+  // front of `from`. So with delta > 0, W > 0 exactly where `to` sees the point.
   if (delta < 0) {
     for (auto& row : r.m)
       for (int32_t& v : row) v = -v;

@@ -78,11 +78,12 @@ inline Channels ycbcr_channels(int32_t y, uint32_t cb, uint32_t cr) {
   const Channels t = chroma_terms(cb, cr);
   return {y + t.r, y + t.g, y + t.b};
 }
-inline uint32_t ycbcr_to_rgb(int32_t y, uint32_t cb, uint32_t cr) {
-  const Channels c = ycbcr_channels(y, cb, cr);
-  return (static_cast<uint32_t>(sat_u8(c.r - kChannelBias)) << 16) | (static_cast<uint32_t>(sat_u8(c.g - kChannelBias)) << 8) |
-         sat_u8(c.b - kChannelBias);
+// Y' and the chroma terms as 0x00RRGGBB.
+inline uint32_t terms_to_8888(int32_t y, const Channels& t) {
+  return (static_cast<uint32_t>(sat_u8(y + t.r - kChannelBias)) << 16) | (static_cast<uint32_t>(sat_u8(y + t.g - kChannelBias)) << 8) |
+         sat_u8(y + t.b - kChannelBias);
 }
+inline uint32_t ycbcr_to_rgb(int32_t y, uint32_t cb, uint32_t cr) { return terms_to_8888(y, chroma_terms(cb, cr)); }
 
 // The same straight to RGB565: each channel's biased value indexes a table
 // holding it clamped, rounded to 5 or 6 bits (pack565's rounding) and in
@@ -95,7 +96,7 @@ struct Pack565Table {
 };
 constexpr Pack565Table make_pack565_table() {
   Pack565Table t{};
-  for (int i = 0; i < 768; ++i) {
+  for (int i = 0; i < kPack565Channel; ++i) {
     const uint32_t v = static_cast<uint32_t>(i < kChannelBias ? 0 : (i > kChannelBias + 255 ? 255 : i - kChannelBias));
     t.v[i] = static_cast<uint16_t>(((v * 249 + 1014) >> 11) << 11);
     t.v[kPack565Channel + i] = static_cast<uint16_t>(((v * 253 + 505) >> 10) << 5);
@@ -149,12 +150,6 @@ inline OutColor<O> from8888(uint32_t c) {
   } else {
     return c & 0xFFFFFFu;
   }
-}
-
-// Y' and the chroma terms as 0x00RRGGBB.
-inline uint32_t terms_to_8888(int32_t y, const Channels& t) {
-  return (static_cast<uint32_t>(sat_u8(y + t.r - kChannelBias)) << 16) | (static_cast<uint32_t>(sat_u8(y + t.g - kChannelBias)) << 8) |
-         sat_u8(y + t.b - kChannelBias);
 }
 
 // Y'CbCr to the output format.
@@ -806,7 +801,8 @@ inline void piece_uv(const RowState& r, int32_t k, int32_t* u, int32_t* v) {
 // is N / W times (1 + e) rounded down, |e| < 2^-18 (recip_y), so it lies
 // within |N / W| 2^-18 + 1 of it. Both ends at least a margin m > 2 (that
 // + 1) inside the box therefore keep every pixel between them inside.
-// The exact sample points at a piece's first and last pixels.
+// The piece's exact sample points at its first and last pixels serve the
+// check (piece_ends, ends_inside) and, on a view-mapped piece, its runs.
 struct PieceEnds {
   int32_t u0, v0, u1, v1;
 };
