@@ -131,7 +131,7 @@ BoardResult run_on_board(const BoardArgs& a, const std::string& name, const Serv
     if (!a.out.empty())
       argv.insert(argv.end(), {"--frames", (dir / "frames").string(), "--y4m", (dir / "frames.y4m").string(), "--contact-sheet",
                                (dir / "contact_sheet.png").string()});
-    if (a.window) argv.push_back("--window");
+    if (a.window) argv.insert(argv.end(), {"--window", "--hold"});
     if (!a.controls.empty()) argv.insert(argv.end(), {"--controls", fs::absolute(a.controls).string()});
   } else {
     if (!a.controls.empty()) throw Failure(kExitUsage, "--controls is for the host board (the qemu board has no controls)");
@@ -176,7 +176,8 @@ BoardResult run_on_board(const BoardArgs& a, const std::string& name, const Serv
     }
   }
   BoardResult out;
-  out.status = board.finish(60);
+  // With a live window the board keeps a model in view until the viewer closes it.
+  out.status = board.finish(a.window ? 1e9 : 60);
   out.report = r;
   out.options = o;
   out.dir = dir;
@@ -193,22 +194,28 @@ void check_board_frames(const BoardArgs& a, const std::string& name, const Board
   const int board_status = br.status;
   print_serve_report(name, o, r);
   std::string crcs;
-  size_t same = 0;
+  size_t same = 0, steered = 0;
   for (size_t i = 0; i < r.frames.size(); ++i) {
-    char line[16];
-    std::snprintf(line, sizeof line, "%08x\n", r.frames[i].crc);
+    char line[24];
+    std::snprintf(line, sizeof line, "%08x%s\n", r.frames[i].crc, r.frames[i].steered ? " steered" : "");
     crcs += line;
-    if (i < want.size() && r.frames[i].index == i && r.frames[i].crc == want[i]) ++same;
+    // A frame drawn as the viewer turned the model is not the stream's alone: not compared.
+    if (r.frames[i].steered && r.frames[i].index == i)
+      ++steered;
+    else if (i < want.size() && r.frames[i].index == i && r.frames[i].crc == want[i])
+      ++same;
   }
   enc::write_file((dir / "crcs.txt").string(), std::span(reinterpret_cast<const uint8_t*>(crcs.data()), crcs.size()));
-  std::printf("  replay             %zu frames; the %s board showed %zu, %zu of them equal to the replay's\n", want.size(),
+  std::printf("  replay             %zu frames; the %s board showed %zu, %zu of them equal to the replay's", want.size(),
               a.board.c_str(), r.frames.size(), same);
+  if (steered > 0) std::printf(", %zu drawn as the viewer turned the model (not compared)", steered);
+  std::printf("\n");
   std::printf("  board              exit status %d; log %s%s\n", board_status, log.string().c_str(),
               a.out.empty() ? "" : (host ? "; frames, frames.y4m, contact_sheet.png and crcs.txt beside it" : "; crcs.txt beside it"));
   check_serve_report(r);
   // A client whose workspace holds only part of a model shows fewer frames;
   // every frame it shows must be the replay's.
-  if (same != r.frames.size() || (!r.receipt_prefix && r.frames.size() != want.size()))
+  if (same + steered != r.frames.size() || (!r.receipt_prefix && r.frames.size() != want.size()))
     throw Failure(kExitBadInput, "the " + a.board + " board's frames differ from the replay");
   if (board_status != 0) throw Failure(kExitBadInput, "the " + a.board + " board exited with status " + std::to_string(board_status));
 }

@@ -4,7 +4,9 @@
 // build in QEMU (mps2-an386, -icount shift=0) whose UART0 is a TCP socket —
 // serves the stream to it over the link at --baud, prints what the client
 // reported, and checks every frame's CRC against the host replay of the
-// client (what `vds frames` computes).
+// client (what `vds frames` computes). On the host board a model can be
+// turned by the viewer (--window, --controls): those frames are marked
+// steered and not compared.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -73,7 +75,10 @@ void add_play(CLI::App& app) {
                   "The board's client firmware (default: the build's firmware_sim/vds_fw_client_host or cm4/firmware_sim/vds_fw_client.elf)");
   sub->add_option("--qemu", a->qemu, "QEMU's Arm system emulator")->capture_default_str();
   sub->add_option("--timeout", a->timeout, "Give up after this many seconds")->capture_default_str();
-  sub->add_flag("--window", a->window, "Host board: show the frames in a live window (SDL2)");
+  sub->add_flag("--window", a->window,
+                "Host board: show the frames in a live window (SDL2); a model is turned by dragging the mouse (or Left/Right) and stays in view until the window is closed");
+  sub->add_option("--controls", a->controls,
+                  "Host board: the viewer's controls from a script instead of the window's (lines 'FRAMES FORWARD RIGHT UP TURN TILT [fast]'; a model turns by TURN degrees a poll)");
   sub->callback([a] { run_play(*a); });
 }
 

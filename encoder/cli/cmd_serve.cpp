@@ -50,9 +50,9 @@ void print_serve_report(const std::string& name, const link::ServeOptions& o, co
   if (r.frame_records != 0) std::printf("  frame records      %u\n", r.frame_records);
   // What the client displayed: one line per frame, then its statistics.
   for (const link::FrameRecord& f : r.frames)
-    std::printf("  frame %5u crc %08x parse %u decode %u (entropy %u transform %u) display %u at %u ms%s\n", f.index,
+    std::printf("  frame %5u crc %08x parse %u decode %u (entropy %u transform %u) display %u at %u ms%s%s\n", f.index,
                 f.crc, f.parse_instructions, f.decode_instructions, f.entropy_instructions, f.transform_instructions,
-                f.display_instructions, f.received_ms, f.late ? " late" : "");
+                f.display_instructions, f.received_ms, f.late ? " late" : "", f.steered ? " steered" : "");
   if (r.have_stats)
     std::printf("  client stats       %u frames shown, %u late, %u stream bytes, workspace %u of %u B, stack %u B, "
                 "link %u resent, %u dropped\n",

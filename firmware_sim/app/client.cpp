@@ -31,6 +31,7 @@ constexpr uint32_t kPendingRecords = 8;     // frame records waiting for the che
 constexpr size_t kStreamReadBytes = 256;    // stream bytes handed to the player at a time
 constexpr uint32_t kDrainTimeoutMs = 20000;  // after the report, wait at most this long for the host's Goodbye
 constexpr uint32_t kGoodbyeWaitMs = 3000;    // once the host has acknowledged everything, this long
+constexpr uint32_t kViewerPollMs = 50;       // a model the viewer turns: their controls read this often
 
 alignas(8) uint8_t g_workspace[VDS_APP_WORKSPACE_MAX];
 
@@ -55,6 +56,7 @@ struct Client {
   uint32_t late_frames = 0;
   uint32_t first_frame_ms = 0;
   uint32_t first_byte_ms = 0;  // when the stream's first byte was taken (a timed stream's clock starts)
+  uint32_t viewer_polled_ms = 0;  // when the viewer's controls were last read (Player::view_input)
 
   // Upward messages.
   link::FrameRecord pending[kPendingRecords];
@@ -113,6 +115,7 @@ void frame_shown(void*, const vds::PlayedFrame& f) {
     rec.transform_instructions = static_cast<uint32_t>(f.transform);
     rec.received_ms = now;
     rec.late = late ? 1 : 0;
+    rec.steered = f.steered ? 1 : 0;
     ++g.pending_count;
   }
 }
@@ -331,6 +334,10 @@ extern "C" int vds_app_main() {
       if (g.stream_bytes != 0 && start_stream() != Status::ok) return 3;
     }
     feed_stream();
+    if (now - g.viewer_polled_ms >= kViewerPollMs) {
+      g.viewer_polled_ms = now;
+      g.player.view_input();  // a model the viewer turns is drawn again for them
+    }
     send_messages(now);
     read_control();
     const size_t m = g.link.transmit(tx, sizeof tx, now);
@@ -364,6 +371,22 @@ extern "C" int vds_app_main() {
       }
     }
     if (!busy) board::wait_for_event(1);
+  }
+  // A model stays in view while a viewer is there to turn it (the host
+  // board's live window until it is closed, a controls script until it ends).
+  if (g.player.have_header() && g.player.header().mode == vds::StreamMode::model && board::viewer_present()) {
+    board::log("client: the model stays in view for the viewer\n");
+    uint32_t viewer_frames = 0;
+    while (board::viewer_present()) {
+      const uint32_t now = board::millis();
+      if (now - g.viewer_polled_ms < kViewerPollMs) {
+        board::wait_for_event(kViewerPollMs - (now - g.viewer_polled_ms));
+        continue;
+      }
+      g.viewer_polled_ms = now;
+      if (g.player.view_input()) ++viewer_frames;
+    }
+    board::log(Line().str("client: the viewer has gone, ").dec(viewer_frames).str(" frames drawn for them after the stream\n").c_str());
   }
   Line l;
   l.str("client: ").str(vds::status_name(g.stream_status)).str(", ").dec(g.player.frames_shown()).str(" frames, ");

@@ -312,9 +312,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   for (size_t at = 0; at < stream.size() && s == vds::Status::more_input; at += piece) {
     const size_t n = piece < stream.size() - at ? piece : stream.size() - at;
     s = player.feed(stream.data() + at, n);
+    player.view_input();  // a model the viewer turns is drawn between the stream's frames
   }
   if (s == vds::Status::more_input) s = player.finish();
   if (s != vds::Status::ok && !vds::is_error(s)) abort();
+  player.view_input();  // and after them
   if (arena.high_water() > ws.size()) abort();
   return 0;
 }

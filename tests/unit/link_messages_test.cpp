@@ -44,6 +44,16 @@ TEST(LinkMessages, EveryMessageRoundTrips) {
   EXPECT_EQ(fr2.display_instructions, 5u);
   EXPECT_EQ(fr2.received_ms, 6u);
   EXPECT_EQ(fr2.late, 1);
+  EXPECT_EQ(fr2.steered, 0);
+  FrameRecord steered = fr;
+  steered.late = 0;
+  steered.steered = 1;
+  ASSERT_EQ(encode(steered, b), kFrameRecordBytes);
+  ASSERT_EQ(decode(b, kFrameRecordBytes, &fr2), Status::ok);
+  EXPECT_EQ(fr2.late, 0);
+  EXPECT_EQ(fr2.steered, 1);
+  b[kFrameRecordBytes - 1] = 4;  // no such flag
+  EXPECT_EQ(decode(b, kFrameRecordBytes, &fr2), Status::malformed);
 
   const ClientStats st{1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
   ASSERT_EQ(encode(st, b), kClientStatsBytes);

@@ -2,7 +2,8 @@
 // display bands: the same frames whatever the piece size; bands inside the
 // frame and no taller than configured; a callback's false aborts; a mode
 // the client does not play is refused at the header; a model larger than
-// the workspace plays the levels that fit, says so, and ends early.
+// the workspace plays the levels that fit, says so, and ends early; the
+// viewer turns a model between the stream's frames.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -454,6 +455,107 @@ TEST(Player, AModelReportsEveryLevelWithItsDecodeCount) {
   }
   EXPECT_EQ(levels.seen.back().vertices, p.mesh.mesh().vertex_count());
   EXPECT_EQ(levels.seen.back().triangles, p.mesh.mesh().triangle_count());
+}
+
+// The viewer's frames (Player::view_input): a turn draws the model again
+// from the stream's last angle plus the turn, shown but not reported; the
+// stream's frames after it are drawn turned the same and marked steered.
+TEST(Player, TheViewerTurnsAModelBetweenTheStreamsFrames) {
+  const char* box = "/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf";
+  vds::enc::ModelStreamOptions o;
+  o.colors.max_res_log2 = 4;
+  o.schedule_views = 0;
+  o.orbit_frames = 8;  // angles 0, 1/8, ... 7/8 turn
+  const vds::enc::ModelStreamResult r = vds::enc::encode_model_stream(vds::enc::load_textured_model(box), o);
+  const std::vector<uint32_t> want = vds::enc::client_frame_crcs(r.stream);
+  ASSERT_GT(want.size(), 8u);
+  const size_t orbit = want.size() - 8;  // the first orbit frame, at angle 0
+  ASSERT_NE(want[orbit], want[orbit + 1]) << "each orbit frame a further step round";
+
+  struct Viewer {
+    int16_t turn = 0;
+    uint32_t reads = 0;
+    std::vector<uint32_t> shown;  // end_frame's CRC of every frame shown
+    std::vector<vds::PlayedFrame> reported;
+  };
+  static Viewer* v = nullptr;
+  Seen seen;
+  vds::PlayerCallbacks cb = callbacks(seen);
+  cb.end_frame = [](void*, uint32_t crc) {
+    v->shown.push_back(crc);
+    return true;
+  };
+  cb.frame_shown = [](void*, const vds::PlayedFrame& f) { v->reported.push_back(f); };
+  cb.steer = [](void*, vds::terrain::SteerInput* in) {
+    ++v->reads;
+    *in = vds::terrain::SteerInput{};
+    in->turn = v->turn;
+    return in->any();
+  };
+  std::vector<uint8_t> ws(1u << 20);
+
+  // After the stream: an eighth of a turn past the last orbit frame (7/8) is angle 0.
+  {
+    Viewer viewer;
+    v = &viewer;
+    vds::Arena arena(ws.data(), ws.size());
+    vds::Player p;
+    ASSERT_EQ(p.init(arena, vds::kClientPlayerConfig, cb), Status::ok);
+    EXPECT_FALSE(p.view_input()) << "nothing to turn before the stream";
+    ASSERT_EQ(p.feed(r.stream.data(), r.stream.size()), Status::ok);
+    ASSERT_EQ(viewer.reported.size(), want.size());
+    for (size_t i = 0; i < want.size(); ++i) {
+      EXPECT_EQ(viewer.reported[i].crc, want[i]) << i;
+      EXPECT_FALSE(viewer.reported[i].steered) << i;
+    }
+    EXPECT_FALSE(p.view_input()) << "controls that do not turn draw nothing";
+    EXPECT_EQ(viewer.reads, 1u);
+    viewer.turn = 8192;
+    ASSERT_TRUE(p.view_input());
+    ASSERT_EQ(viewer.shown.size(), want.size() + 1);
+    EXPECT_EQ(viewer.shown.back(), want[orbit]) << "7/8 + 1/8 turn: the orbit's first angle";
+    EXPECT_EQ(viewer.reported.size(), want.size()) << "the viewer's frame is not the stream's";
+    EXPECT_EQ(p.frames_shown(), want.size());
+    ASSERT_TRUE(p.view_input());
+    EXPECT_EQ(viewer.shown.back(), want[orbit + 1]);
+  }
+  // During the stream: the turn stays, so each orbit frame shows the next angle's picture.
+  {
+    Viewer viewer;
+    v = &viewer;
+    vds::Arena arena(ws.data(), ws.size());
+    vds::Player p;
+    ASSERT_EQ(p.init(arena, vds::kClientPlayerConfig, cb), Status::ok);
+    size_t at = 0;
+    Status st = Status::more_input;
+    while (st == Status::more_input && viewer.reported.size() < orbit) st = p.feed(&r.stream[at++], 1);
+    ASSERT_EQ(st, Status::more_input);
+    viewer.turn = 8192;
+    ASSERT_TRUE(p.view_input());
+    viewer.turn = 0;
+    ASSERT_EQ(p.feed(r.stream.data() + at, r.stream.size() - at), Status::ok);
+    ASSERT_EQ(viewer.reported.size(), want.size());
+    for (size_t i = 0; i < orbit; ++i) EXPECT_FALSE(viewer.reported[i].steered) << i;
+    for (size_t i = orbit; i < want.size(); ++i) {
+      EXPECT_TRUE(viewer.reported[i].steered) << i;
+      EXPECT_EQ(viewer.reported[i].index, i);
+      if (i + 1 < want.size()) EXPECT_EQ(viewer.reported[i].crc, want[i + 1]) << i;
+    }
+    EXPECT_EQ(viewer.reported.back().crc, want[orbit]) << "7/8 + 1/8 turn";
+  }
+  // Other modes have no viewer's frames.
+  {
+    Viewer viewer;
+    viewer.turn = 8192;
+    v = &viewer;
+    vds::Arena arena(ws.data(), ws.size());
+    vds::Player p;
+    ASSERT_EQ(p.init(arena, vds::kClientPlayerConfig, cb), Status::ok);
+    const std::vector<uint8_t> images = image_stream();
+    ASSERT_EQ(p.feed(images.data(), images.size()), Status::ok);
+    EXPECT_FALSE(p.view_input());
+    EXPECT_EQ(viewer.reads, 0u);
+  }
 }
 
 }  // namespace

@@ -54,6 +54,7 @@
 //   just drawn and sends it up as a steered pose every frame they move it
 //   (else every pose period); the frames it draws still come from the
 //   stream alone (the server draws the steered pose it received).
+//   A model stream reads them in view_input(): the viewer turns the model.
 // Bit-exact: the same stream and configuration give the same bands on
 // every platform. No heap, no float, no exceptions.
 #pragma once
@@ -101,6 +102,9 @@ struct PlayedFrame {
   uint32_t crc = 0;    // CRC-32C of its RGB565 rows, top to bottom
   uint64_t parse = 0, decode = 0, display = 0;
   uint64_t entropy = 0, transform = 0;  // of decode (images)
+  // Drawn as the viewer turned it (a model: Player::view_input), not as
+  // the stream alone draws it: a replay of the stream does not show it.
+  bool steered = false;
 };
 
 // A model's level, complete (level 0: the base mesh).
@@ -165,6 +169,8 @@ struct PlayerMode {
   // Most stream bytes to feed at once when `frames_room` more frames may
   // complete (0: no limit of the mode's own).
   size_t (*feed_limit)(const Player& p, uint32_t frames_room);
+  // Player::view_input() (nullptr: the mode has no viewer's frames).
+  bool (*view_input)(Player& p) = nullptr;
 };
 // The feed limit of a mode that may complete a frame at any chunk: no
 // more bytes than can finish as many chunks (12 bytes of framing at least)
@@ -210,6 +216,19 @@ class Player {
   Status feed(const uint8_t* data, size_t n);
   // The caller has no more bytes: ok if the stream ended (or was full).
   Status finish();
+
+  // The viewer's own frames, between the stream's: reads the controls
+  // (callbacks.steer) and, for a model whose base mesh is in, turns it
+  // round its up axis by their turn (the live window's mouse drag and
+  // Left/Right keys). When they turn it, draws the model as held from the
+  // new angle: shown (begin_frame, bands, end_frame) but not a frame of the
+  // stream (no frame_shown, no index, no frame_crc record). From then on
+  // the stream's frames are drawn turned the same and reported with
+  // PlayedFrame::steered. true when it drew a frame; false for other
+  // modes, before the base mesh, without a steer callback or an error.
+  // The client calls it while it waits for stream bytes, at most once a
+  // frame period.
+  bool view_input();
 
   // The most bytes feed() should take next so that no more than
   // `frames_room` frames complete (a caller with a bounded queue of frame
@@ -258,9 +277,13 @@ class Player {
   uint64_t enter_chunk();
   void leave_chunk();
   void restart_counts(uint64_t parse_from);
-  bool begin_frame();
+  // A viewer's frame (view_input): begin_frame(false) does not wait for a
+  // timed stream's schedule, end_frame(false) reports nothing.
+  bool begin_frame(bool stream_frame = true);
   bool band(const PixelRect& r);
-  bool end_frame();
+  bool end_frame(bool stream_frame = true);
+  // The stream's frames drawn from now on are the viewer's (view_input).
+  void mark_steered() { steered_ = true; }
   void add_decode(uint64_t n) { decode_total_ += n; }
   void add_display(uint64_t n) { display_total_ += n; }
   uint64_t display_total() const { return display_total_; }
@@ -292,6 +315,8 @@ class Player {
   MeshDecoder mesh;
   ModelView view;
   ModelFrames model_frames;
+  uint16_t model_angle = 0;  // the stream's angle of the last frame drawn (2^-16 turn)
+  uint16_t model_turn = 0;   // the viewer's turn added to it (view_input)
   bool model_started = false;
   struct ModelColors* colors = nullptr;  // decoder/src/player/mode_model.cpp
   struct VertexColours* vertex_colours = nullptr;  // the same
@@ -320,6 +345,7 @@ class Player {
   PlayedFrame at_start_{};  // the totals a frame's counts start from
   uint32_t frame_crc_ = 0;
   uint32_t frames_ = 0;
+  bool steered_ = false;
   bool timed_ = false;
   uint32_t preroll_ms_ = 0;
 };

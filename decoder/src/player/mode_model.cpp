@@ -68,6 +68,7 @@ bool start(Player& p, const StreamHeader&) {
   p.vertex_colours = nullptr;
   p.level_mark = 0;
   p.model_frames = ModelFrames{};
+  p.model_angle = p.model_turn = 0;
   return true;  // the decoder and the view are set up when MSHH arrives
 }
 
@@ -105,18 +106,26 @@ bool start_mesh(Player& p, const uint8_t* mshh, uint32_t size) {
   return true;
 }
 
-// Draws the current mesh (with its colours once they are in) as the next
-// frame, from `angle` (2^-16 turn), or the orbit's next one when negative.
-ChunkResult draw_frame(Player& p, int32_t angle = -1) {
-  if (!p.begin_frame()) return ChunkResult::abort;
+// Draws the current mesh (with its colours once they are in) into the
+// frame begun, from the stream's angle `model_angle` turned by the viewer's
+// `model_turn`.
+Status draw_model(Player& p) {
   const uint64_t display_before = p.display_total();
   const uint64_t d0 = p.work_clock();
-  const MeshColorsSurface* surface = p.model_colors();
-  const uint16_t at = angle >= 0 ? static_cast<uint16_t>(angle) : p.model_frames.angle();
-  const Status d = p.view.draw(p.mesh.mesh(), at, detail::render_band_to_player, &p, surface);
-  p.model_frames.mark_drawn(p.mesh);
+  const uint16_t at = static_cast<uint16_t>(p.model_angle + p.model_turn);
+  const Status d = p.view.draw(p.mesh.mesh(), at, detail::render_band_to_player, &p, p.model_colors());
   // Drawing counts as display: the bands have added their part, add the renderer's.
   p.add_display((p.work_clock() - d0) - (p.display_total() - display_before));
+  return d;
+}
+
+// The stream's next frame, from `angle` (2^-16 turn), or the orbit's next
+// one when negative.
+ChunkResult draw_frame(Player& p, int32_t angle = -1) {
+  if (!p.begin_frame()) return ChunkResult::abort;
+  p.model_angle = angle >= 0 ? static_cast<uint16_t>(angle) : p.model_frames.angle();
+  const Status d = draw_model(p);
+  p.model_frames.mark_drawn(p.mesh);
   if (d != Status::ok) {
     p.fail(d, "the model view could not draw");
     return ChunkResult::abort;
@@ -305,6 +314,22 @@ ChunkResult orbit(Player& p, const uint8_t* payload, uint32_t size) {
   return r;
 }
 
+// The viewer turns the model (Player::view_input): the controls' turn
+// (2^-16 turn) is added to the orbit angle of every frame drawn from now
+// on, and the model is drawn again at once, as a frame that is not the
+// stream's.
+bool view_input(Player& p) {
+  if (!p.model_started || !p.mesh.drawable() || p.mesh.mesh().triangles16() == nullptr) return false;
+  terrain::SteerInput in;
+  if (!p.callbacks().steer(p.callbacks().ctx, &in) || in.turn == 0) return false;
+  p.model_turn = static_cast<uint16_t>(p.model_turn + static_cast<uint16_t>(in.turn));
+  p.mark_steered();
+  if (!p.begin_frame(false)) return false;
+  const Status d = draw_model(p);
+  const bool closed = p.end_frame(false);  // the frame is closed even if the view could not draw it
+  return d == Status::ok && closed;
+}
+
 ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t size) {
   if (type == kModelOrbitChunk) return orbit(p, payload, size);
   if (type == mc::kChunkHeader || type == mc::kChunkLevel || type == mc::kChunkVertices)
@@ -376,7 +401,7 @@ int Player::model_colors_level() const {
 
 namespace detail {
 extern const PlayerMode kModelMode;
-const PlayerMode kModelMode{StreamMode::model, start, on_chunk, feed_limit};
+const PlayerMode kModelMode{StreamMode::model, start, on_chunk, feed_limit, view_input};
 }  // namespace detail
 
 }  // namespace vds

@@ -75,12 +75,14 @@ Status Player::init(Arena& arena, const PlayerConfig& config, const PlayerCallba
   at_start_ = PlayedFrame{};
   frame_crc_ = 0;
   frames_ = 0;
+  steered_ = false;
   timed_ = false;
   preroll_ms_ = 0;
   band_buffer = nullptr;
   image_ready = image_open = jpeg_ready = jpeg_open = jpeg_begun = false;
   level_mark = 0;
   model_frames = ModelFrames{};
+  model_angle = model_turn = 0;
   model_started = false;
   walk = nullptr;
   terrain = nullptr;
@@ -135,9 +137,9 @@ void Player::restart_counts(uint64_t parse_from) {
   at_start_.transform = stages_.spent[StageClock::transform];
 }
 
-bool Player::begin_frame() {
+bool Player::begin_frame(bool stream_frame) {
   frame_crc_ = 0;
-  if (timed_ && cb_.wait_until != nullptr) {
+  if (stream_frame && timed_ && cb_.wait_until != nullptr) {
     const uint64_t w0 = cb_.clock != nullptr ? cb_.clock(cb_.ctx) : 0;
     cb_.wait_until(cb_.ctx, due_ms(frames_));
     if (cb_.clock != nullptr) service_total_ += cb_.clock(cb_.ctx) - w0;
@@ -159,11 +161,13 @@ bool Player::band(const PixelRect& r) {
   return go;
 }
 
-bool Player::end_frame() {
+bool Player::end_frame(bool stream_frame) {
   const uint64_t t0 = work_clock();
   const bool go = cb_.end_frame == nullptr || cb_.end_frame(cb_.ctx, frame_crc_);
   display_total_ += work_clock() - t0;
+  if (!stream_frame) return go;
   PlayedFrame f;
+  f.steered = steered_;
   f.index = frames_;
   f.crc = frame_crc_;
   f.parse = parse_total_ - at_start_.parse;
@@ -193,6 +197,22 @@ Status Player::feed(const uint8_t* data, size_t n) {
 Status Player::finish() {
   if (full_ && parser_.status() == Status::more_input) return Status::ok;
   return parser_.finish();
+}
+
+bool Player::view_input() {
+  if (mode_ == nullptr || mode_->view_input == nullptr || cb_.steer == nullptr || is_error(mode_status_) ||
+      is_error(parser_.status()))
+    return false;
+  // A viewer's frame counts in no frame of the stream.
+  const uint64_t parse0 = parse_total_, decode0 = decode_total_, display0 = display_total_;
+  const uint64_t entropy0 = stages_.spent[StageClock::entropy], transform0 = stages_.spent[StageClock::transform];
+  const bool drew = mode_->view_input(*this);
+  at_start_.parse += parse_total_ - parse0;
+  at_start_.decode += decode_total_ - decode0;
+  at_start_.display += display_total_ - display0;
+  at_start_.entropy += stages_.spent[StageClock::entropy] - entropy0;
+  at_start_.transform += stages_.spent[StageClock::transform] - transform0;
+  return drew;
 }
 
 size_t Player::feed_limit(uint32_t frames_room) const {

@@ -45,6 +45,7 @@ struct Options {
   int contact_columns = 6;
   bool window = false;         // live window (SDL2)
   int window_scale = 2;
+  bool hold = false;           // after a model's stream, keep it in view until the window is closed
   std::string controls;        // a controls script (read_controls), instead of the window's keys
 };
 
@@ -250,6 +251,11 @@ bool read_controls(terrain::SteerInput* in) {
   return g_opt.window && g_window.controls(in);
 }
 
+bool viewer_present() {
+  if (!g_opt.controls.empty()) return g_control_next < g_script.size();
+  return g_opt.hold && g_opt.window && g_window.active();
+}
+
 size_t workspace_budget() { return g_opt.workspace; }
 
 int32_t host_file_read(const char* path, uint32_t offset, uint8_t* buf, uint32_t max) {
@@ -278,6 +284,8 @@ int main(int argc, char** argv) {
   app.add_flag("--window", g_opt.window, "Show the frames in a live window (SDL2)");
   app.add_option("--window-scale", g_opt.window_scale, "Window pixels per frame pixel")->check(CLI::Range(1, 8))
       ->capture_default_str();
+  app.add_flag("--hold", g_opt.hold,
+               "With --window: after a model's stream, keep the model in view (the viewer turns it) until the window is closed");
   app.add_option("--controls", g_opt.controls,
                  "The viewer's controls from a script instead of the window's keys: lines 'FRAMES FORWARD RIGHT UP TURN TILT [fast]'");
   CLI11_PARSE(app, argc, argv);

@@ -79,6 +79,12 @@ bool Window::show(const io::Image& rgb, uint32_t index) {
   return true;
 }
 
+bool Window::active() {
+  if (!impl_) return false;
+  impl_->pump();
+  return !impl_->closed;
+}
+
 bool Window::controls(terrain::SteerInput* in) {
   if (!impl_) return false;
   impl_->pump();
@@ -116,6 +122,8 @@ bool Window::open(int, int, int, std::string* error) {
 bool Window::show(const io::Image&, uint32_t) { return false; }
 
 bool Window::controls(terrain::SteerInput*) { return false; }
+
+bool Window::active() { return false; }
 
 #endif
 

@@ -20,6 +20,8 @@ class Window {
   // when it cannot (no SDL2 in this build, no display).
   bool open(int width, int height, int scale, std::string* error);
   bool is_open() const { return impl_ != nullptr; }
+  // Open and not closed by the user (reads the window's events).
+  bool active();
   // Shows a frame; false once the user has closed the window.
   bool show(const io::Image& rgb, uint32_t index);
   // The viewer's controls now: W/S or Up/Down forward and back, A/D to the

@@ -164,6 +164,7 @@ void log(const char* text) { semihost(kSysWrite0, text); }
 
 // No controls on this board: a flight script steers it.
 bool read_controls(terrain::SteerInput*) { return false; }
+bool viewer_present() { return false; }
 
 int32_t host_file_read(const char* path, uint32_t offset, uint8_t* buf, uint32_t max) {
   uint32_t len = 0;

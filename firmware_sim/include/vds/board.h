@@ -54,9 +54,13 @@ void display_begin_frame(uint16_t width, uint16_t height);
 void display_band(uint16_t y0, uint16_t rows, const uint16_t* rgb565, size_t stride_pixels);
 void display_end_frame(uint32_t frame_crc);
 
-// The viewer's controls (keys, a stick, a mouse), read once a frame: false
-// when the board has none or they do not move the viewer this frame.
+// The viewer's controls (keys, a stick, a mouse), read once a frame (a
+// terrain stream) or every viewer's poll (a model the viewer turns): false
+// when the board has none or they do not move the viewer this time.
 bool read_controls(terrain::SteerInput* in);
+// Whether a viewer is still there to steer (a live window open, controls
+// left in a script): a model stays in view for them after its stream.
+bool viewer_present();
 
 // The workspace budget of this run, bytes: the application must not use
 // more (a compile-time constant on hardware, an option on the host board).

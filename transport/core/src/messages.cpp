@@ -33,7 +33,7 @@ size_t encode(const FrameRecord& m, uint8_t out[kFrameRecordBytes]) {
   put32(p, m.transform_instructions);
   put32(p, m.display_instructions);
   put32(p, m.received_ms);
-  *p++ = m.late;
+  *p++ = static_cast<uint8_t>((m.late ? 1 : 0) | (m.steered ? 2 : 0));  // bit 0 late, bit 1 steered
   return kFrameRecordBytes;
 }
 
@@ -83,7 +83,9 @@ Status decode(const uint8_t* p, size_t n, FrameRecord* m) {
   m->transform_instructions = get32(p);
   m->display_instructions = get32(p);
   m->received_ms = get32(p);
-  m->late = *p;
+  if ((*p & ~3u) != 0) return Status::malformed;
+  m->late = *p & 1;
+  m->steered = (*p >> 1) & 1;
   return Status::ok;
 }
 

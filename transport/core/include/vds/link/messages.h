@@ -33,6 +33,7 @@ struct FrameRecord {
   uint32_t display_instructions; // band output and the frame CRC
   uint32_t received_ms;          // when its last byte arrived (board clock)
   uint8_t late;                  // 1 if it missed its presentation time
+  uint8_t steered = 0;           // 1 if drawn as the viewer turned it: a replay of the stream does not show it
 };
 constexpr size_t kFrameRecordBytes = 1 + 8 * 4 + 1;
 
