@@ -86,7 +86,9 @@ def main():
     fig.savefig(os.path.join(results, "model_rd.png"), dpi=90)
     head = ["## Summary: BD-rate of the mesh colors codecs on rendered-view PSNR", "",
             "mcc-vds is the improved codec (vds mode; its sample density follows the quality, "
-            "`density_for_quality`; at each quality the encoder draws its four choices of chroma lattice and face "
+            "`density_for_quality`, and no finer than the views show, 2 samples per pixel side where they come "
+            "nearest, `--samples-per-pixel`; its vertex samples in steps of half the quality, "
+            "`vertex_step_for_quality`; at each quality the encoder draws its four choices of chroma lattice and face "
             "resolutions from 5 views of its own and keeps the best, `choose_colours`: the choice is printed in "
             "`rendered.txt`), mcc-paper the thesis's (one sample per texel side, chroma on each level's own "
             "lattice). Bytes: the header and "

@@ -442,13 +442,21 @@ Status MeshColors::read_header(const uint8_t* data, size_t size, const Planes* v
   const uint32_t vertices = static_cast<uint32_t>(data[6] | (data[7] << 8));
   const uint32_t faces = static_cast<uint32_t>(data[8]) | (static_cast<uint32_t>(data[9]) << 8) |
                          (static_cast<uint32_t>(data[10]) << 16) | (static_cast<uint32_t>(data[11]) << 24);
-  if (max_res > kMaxResLog2 || (data[3] & ~(kFlagVertexColours | kFlagChromaHalf)) != 0 || q8 == 0 ||
+  if (max_res > kMaxResLog2 || (data[3] & ~(kFlagVertexColours | kFlagChromaHalf | kFlagVertexStep)) != 0 || q8 == 0 ||
       vertices != topo_.vertices ||
       faces != topo_.faces)
     return Status::malformed;
   const bool paper = data[1] == kModePaper;
   // The vertex samples: the colours that came with the vertices, or in here.
   const bool outside = (data[3] & kFlagVertexColours) != 0;
+  size_t at = kHeaderFixedBytes;
+  int32_t vertex_step = 1;
+  if ((data[3] & kFlagVertexStep) != 0) {
+    if (paper || outside) return Status::malformed;  // only the vds mode's own vertex samples have a step
+    if (size < at + 1) return Status::truncated;
+    vertex_step = data[at++];
+    if (vertex_step < 2 || vertex_step > kMaxVertexStep) return Status::malformed;
+  }
   if (outside) {
     if (vertex_colours == nullptr) return Status::malformed;  // no colours came with the vertices
     for (uint32_t v = 0; v < vertices; ++v)
@@ -456,10 +464,10 @@ Status MeshColors::read_header(const uint8_t* data, size_t size, const Planes* v
   }
   // The paper mode carries the vertex samples raw, before the coded part.
   const size_t vbytes = paper && !outside ? 3 * static_cast<size_t>(vertices) : 0;
-  if (size - kHeaderFixedBytes < vbytes) return Status::truncated;
-  for (size_t i = 0; i < vbytes; ++i) vertex_ycc_[i] = data[kHeaderFixedBytes + i];
+  if (size - at < vbytes) return Status::truncated;
+  for (size_t i = 0; i < vbytes; ++i) vertex_ycc_[i] = data[at + i];
   ArithDecoder dec;
-  Status s = dec.init(data + kHeaderFixedBytes + vbytes, size - kHeaderFixedBytes - vbytes);
+  Status s = dec.init(data + at + vbytes, size - at - vbytes);
   if (s != Status::ok) return s;
   ArithContext ctx[kMaxResLog2 + 1][kMaxResLog2];
   arith_init_contexts(&ctx[0][0], (kMaxResLog2 + 1) * kMaxResLog2);
@@ -473,7 +481,7 @@ Status MeshColors::read_header(const uint8_t* data, size_t size, const Planes* v
   }
   if (!paper && !outside) {
     // The vds mode codes each vertex sample as its difference from the
-    // prediction of the vertices before it (vertex_prediction).
+    // prediction of the vertices before it (vertex_prediction), in steps.
     const size_t mark = arena_->mark();
     Adjacency adj;
     s = build_adjacency(*arena_, topo_, &adj);
@@ -483,8 +491,9 @@ Status MeshColors::read_header(const uint8_t* data, size_t size, const Planes* v
     for (uint32_t v = 0; v < vertices && dec.ok(); ++v)
       for (int c = 0; c < 3; ++c) {
         const int cls = c == 0 ? 0 : 1;
-        const int32_t value = vertex_prediction(adj, vertex_ycc_, v, c) +
-                              dec.decode_signed(vx.zero[cls], vx.mag[cls], VertexContexts::kMagCtx, kDcCutoff, kDcOrder);
+        const int64_t value =
+            vertex_prediction(adj, vertex_ycc_, v, c) +
+            int64_t{dec.decode_signed(vx.zero[cls], vx.mag[cls], VertexContexts::kMagCtx, kDcCutoff, kDcOrder)} * vertex_step;
         if (value < 0 || value > 255) {
           arena_->rewind(mark);
           return Status::malformed;

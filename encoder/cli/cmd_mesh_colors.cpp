@@ -21,6 +21,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "anchors.h"
@@ -53,6 +54,7 @@ struct MeshColorsOptions {
   std::vector<std::string> codecs{"vds", "paper"};
   double deadzone = enc::MccOptions{}.deadzone;
   bool no_seam_boost = false;
+  double samples_per_pixel = 2;  // the vds codec's faces: no finer than a view of --size shows (0: no cap)
   ColourChoiceArgs colour;
 };
 
@@ -93,14 +95,23 @@ void run(const MeshColorsOptions& o) {
   // The mesh colors at each sample density used, converted once each.
   // Keyed by density and, for the vds codec's rate-distortion choice of face
   // resolutions, the quality (0: none).
-  std::map<std::pair<double, double>, enc::MeshColorsModel> converted;
-  auto colors = [&](double density, double rd_quality = 0) -> const enc::MeshColorsModel& {
-    auto it = converted.find({density, rd_quality});
+  // The vds codec's faces are no finer than the display shows: what the
+  // nearest surface of an orbit view of --size pixels covers (the model
+  // stream's rule, docs/model-mode.md); the thesis's keep the texel rule.
+  const std::vector<uint8_t> display_caps =
+      o.samples_per_pixel > 0
+          ? enc::display_face_caps(model.positions, model.triangles,
+                                   enc::orbit_nearest_px_per_unit(model.positions, o.size), o.samples_per_pixel)
+          : std::vector<uint8_t>{};
+  std::map<std::tuple<double, double, bool>, enc::MeshColorsModel> converted;
+  auto colors = [&](double density, double rd_quality = 0, bool capped = false) -> const enc::MeshColorsModel& {
+    auto it = converted.find({density, rd_quality, capped});
     if (it != converted.end()) return it->second;
     enc::MeshColorsOptions mo;
     mo.density = density;
     mo.max_res_log2 = o.max_res;
     mo.seam_boost = !o.no_seam_boost;
+    if (capped) mo.face_max_res = display_caps;
     enc::MeshColorsModel mcm;
     try {
       mcm = rd_quality > 0 ? enc::to_mesh_colors_rd(model, mo, rd_quality, options("vds"))
@@ -108,7 +119,8 @@ void run(const MeshColorsOptions& o) {
     } catch (const std::runtime_error& e) {
       throw Failure(kExitBadInput, e.what());
     }
-    std::printf("density %g%s: resolutions", density, rd_quality > 0 ? (", chosen for quality " + std::to_string(rd_quality)).c_str() : "");
+    std::printf("density %g%s%s: resolutions", density, rd_quality > 0 ? (", chosen for quality " + std::to_string(rd_quality)).c_str() : "",
+                capped && !display_caps.empty() ? ", no finer than the display" : "");
     std::vector<size_t> hist(mc::kMaxResLog2 + 1, 0);
     for (uint8_t r : mcm.face_res) ++hist[r];
     for (int r = 0; r <= mc::kMaxResLog2; ++r)
@@ -116,7 +128,7 @@ void run(const MeshColorsOptions& o) {
     std::printf("; samples per level");
     for (int m = 0; m <= mcm.max_res; ++m) std::printf(" %d: %u", m, mcm.samples(m));
     std::printf("\n");
-    return converted.emplace(std::make_pair(density, rd_quality), std::move(mcm)).first->second;
+    return converted.emplace(std::make_tuple(density, rd_quality, capped), std::move(mcm)).first->second;
   };
   // The vds codec's density follows the quality unless --density fixes it;
   // the thesis's codec keeps one sample per texel.
@@ -158,13 +170,14 @@ void run(const MeshColorsOptions& o) {
         mo.density = density;
         mo.max_res_log2 = o.max_res;
         mo.seam_boost = !o.no_seam_boost;
+        mo.face_max_res = display_caps;
         enc::ColourChoice choice = enc::choose_colours(model, mo, q, options(codec), choice_views, choice_reference);
         std::printf("quality %g: chroma %s, faces %s (%.2f dB in %zu bytes on the encoder's views)\n", q,
                     choice.chroma_half ? "from the next level" : "on its own level",
                     choice.coarser_faces ? "made coarser" : "at their texels' resolution", choice.psnr, choice.bytes);
         coded = Coded{std::move(choice.mc), std::move(choice.coded)};
       } else {
-        coded.mc = colors(density, rd_of(codec, q));
+        coded.mc = colors(density, rd_of(codec, q), codec == "vds");
         coded.e = enc::encode_mesh_colors(coded.mc, q, options(codec));
       }
       const Coded& entry = encoded.emplace(std::make_pair(codec, q), std::move(coded)).first->second;
@@ -294,6 +307,9 @@ void add_mesh_colors(CLI::App& app) {
       ->check(CLI::IsMember({"vds", "paper"}));
   c->add_option("--deadzone", o->deadzone, "vds codec: levels rounded down below 0.5 + this of a step")
       ->check(CLI::Range(0.0, 0.5));
+  c->add_option("--samples-per-pixel", o->samples_per_pixel,
+                "vds codec: a face's samples per pixel side at most, on the nearest surface of a view of --size (0: no cap)")
+      ->check(CLI::Range(0.0, 16.0));
   c->add_flag("--no-seam-boost", o->no_seam_boost, "keep faces on seams whose sides differ at their own resolution");
   add_colour_choice_options(c, &o->colour);
   c->add_option("--density", o->density,

@@ -14,6 +14,9 @@ namespace vds::enc {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+// vertex_step_for_quality: the vertex samples' step per unit of quality
+// (docs/model-mode.md, "Vertex samples").
+constexpr double kVertexStepPerQuality = 0.5;
 
 // The modified DCT-II of length n: out[0] the mean, out[k] = sum x_i cos(pi/n (i + 1/2) k).
 void forward_dct(const double* x, int n, double* out, int in_stride = 1, int out_stride = 1) {
@@ -392,6 +395,33 @@ struct Layout {
   mc::MeshColors mc;
 };
 
+// `model` with its vertex samples as a client reconstructs them from
+// differences coded in multiples of `step` (kFlagVertexStep): vertex by
+// vertex, each the prediction from the samples reconstructed before it
+// plus the nearest whole number of steps inside 0..255; the same samples
+// at every level.
+MeshColorsModel with_stepped_vertices(const MeshColorsModel& model, const mc::Topology& topo, int step) {
+  std::vector<uint8_t> scratch(mc::adjacency_bytes(topo.vertices, topo.edges));
+  Arena arena(scratch.data(), scratch.size());
+  mc::Adjacency adj;
+  if (mc::build_adjacency(arena, topo, &adj) != Status::ok) throw std::logic_error("mesh colors: adjacency");
+  MeshColorsModel out = model;
+  const uint32_t V = static_cast<uint32_t>(model.positions.size());
+  for (uint32_t v = 0; v < V; ++v)
+    for (int c = 0; c < 3; ++c) {
+      const int32_t p = mc::vertex_prediction(adj, out.vertex_ycc.data(), v, c);
+      const double r = (static_cast<double>(model.vertex_ycc[3 * v + c]) - p) / step;
+      int32_t k = static_cast<int32_t>(r < 0 ? -std::floor(-r + 0.5) : std::floor(r + 0.5));
+      while (p + k * step > 255) --k;
+      while (p + k * step < 0) ++k;
+      out.vertex_ycc[3 * v + c] = static_cast<uint8_t>(p + k * step);
+    }
+  for (auto& level : out.levels)
+    for (int c = 0; c < 3; ++c)
+      for (uint32_t v = 0; v < V; ++v) level[c][v] = out.vertex_ycc[3 * v + c];
+  return out;
+}
+
 void set_up(const MeshColorsModel& model, uint16_t q8, uint8_t mode, bool chroma_half, Layout& l) {
   const uint32_t F = static_cast<uint32_t>(model.face_res.size());
   const uint32_t V = static_cast<uint32_t>(model.positions.size());
@@ -410,29 +440,52 @@ namespace {
 MccEncoded encode_impl(const MeshColorsModel& model, double quality, const MccOptions& o, int only_level);
 }  // namespace
 
+MeshColorsModel with_stepped_vertex_samples(const MeshColorsModel& model, int step) {
+  if (step <= 1) return model;
+  Layout l;
+  set_up(model, 256, mc::kModeVds, false, l);
+  return with_stepped_vertices(model, l.mc.topology(), std::min(step, mc::kMaxVertexStep));
+}
+
+int vertex_step_for_quality(double quality) {
+  return static_cast<int>(std::clamp<long>(std::lround(kVertexStepPerQuality * quality), 1, mc::kMaxVertexStep));
+}
+
 MccEncoded encode_mesh_colors(const MeshColorsModel& model, double quality, const MccOptions& o) {
   return encode_impl(model, quality, o, -1);
 }
 
 namespace {
-MccEncoded encode_impl(const MeshColorsModel& model, double quality, const MccOptions& o, int only_level) {
+MccEncoded encode_impl(const MeshColorsModel& given, double quality, const MccOptions& o, int only_level) {
   const bool chroma_half = o.chroma_half;
   const uint16_t q8 = static_cast<uint16_t>(std::clamp<long>(std::lround(quality * 256), 1, 65535));
   const uint8_t mode = o.paper ? mc::kModePaper : mc::kModeVds;
+  const bool outside = o.vertex_colours_outside;
+  const int vertex_step =
+      o.paper || outside ? 1 : std::clamp(o.vertex_step > 0 ? o.vertex_step : vertex_step_for_quality(quality), 1, mc::kMaxVertexStep);
   Layout l, next;
-  set_up(model, q8, mode, chroma_half, l);
+  set_up(given, q8, mode, chroma_half, l);
+  // Lossy vertex samples: the model with the samples the client will
+  // reconstruct, coded from there on as if they were its own.
+  MeshColorsModel lossy;
+  if (vertex_step > 1) {
+    lossy = with_stepped_vertices(given, l.mc.topology(), vertex_step);
+    set_up(lossy, q8, mode, chroma_half, l);
+  }
+  const MeshColorsModel& model = vertex_step > 1 ? lossy : given;
   set_up(model, q8, mode, chroma_half, next);
   const uint32_t F = static_cast<uint32_t>(model.face_res.size());
   const uint32_t V = static_cast<uint32_t>(model.positions.size());
   MccEncoded out;
   std::vector<uint8_t>& h = out.header;
-  const bool outside = o.vertex_colours_outside;
-  const uint8_t flags = static_cast<uint8_t>((outside ? mc::kFlagVertexColours : 0) | (chroma_half ? mc::kFlagChromaHalf : 0));
+  const uint8_t flags = static_cast<uint8_t>((outside ? mc::kFlagVertexColours : 0) | (chroma_half ? mc::kFlagChromaHalf : 0) |
+                                             (vertex_step > 1 ? mc::kFlagVertexStep : 0));
   h = {mc::kVersion, mode, static_cast<uint8_t>(model.max_res), flags,
        static_cast<uint8_t>(q8 & 0xFF),
        static_cast<uint8_t>(q8 >> 8), static_cast<uint8_t>(V & 0xFF), static_cast<uint8_t>(V >> 8),
        static_cast<uint8_t>(F & 0xFF), static_cast<uint8_t>((F >> 8) & 0xFF), static_cast<uint8_t>((F >> 16) & 0xFF),
        static_cast<uint8_t>(F >> 24)};
+  if (vertex_step > 1) h.push_back(static_cast<uint8_t>(vertex_step));
   if (o.paper && !outside) h.insert(h.end(), model.vertex_ycc.begin(), model.vertex_ycc.end());
   ArithEncoder enc;
   ArithContext ctx[mc::kMaxResLog2 + 1][mc::kMaxResLog2];
@@ -454,7 +507,8 @@ MccEncoded encode_impl(const MeshColorsModel& model, double quality, const MccOp
     for (uint32_t v = 0; v < V; ++v)
       for (int c = 0; c < 3; ++c) {
         const int cls = c == 0 ? 0 : 1;
-        const int32_t r = model.vertex_ycc[3 * v + c] - mc::vertex_prediction(adj, model.vertex_ycc.data(), v, c);
+        // In steps: the lossy model's samples are the prediction plus whole steps.
+        const int32_t r = (model.vertex_ycc[3 * v + c] - mc::vertex_prediction(adj, model.vertex_ycc.data(), v, c)) / vertex_step;
         enc.encode_signed(vx.zero[cls], vx.mag[cls], mc::VertexContexts::kMagCtx, r, mc::kDcCutoff, mc::kDcOrder);
       }
   }

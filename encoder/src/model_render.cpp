@@ -89,9 +89,15 @@ Rgb bilinear(const Image& img, double u, double v) { return io::bilinear_repeat(
 
 }  // namespace
 
-ModelViews orbit_views(const std::vector<std::array<double, 3>>& positions, int count, int width, int height,
-                       int supersample, int up) {
-  if (positions.empty() || count < 1) throw std::invalid_argument("orbit_views: no positions or no views");
+namespace {
+
+// The orbit: round the centre of the bounds, framing the bounding sphere.
+constexpr double kOrbitFovDegrees = 40;
+struct Orbit {
+  ref::Vec3d centre;
+  double radius, distance;
+};
+Orbit orbit_of(const std::vector<std::array<double, 3>>& positions) {
   std::array<double, 3> lo = positions[0], hi = positions[0];
   for (const auto& p : positions)
     for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], p[k]), hi[k] = std::max(hi[k], p[k]);
@@ -100,8 +106,47 @@ ModelViews orbit_views(const std::vector<std::array<double, 3>>& positions, int 
   for (const auto& p : positions)
     radius = std::max(radius, std::hypot(p[0] - centre.x, p[1] - centre.y, p[2] - centre.z));
   if (radius <= 0) radius = 1;
-  const double fov = 40;
-  const double distance = radius / std::sin(fov / 2 * kPi / 180) * 1.05;
+  return Orbit{centre, radius, radius / std::sin(kOrbitFovDegrees / 2 * kPi / 180) * 1.05};
+}
+
+}  // namespace
+
+std::vector<uint8_t> display_face_caps(const std::vector<std::array<double, 3>>& positions,
+                                       const std::vector<std::array<uint32_t, 3>>& triangles, double px_per_unit,
+                                       double samples_per_pixel) {
+  std::vector<uint8_t> caps(triangles.size());
+  for (size_t f = 0; f < triangles.size(); ++f) {
+    const auto& a = positions[triangles[f][0]];
+    const auto& b = positions[triangles[f][1]];
+    const auto& c = positions[triangles[f][2]];
+    double e[2][3];
+    for (int k = 0; k < 3; ++k) {
+      e[0][k] = (b[k] - a[k]) * px_per_unit;
+      e[1][k] = (c[k] - a[k]) * px_per_unit;
+    }
+    const double cx = e[0][1] * e[1][2] - e[0][2] * e[1][1], cy = e[0][2] * e[1][0] - e[0][0] * e[1][2],
+                 cz = e[0][0] * e[1][1] - e[0][1] * e[1][0];
+    const double area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
+    const double samples = std::max(1.0, samples_per_pixel * std::sqrt(2 * area));
+    caps[f] = static_cast<uint8_t>(std::clamp(static_cast<int>(std::ceil(std::log2(samples) - 1e-9)), 0, mc::kMaxResLog2));
+  }
+  return caps;
+}
+
+double orbit_nearest_px_per_unit(const std::vector<std::array<double, 3>>& positions, int height) {
+  if (positions.empty() || height < 1) throw std::invalid_argument("orbit_nearest_px_per_unit: no positions or no pixels");
+  const Orbit o = orbit_of(positions);
+  const double focal = height / 2.0 / std::tan(kOrbitFovDegrees / 2 * kPi / 180);
+  return focal / std::max(o.distance - o.radius, o.distance * 0.01);
+}
+
+ModelViews orbit_views(const std::vector<std::array<double, 3>>& positions, int count, int width, int height,
+                       int supersample, int up) {
+  if (positions.empty() || count < 1) throw std::invalid_argument("orbit_views: no positions or no views");
+  const Orbit o = orbit_of(positions);
+  const ref::Vec3d centre = o.centre;
+  const double fov = kOrbitFovDegrees;
+  const double distance = o.distance;
   ModelViews v;
   v.width = width;
   v.height = height;

@@ -235,20 +235,10 @@ std::vector<uint8_t> display_caps(const TexturedModel& dm, const Quantisation& q
   }
   const double nearest = std::max(0.25, kModelViewDistanceQ16 / 65536.0 - radius);
   const double px_per_unit = std::max<int32_t>(h.height, kCameraMinFocalPx) / nearest;
-  std::vector<uint8_t> caps(dm.triangles.size());
-  for (size_t f = 0; f < dm.triangles.size(); ++f) {
-    // The face's area in pixels (a lattice of resolution R holds about R^2 / 2 samples).
-    double e[2][3];
-    for (int k = 0; k < 2; ++k)
-      for (int c = 0; c < 3; ++c)
-        e[k][c] = (double(grid[dm.triangles[f][k + 1]][c]) - grid[dm.triangles[f][0]][c]) * unit * px_per_unit;
-    const double cx = e[0][1] * e[1][2] - e[0][2] * e[1][1], cy = e[0][2] * e[1][0] - e[0][0] * e[1][2],
-                 cz = e[0][0] * e[1][1] - e[0][1] * e[1][0];
-    const double area = 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz);
-    const double samples = std::max(1.0, samples_per_pixel * std::sqrt(2 * area));
-    caps[f] = static_cast<uint8_t>(std::clamp(static_cast<int>(std::ceil(std::log2(samples) - 1e-9)), 0, mc::kMaxResLog2));
-  }
-  return caps;
+  std::vector<std::array<double, 3>> positions(grid.size());
+  for (size_t i = 0; i < grid.size(); ++i)
+    for (int a = 0; a < 3; ++a) positions[i][a] = grid[i][a] * unit;
+  return display_face_caps(positions, dm.triangles, px_per_unit, samples_per_pixel);
 }
 
 Colours colours_at(const TexturedModel& dm, const ModelStreamOptions& o, double quality, size_t max_chunk,

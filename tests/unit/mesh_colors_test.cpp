@@ -234,12 +234,34 @@ TEST(MeshColorsCodec, TheVdsModeRoundTripsWithinBoundsAndBeatsThePaperMode) {
     EXPECT_GE(p, min_psnr[qi]) << "quality " << quality[qi];
     if (!vds.empty()) EXPECT_LT(bytes, vds.back().first) << "quality " << quality[qi];
     vds.emplace_back(bytes, p);
-    // Vertex samples are coded losslessly, every level decodes.
+    // Vertex samples: losslessly with a step of 1, else within the step
+    // (to the nearest step but at the ends of 0..255), the same at every
+    // level; every level decodes.
+    enc::MccOptions lossless;
+    lossless.vertex_step = 1;
+    const enc::MccEncoded exact = enc::encode_mesh_colors(m, quality[qi], lossless);
+    EXPECT_EQ(exact.header[3] & mc::kFlagVertexStep, 0);
+    const int step = enc::vertex_step_for_quality(quality[qi]);
     const enc::MccEncoded e = enc::encode_mesh_colors(m, quality[qi]);
+    EXPECT_EQ((e.header[3] & mc::kFlagVertexStep) != 0, step > 1);
+    if (step > 1) {
+      EXPECT_EQ(e.header[mc::kHeaderFixedBytes], step);
+      EXPECT_LT(e.header.size(), exact.header.size()) << "quality " << quality[qi];
+    }
+    const auto lossy0 = enc::decode_mesh_colors_level(m, e, 0);
+    // The samples the encoder coded the levels from are the client's.
+    const enc::MeshColorsModel stepped = enc::with_stepped_vertex_samples(m, step);
+    for (int c = 0; c < 3; ++c)
+      for (size_t v = 0; v < m.positions.size(); ++v) ASSERT_EQ(lossy0[c][v], stepped.vertex_ycc[3 * v + c]);
     for (int level = 0; level < m.max_res; ++level) {
-      const auto planes = enc::decode_mesh_colors_level(m, e, level);
+      const auto planes = enc::decode_mesh_colors_level(m, exact, level);
+      const auto lossy = enc::decode_mesh_colors_level(m, e, level);
       for (int c = 0; c < 3; ++c)
-        for (size_t v = 0; v < m.positions.size(); ++v) ASSERT_EQ(planes[c][v], m.levels[level][c][v]);
+        for (size_t v = 0; v < m.positions.size(); ++v) {
+          ASSERT_EQ(planes[c][v], m.levels[level][c][v]);
+          ASSERT_LE(std::abs(lossy[c][v] - m.levels[level][c][v]), step);
+          ASSERT_EQ(lossy[c][v], lossy0[c][v]);
+        }
     }
   }
   // Every paper-mode point is beaten: some vds point has no more bytes and a higher PSNR.
@@ -412,6 +434,34 @@ TEST(MeshColorsCodec, HeadersAClientCannotTakeAreRefused) {
   EXPECT_EQ(with(2, 11), Status::malformed);  // above kMaxResLog2
   EXPECT_TRUE(is_error(with(2, 4)));         // not the largest face's (the codes end early)
   EXPECT_EQ(with(3, 1), Status::malformed);  // flags
+  EXPECT_EQ(with(3, mc::kFlagVertexStep), Status::malformed);  // a step for the paper mode's raw samples
+  EXPECT_EQ(with(3, 8), Status::malformed);  // no such flag
+  // A vds header with a vertex step: the step must be 2..kMaxVertexStep.
+  {
+    enc::MccOptions stepped;
+    stepped.vertex_step = 4;
+    const enc::MccEncoded v = enc::encode_mesh_colors(m, 1, stepped);
+    ASSERT_EQ(v.header[3] & mc::kFlagVertexStep, mc::kFlagVertexStep);
+    ASSERT_EQ(v.header[mc::kHeaderFixedBytes], 4);
+    ASSERT_EQ(h.mc.read_header(v.header.data(), v.header.size()), Status::ok);
+    for (uint8_t bad : {uint8_t{0}, uint8_t{1}, static_cast<uint8_t>(mc::kMaxVertexStep + 1), uint8_t{255}}) {
+      std::vector<uint8_t> b = v.header;
+      b[mc::kHeaderFixedBytes] = bad;
+      EXPECT_EQ(h.mc.read_header(b.data(), b.size()), Status::malformed) << int{bad};
+    }
+    std::vector<uint8_t> cut(v.header.begin(), v.header.begin() + mc::kHeaderFixedBytes);
+    EXPECT_EQ(h.mc.read_header(cut.data(), cut.size()), Status::truncated);
+    // Every sample a whole number of steps from its prediction: another step reads other samples.
+    std::vector<uint8_t> b = v.header;
+    b[mc::kHeaderFixedBytes] = 5;
+    const Status other = h.mc.read_header(b.data(), b.size());
+    if (other == Status::ok) {
+      Held again;
+      ASSERT_EQ(again.init(m.triangles, static_cast<uint32_t>(m.positions.size())), Status::ok);
+      ASSERT_EQ(again.mc.read_header(v.header.data(), v.header.size()), Status::ok);
+      EXPECT_FALSE(std::equal(h.mc.vertex_samples(), h.mc.vertex_samples() + 3 * m.positions.size(), again.mc.vertex_samples()));
+    }
+  }
   std::vector<uint8_t> zero_quality = e.header;
   zero_quality[4] = zero_quality[5] = 0;
   EXPECT_EQ(h.mc.read_header(zero_quality.data(), zero_quality.size()), Status::malformed);

@@ -223,13 +223,16 @@ constexpr uint32_t kNzCutoff = 6;
 constexpr int kNzOrder = 1;
 
 // --- The header chunk (MCLH) ------------------------------------------------
-//   u8 version (1), u8 mode (0 = paper, 1 = vds), u8 max_res_log2 (0..10), u8 flags (kFlagVertexColours | kFlagChromaHalf),
+//   u8 version (1), u8 mode (0 = paper, 1 = vds), u8 max_res_log2 (0..10),
+//   u8 flags (kFlagVertexColours | kFlagChromaHalf | kFlagVertexStep),
 //   u16 quality factor x 256 (>= 1), u16 vertices, u32 faces,
+//   with kFlagVertexStep: u8 the vertex samples' step (2..kMaxVertexStep);
 //   paper mode, unless kFlagVertexColours: vertices x 3 bytes, every vertex's Y', Cb, Cr;
 //   arithmetic coded: the faces' resolution exponents, face f's as a
 //   truncated unary code (max max_res_log2) in the contexts of face f - 1's;
 //   vds mode, unless kFlagVertexColours: then every vertex's Y', Cb, Cr as
-//   signed differences from vertex_prediction (vertices in order).
+//   signed differences from vertex_prediction (vertices in order), in
+//   multiples of the step (1 without kFlagVertexStep).
 constexpr uint32_t kChunkVertices = fourcc('M', 'C', 'V', 'X');  // after the base and each split level
 constexpr uint32_t kChunkHeader = fourcc('M', 'C', 'L', 'H');  // after the mesh's last level
 constexpr uint32_t kChunkLevel = fourcc('M', 'C', 'L', 'V');   // one MIP level, coarsest first
@@ -244,6 +247,11 @@ constexpr uint8_t kFlagVertexColours = 1;
 // (Taskin section 2.3: chroma from MIP level 1). Per element the level's
 // luma blocks come first, then the chroma blocks (Cb, Cr each block).
 constexpr uint8_t kFlagChromaHalf = 2;
+// MCLH flags (vds mode, its own vertex samples only): the vertex samples'
+// differences from their predictions are multiples of a step, a u8 after
+// the fixed bytes: the samples are lossy, as the blocks' means are.
+constexpr uint8_t kFlagVertexStep = 4;
+constexpr int kMaxVertexStep = 64;
 // The components of each element of a level in MCLV order, group by group:
 // components [first, end) on the lattice `shift` levels coarser.
 struct ComponentGroup {

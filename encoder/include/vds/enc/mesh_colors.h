@@ -151,7 +151,19 @@ struct MccOptions {
   // about a quarter of the chroma samples (choose_colours measures whether
   // it pays).
   bool chroma_half = false;
+  // vds mode, vertex samples in MCLH: their differences from the
+  // predictions are coded in multiples of this step (vds::mc::kFlagVertexStep;
+  // 1: lossless; 0: vertex_step_for_quality).
+  int vertex_step = 0;
 };
+
+// The vds encoder's vertex sample step at quality factor q (MccOptions::
+// vertex_step): the vertex samples are lossy as the blocks' means are.
+int vertex_step_for_quality(double quality);
+// `mc` with its vertex samples as a client reconstructs them from
+// differences coded in steps of `step` (what the vds mode codes the levels
+// from; step 1: mc itself).
+MeshColorsModel with_stepped_vertex_samples(const MeshColorsModel& mc, int step);
 
 
 // Every level of `mc` at quality factor `quality` (the JPEG tables'

@@ -29,6 +29,17 @@ struct ModelViews {
 ModelViews orbit_views(const std::vector<std::array<double, 3>>& positions, int count, int width, int height,
                        int supersample, int up = 1);
 
+// The largest resolution exponent each face can show on a display of
+// `px_per_unit` pixels per model unit: R for R^2 / 2 samples over the
+// face's area in pixels (facing the camera), times samples_per_pixel, to
+// the next power of two (docs/model-mode.md, "No finer than the display").
+std::vector<uint8_t> display_face_caps(const std::vector<std::array<double, 3>>& positions,
+                                       const std::vector<std::array<uint32_t, 3>>& triangles, double px_per_unit,
+                                       double samples_per_pixel);
+// Pixels per model unit where an orbit view (orbit_views) of `height`
+// pixels comes nearest the model: on its bounding sphere, facing the camera.
+double orbit_nearest_px_per_unit(const std::vector<std::array<double, 3>>& positions, int height);
+
 // One view of the model: RGB and a coverage mask (255 where the model is).
 struct ModelFrame {
   Image rgb;
