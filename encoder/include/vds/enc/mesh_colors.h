@@ -140,7 +140,7 @@ struct MccOptions {
   // position (the image codec's scheme, docs/texture-codec.md).
   bool paper = false;
   // vds mode: AC levels rounded down below 0.5 + deadzone of a step.
-  double deadzone = 0.35;
+  double deadzone = 0.2;
   // The largest MCLV payload (a client's chunk buffer); 0: a level in one chunk.
   size_t max_chunk = 0;
   // The vertex samples travel with the vertices (MCVX), not in MCLH
