@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -176,8 +177,11 @@ BoardResult run_on_board(const BoardArgs& a, const std::string& name, const Serv
     }
   }
   BoardResult out;
-  // With a live window the board keeps a model in view until the viewer closes it.
-  out.status = board.finish(a.window ? 1e9 : 60);
+  // With a viewer (a live window, a controls script) the board keeps a
+  // model in view for them: until the window is closed or the script ends,
+  // within --timeout.
+  const bool viewer = host && (a.window || !a.controls.empty());
+  out.status = board.finish(viewer ? std::max<double>(60, a.timeout) : 60);
   out.report = r;
   out.options = o;
   out.dir = dir;
@@ -195,14 +199,18 @@ void check_board_frames(const BoardArgs& a, const std::string& name, const Board
   print_serve_report(name, o, r);
   std::string crcs;
   size_t same = 0, steered = 0;
+  // A frame drawn as the viewer turned the model is not the stream's alone:
+  // not compared, where there is a viewer (the host board's window or
+  // controls script), and only from the first such frame on (once turned,
+  // every later frame is).
+  const bool viewer = host && (a.window || !a.controls.empty());
   for (size_t i = 0; i < r.frames.size(); ++i) {
     char line[24];
     std::snprintf(line, sizeof line, "%08x%s\n", r.frames[i].crc, r.frames[i].steered ? " steered" : "");
     crcs += line;
-    // A frame drawn as the viewer turned the model is not the stream's alone: not compared.
-    if (r.frames[i].steered && r.frames[i].index == i)
+    if (viewer && r.frames[i].steered && r.frames[i].index == i && (steered > 0 || same == i))
       ++steered;
-    else if (i < want.size() && r.frames[i].index == i && r.frames[i].crc == want[i])
+    else if (steered == 0 && i < want.size() && r.frames[i].index == i && r.frames[i].crc == want[i])
       ++same;
   }
   enc::write_file((dir / "crcs.txt").string(), std::span(reinterpret_cast<const uint8_t*>(crcs.data()), crcs.size()));

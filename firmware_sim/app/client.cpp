@@ -374,7 +374,10 @@ extern "C" int vds_app_main() {
   }
   // A model stays in view while a viewer is there to turn it (the host
   // board's live window until it is closed, a controls script until it ends).
-  if (g.player.have_header() && g.player.header().mode == vds::StreamMode::model && board::viewer_present()) {
+  // Only a model the stream showed whole: else nothing reads the controls.
+  const bool shown = g.player.have_header() && g.player.header().mode == vds::StreamMode::model &&
+                     !vds::is_error(g.stream_status) && g.player.frames_shown() > 0;
+  if (shown && board::viewer_present()) {
     board::log("client: the model stays in view for the viewer\n");
     uint32_t viewer_frames = 0;
     while (board::viewer_present()) {

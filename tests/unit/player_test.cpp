@@ -543,6 +543,39 @@ TEST(Player, TheViewerTurnsAModelBetweenTheStreamsFrames) {
     }
     EXPECT_EQ(viewer.reported.back().crc, want[orbit]) << "7/8 + 1/8 turn";
   }
+  // Turned and turned back between any two pieces of a stream whose levels
+  // come in several chunks: a viewer's frame at the stream's own angle is
+  // the stream's last frame, never a level half decoded or a mesh whose
+  // colours have not come; the stream's frames are the replay's.
+  {
+    vds::enc::ModelStreamOptions small = o;
+    small.codec.max_chunk = 512;
+    small.mesh.max_chunk_payload = 512;
+    const vds::enc::ModelStreamResult rs = vds::enc::encode_model_stream(vds::enc::load_textured_model(box), small);
+    const std::vector<uint32_t> crcs = vds::enc::client_frame_crcs(rs.stream);
+    Viewer viewer;
+    v = &viewer;
+    vds::Arena arena(ws.data(), ws.size());
+    vds::Player p;
+    ASSERT_EQ(p.init(arena, vds::kClientPlayerConfig, cb), Status::ok);
+    Status st = Status::more_input;
+    size_t checked = 0;
+    for (size_t at = 0; at < rs.stream.size() && st == Status::more_input; at += 16) {
+      st = p.feed(rs.stream.data() + at, std::min<size_t>(16, rs.stream.size() - at));
+      viewer.turn = 16384;
+      p.view_input();
+      viewer.turn = -16384;
+      if (p.view_input()) {
+        ASSERT_FALSE(viewer.reported.empty());
+        EXPECT_EQ(viewer.shown.back(), viewer.reported.back().crc) << "at byte " << at;
+        ++checked;
+      }
+    }
+    ASSERT_EQ(st, Status::ok);
+    ASSERT_EQ(viewer.reported.size(), crcs.size());
+    for (size_t i = 0; i < crcs.size(); ++i) EXPECT_EQ(viewer.reported[i].crc, crcs[i]) << i;
+    EXPECT_GT(checked, crcs.size());
+  }
   // Other modes have no viewer's frames.
   {
     Viewer viewer;

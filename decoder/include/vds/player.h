@@ -225,9 +225,11 @@ class Player {
   // stream (no frame_shown, no index, no frame_crc record). From then on
   // the stream's frames are drawn turned the same and reported with
   // PlayedFrame::steered. true when it drew a frame; false for other
-  // modes, before the base mesh, without a steer callback or an error.
-  // The client calls it while it waits for stream bytes, at most once a
-  // frame period.
+  // modes, before the base mesh, without a steer callback or an error, and
+  // while the model holds what the stream has not shown yet (a level
+  // whose colours follow, a colour level half decoded): the stream's next
+  // frame shows the turn then. The client calls it while it waits for
+  // stream bytes (every 50 ms on the boards).
   bool view_input();
 
   // The most bytes feed() should take next so that no more than

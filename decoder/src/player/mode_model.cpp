@@ -317,13 +317,18 @@ ChunkResult orbit(Player& p, const uint8_t* payload, uint32_t size) {
 // The viewer turns the model (Player::view_input): the controls' turn
 // (2^-16 turn) is added to the orbit angle of every frame drawn from now
 // on, and the model is drawn again at once, as a frame that is not the
-// stream's.
+// stream's, when what it holds is what the stream last showed (not a
+// level whose colours have not come yet, nor a colour level half decoded
+// over the one shown): else the stream's next frame shows the turn.
 bool view_input(Player& p) {
   if (!p.model_started || !p.mesh.drawable() || p.mesh.mesh().triangles16() == nullptr) return false;
   terrain::SteerInput in;
   if (!p.callbacks().steer(p.callbacks().ctx, &in) || in.turn == 0) return false;
   p.model_turn = static_cast<uint16_t>(p.model_turn + static_cast<uint16_t>(in.turn));
   p.mark_steered();
+  const bool shown = !p.model_frames.due(p.mesh) &&
+                     (p.colors == nullptr || p.colors->mc.decoding_level() < 0 || p.colors->mc.level_complete());
+  if (!shown) return false;
   if (!p.begin_frame(false)) return false;
   const Status d = draw_model(p);
   const bool closed = p.end_frame(false);  // the frame is closed even if the view could not draw it
