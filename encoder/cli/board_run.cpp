@@ -180,8 +180,7 @@ BoardResult run_on_board(const BoardArgs& a, const std::string& name, const Serv
   // With a viewer (a live window, a controls script) the board keeps a
   // model in view for them: until the window is closed or the script ends,
   // within --timeout.
-  const bool viewer = host && (a.window || !a.controls.empty());
-  out.status = board.finish(viewer ? std::max<double>(60, a.timeout) : 60);
+  out.status = board.finish(a.has_viewer() ? std::max<double>(60, a.timeout) : 60);
   out.report = r;
   out.options = o;
   out.dir = dir;
@@ -203,7 +202,7 @@ void check_board_frames(const BoardArgs& a, const std::string& name, const Board
   // not compared, where there is a viewer (the host board's window or
   // controls script), and only from the first such frame on (once turned,
   // every later frame is).
-  const bool viewer = host && (a.window || !a.controls.empty());
+  const bool viewer = a.has_viewer();
   for (size_t i = 0; i < r.frames.size(); ++i) {
     char line[24];
     std::snprintf(line, sizeof line, "%08x%s\n", r.frames[i].crc, r.frames[i].steered ? " steered" : "");

@@ -21,6 +21,8 @@ struct BoardArgs {
   uint32_t timeout = 600;
   bool window = false;
   std::string controls;  // host board: a controls script (the viewer's keys, scripted)
+  // A viewer who may turn a model: the host board with its window or a controls script.
+  bool has_viewer() const { return board == "host" && (window || !controls.empty()); }
 };
 
 struct BoardResult {

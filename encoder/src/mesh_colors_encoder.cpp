@@ -395,23 +395,27 @@ struct Layout {
   mc::MeshColors mc;
 };
 
+// Every vertex's neighbours (vds::mc::vertex_prediction's), in `scratch`.
+mc::Adjacency vertex_neighbours(const mc::Topology& topo, std::vector<uint8_t>& scratch) {
+  scratch.assign(mc::adjacency_bytes(topo.vertices, topo.edges), 0);
+  Arena arena(scratch.data(), scratch.size());
+  mc::Adjacency adj;
+  if (mc::build_adjacency(arena, topo, &adj) != Status::ok) throw std::logic_error("mesh colors: adjacency");
+  return adj;
+}
+
 // `model` with its vertex samples as a client reconstructs them from
 // differences coded in multiples of `step` (kFlagVertexStep): vertex by
 // vertex, each the prediction from the samples reconstructed before it
 // plus the nearest whole number of steps inside 0..255; the same samples
 // at every level.
-MeshColorsModel with_stepped_vertices(const MeshColorsModel& model, const mc::Topology& topo, int step) {
-  std::vector<uint8_t> scratch(mc::adjacency_bytes(topo.vertices, topo.edges));
-  Arena arena(scratch.data(), scratch.size());
-  mc::Adjacency adj;
-  if (mc::build_adjacency(arena, topo, &adj) != Status::ok) throw std::logic_error("mesh colors: adjacency");
+MeshColorsModel with_stepped_vertices(const MeshColorsModel& model, const mc::Adjacency& adj, int step) {
   MeshColorsModel out = model;
   const uint32_t V = static_cast<uint32_t>(model.positions.size());
   for (uint32_t v = 0; v < V; ++v)
     for (int c = 0; c < 3; ++c) {
       const int32_t p = mc::vertex_prediction(adj, out.vertex_ycc.data(), v, c);
-      const double r = (static_cast<double>(model.vertex_ycc[3 * v + c]) - p) / step;
-      int32_t k = static_cast<int32_t>(r < 0 ? -std::floor(-r + 0.5) : std::floor(r + 0.5));
+      int32_t k = static_cast<int32_t>(std::lround((static_cast<double>(model.vertex_ycc[3 * v + c]) - p) / step));
       while (p + k * step > 255) --k;
       while (p + k * step < 0) ++k;
       out.vertex_ycc[3 * v + c] = static_cast<uint8_t>(p + k * step);
@@ -444,7 +448,8 @@ MeshColorsModel with_stepped_vertex_samples(const MeshColorsModel& model, int st
   if (step <= 1) return model;
   Layout l;
   set_up(model, 256, mc::kModeVds, false, l);
-  return with_stepped_vertices(model, l.mc.topology(), std::min(step, mc::kMaxVertexStep));
+  std::vector<uint8_t> scratch;
+  return with_stepped_vertices(model, vertex_neighbours(l.mc.topology(), scratch), std::min(step, mc::kMaxVertexStep));
 }
 
 int vertex_step_for_quality(double quality) {
@@ -465,11 +470,15 @@ MccEncoded encode_impl(const MeshColorsModel& given, double quality, const MccOp
       o.paper || outside ? 1 : std::clamp(o.vertex_step > 0 ? o.vertex_step : vertex_step_for_quality(quality), 1, mc::kMaxVertexStep);
   Layout l, next;
   set_up(given, q8, mode, chroma_half, l);
+  // The vds mode's own vertex samples are coded from their neighbours'.
+  std::vector<uint8_t> scratch;
+  const bool coded_vertices = !o.paper && !outside;
+  const mc::Adjacency adj = coded_vertices ? vertex_neighbours(l.mc.topology(), scratch) : mc::Adjacency{};
   // Lossy vertex samples: the model with the samples the client will
   // reconstruct, coded from there on as if they were its own.
   MeshColorsModel lossy;
   if (vertex_step > 1) {
-    lossy = with_stepped_vertices(given, l.mc.topology(), vertex_step);
+    lossy = with_stepped_vertices(given, adj, vertex_step);
     set_up(lossy, q8, mode, chroma_half, l);
   }
   const MeshColorsModel& model = vertex_step > 1 ? lossy : given;
@@ -496,12 +505,7 @@ MccEncoded encode_impl(const MeshColorsModel& given, double quality, const MccOp
       enc.encode_unary(ctx[prev], mc::kMaxResLog2, model.face_res[f], static_cast<uint32_t>(model.max_res));
       prev = model.face_res[f];
     }
-  if (!o.paper && !outside) {
-    const mc::Topology& topo = l.mc.topology();
-    std::vector<uint8_t> scratch(mc::adjacency_bytes(topo.vertices, topo.edges));
-    Arena arena(scratch.data(), scratch.size());
-    mc::Adjacency adj;
-    if (mc::build_adjacency(arena, topo, &adj) != Status::ok) throw std::logic_error("mesh colors: adjacency");
+  if (coded_vertices) {
     mc::VertexContexts vx;
     vx.reset();
     for (uint32_t v = 0; v < V; ++v)

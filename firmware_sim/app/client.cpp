@@ -159,6 +159,14 @@ void notice(void*, vds::PlayerNotice what, uint32_t a, uint32_t b, uint32_t c) {
   board::log(l.c_str());
 }
 
+// Lets the player read the viewer's controls, once kViewerPollMs have passed
+// since it last did: true when it drew a frame for them.
+bool poll_viewer(uint32_t now) {
+  if (now - g.viewer_polled_ms < kViewerPollMs) return false;
+  g.viewer_polled_ms = now;
+  return g.player.view_input();  // a model the viewer turns is drawn again for them
+}
+
 // (Re)starts the per-stream state above the link's buffers.
 Status start_stream() {
   g.arena.rewind(g.stream_mark);
@@ -334,10 +342,7 @@ extern "C" int vds_app_main() {
       if (g.stream_bytes != 0 && start_stream() != Status::ok) return 3;
     }
     feed_stream();
-    if (now - g.viewer_polled_ms >= kViewerPollMs) {
-      g.viewer_polled_ms = now;
-      g.player.view_input();  // a model the viewer turns is drawn again for them
-    }
+    poll_viewer(now);
     send_messages(now);
     read_control();
     const size_t m = g.link.transmit(tx, sizeof tx, now);
@@ -382,12 +387,10 @@ extern "C" int vds_app_main() {
     uint32_t viewer_frames = 0;
     while (board::viewer_present()) {
       const uint32_t now = board::millis();
-      if (now - g.viewer_polled_ms < kViewerPollMs) {
+      if (now - g.viewer_polled_ms < kViewerPollMs)
         board::wait_for_event(kViewerPollMs - (now - g.viewer_polled_ms));
-        continue;
-      }
-      g.viewer_polled_ms = now;
-      if (g.player.view_input()) ++viewer_frames;
+      else if (poll_viewer(now))
+        ++viewer_frames;
     }
     board::log(Line().str("client: the viewer has gone, ").dec(viewer_frames).str(" frames drawn for them after the stream\n").c_str());
   }
