@@ -5,6 +5,7 @@
 // b y + c) / (g x + h y + i) is rational linear interpolation (Heckbert,
 // "Fundamentals of texture mapping and image warping", 1989); the
 // fixed-point scaling is in docs/renderer.md.
+#include <cstddef>
 #include <type_traits>
 
 #include "colour.h"
@@ -248,11 +249,16 @@ struct BilinearBlend : TexSampler {
   // bits (Q16: the affine runs' steps); the same texels and weights as
   // sample(t, u >> 8, v >> 8).
   static constexpr bool kChromaMemo = TF == TexFormat::ycbcr420 && kNearestChroma && A == Addr::inside;
+  // rgb565: each channel's part of kPack565 moved by its term, indexed by
+  // Y' alone (one load a channel: no addition, no table base register).
   struct ChromaMemo {
     uint32_t ci = ~0u;
     Channels terms{};
+    const uint16_t* r565 = nullptr;
+    const uint16_t* g565 = nullptr;
+    const uint16_t* b565 = nullptr;
   };
-  static OutColor<O> sample_q16(const TexCtx& t, ChromaMemo& m, int32_t u, int32_t v)
+  [[gnu::always_inline]] static OutColor<O> sample_q16(const TexCtx& t, ChromaMemo& m, int32_t u, int32_t v)
     requires kChromaMemo
   {
     const int32_t i0 = u >> 16, j0 = v >> 16;
@@ -263,14 +269,17 @@ struct BilinearBlend : TexSampler {
     const uint32_t ci = static_cast<uint32_t>((v + 32768) >> 17) * t.cstride + static_cast<uint32_t>((u + 32768) >> 17);
     if (ci != m.ci) {
       m.ci = ci;
-      m.terms = chroma_terms(t.cb[ci], t.cr[ci]);
+      const Channels terms = chroma_terms(t.cb[ci], t.cr[ci]);
       if constexpr (O == PixelFormat::rgb565) {
-        m.terms.g += kPack565Channel;
-        m.terms.b += 2 * kPack565Channel;
+        m.r565 = kPack565.v + terms.r;
+        m.g565 = kPack565.v + kPack565Channel + terms.g;
+        m.b565 = kPack565.v + 2 * kPack565Channel + terms.b;
+      } else {
+        m.terms = terms;
       }
     }
     if constexpr (O == PixelFormat::rgb565) {
-      return static_cast<uint16_t>(kPack565.v[yy + m.terms.r] | kPack565.v[yy + m.terms.g] | kPack565.v[yy + m.terms.b]);
+      return static_cast<uint16_t>(m.r565[yy] | m.g565[yy] | m.b565[yy]);
     } else {
       return from8888<O>(terms_to_8888(yy, m.terms));
     }
@@ -854,7 +863,7 @@ struct MemoOf<S, true> {
 // kTextureMaxSize 2^8 = 2^20 with 8 fraction bits); a point beyond it (far
 // outside the texture, where its clamps give the edge's texels; a
 // repeating texture's 8,192nd copy) is held at the limit.
-constexpr int32_t kAffineRun = 8;
+constexpr int32_t kAffineRun = 16;
 constexpr int32_t kAffineLimit = 1 << 21;
 // The homography's numerators and divisor where a run starts, and the
 // exact point there.
@@ -902,6 +911,146 @@ inline int32_t hold_affine(int32_t x) { return x < -kAffineLimit ? -kAffineLimit
   run_to(a, n, u1, v1, su, sv, du, dv);
 }
 
+// The walkthrough's pixels on Thumb-2 (Cortex-M3/M4/M7): the loop of
+// affine_pixels for Y'CbCr 4:2:0 views sampled inside (bilinear luma, the
+// chroma texel memo) into rgb565 with 16-bit depth, written out because the
+// compiler, allocating the loop's 17 values to 14 registers, reloads about
+// 11 of them from the stack each pixel. The same pixels as the C++ loop
+// (the boards' frame CRCs equal the host's replay: the end-to-end tests).
+#if defined(__arm__) && defined(__thumb2__)
+#define VDS_VIEW_RUN_ASM 1
+// A run's state: the cold words are copied to the stack, the hot ones held
+// in r0-r9 (in this order) and written back at the end.
+struct ViewRun {
+  // cold
+  int32_t du, dv, dq;
+  uint16_t* zlast;  // the run's last depth entry
+  uintptr_t delta;  // colour address less depth address
+  uint32_t cstride;
+  const uint8_t* cb;
+  const uint8_t* cr;
+  const ChromaTables* chroma;
+  const uint16_t* pack;
+  // hot
+  int32_t su, sv;
+  uint16_t* z;  // the depth entry before the run's next pixel
+  int32_t q;
+  const uint8_t* y;
+  uint32_t stride;
+  uint32_t key;  // the chroma texel of r565..b565: row << 16 | column (~0: none)
+  const uint16_t* r565;
+  const uint16_t* g565;
+  const uint16_t* b565;
+};
+static_assert(offsetof(ViewRun, du) == 0 && offsetof(ViewRun, zlast) == 12 && offsetof(ViewRun, delta) == 16 &&
+              offsetof(ViewRun, cstride) == 20 && offsetof(ViewRun, cb) == 24 && offsetof(ViewRun, cr) == 28 &&
+              offsetof(ViewRun, chroma) == 32 && offsetof(ViewRun, pack) == 36 && offsetof(ViewRun, su) == 40 &&
+              offsetof(ViewRun, b565) == 76);
+static_assert(offsetof(ChromaTables, r) == 0 && offsetof(ChromaTables, b) == 512 && offsetof(ChromaTables, g_cb) == 1024 &&
+              offsetof(ChromaTables, g_cr) == 2048 && colour::kFracBits == 16 && kPack565Channel == 768 &&
+              kDepth16Shift == 14);
+[[gnu::naked, gnu::noinline]] void view_run(ViewRun*) {
+  __asm__ volatile(
+      ".syntax unified\n\t"
+      "push   {r4-r11, lr}\n\t"
+      "sub    sp, sp, #48\n\t"
+      "str    r0, [sp, #40]\n\t"
+      "ldmia  r0!, {r1-r10}\n\t"  // the cold words to [sp, #0..36]
+      "stmia  sp, {r1-r10}\n\t"
+      "ldmia  r0, {r0-r9}\n\t"  // su sv z q y stride key r565 g565 b565
+      // A pixel: the depth test
+      "1:\n\t"
+      "ldrh   r11, [r2, #2]!\n\t"
+      "ubfx   r12, r3, #14, #16\n\t"
+      "ldr    r10, [sp, #8]\n\t"
+      "add    r3, r3, r10\n\t"
+      "cmp    r11, r12\n\t"
+      "bcs    3f\n\t"
+      "strh   r12, [r2]\n\t"
+      // Y': bilinear in the texels (su >> 16, sv >> 16) and their
+      // neighbours right and below, weights (su >> 8) & 255, (sv >> 8) & 255
+      "asr    r10, r1, #16\n\t"
+      "add    r11, r4, r0, asr #16\n\t"
+      "mla    r10, r10, r5, r11\n\t"
+      "ldrb   r11, [r10]\n\t"
+      "ldrb   r12, [r10, #1]\n\t"
+      "sub    r12, r12, r11\n\t"
+      "ubfx   lr, r0, #8, #8\n\t"
+      "mul    r12, r12, lr\n\t"
+      "add    r11, r12, r11, lsl #8\n\t"  // the upper row's blend, Q8
+      "add    r10, r10, r5\n\t"
+      "ldrb   r12, [r10]\n\t"
+      "ldrb   r10, [r10, #1]\n\t"
+      "sub    r10, r10, r12\n\t"
+      "mul    r10, r10, lr\n\t"
+      "add    r10, r10, r12, lsl #8\n\t"  // the lower row's
+      "sub    r10, r10, r11\n\t"
+      "ubfx   lr, r1, #8, #8\n\t"
+      "mul    r10, r10, lr\n\t"
+      "add    r10, r10, r11, lsl #8\n\t"
+      "add    r10, r10, #32768\n\t"
+      "lsr    r10, r10, #16\n\t"  // Y'
+      // The chroma texel ((sv + 2^15) >> 17, (su + 2^15) >> 17)
+      "add    r11, r0, #32768\n\t"
+      "asr    r11, r11, #17\n\t"
+      "add    r12, r1, #32768\n\t"
+      "asr    r12, r12, #17\n\t"
+      "orr    r11, r11, r12, lsl #16\n\t"
+      "cmp    r11, r6\n\t"
+      "bne    4f\n\t"
+      // Each channel's table entry at Y', ORed, stored
+      "2:\n\t"
+      "ldrh   r11, [r7, r10, lsl #1]\n\t"
+      "ldrh   r12, [r8, r10, lsl #1]\n\t"
+      "orr    r11, r11, r12\n\t"
+      "ldrh   r12, [r9, r10, lsl #1]\n\t"
+      "orr    r11, r11, r12\n\t"
+      "ldr    r12, [sp, #16]\n\t"
+      "strh   r11, [r2, r12]\n\t"
+      // The next pixel
+      "3:\n\t"
+      "ldrd   r10, r11, [sp, #0]\n\t"
+      "add    r0, r0, r10\n\t"
+      "add    r1, r1, r11\n\t"
+      "ldr    r12, [sp, #12]\n\t"
+      "cmp    r2, r12\n\t"
+      "bne    1b\n\t"
+      "ldr    r10, [sp, #40]\n\t"
+      "add    r10, r10, #40\n\t"
+      "stmia  r10, {r0-r9}\n\t"
+      "add    sp, sp, #48\n\t"
+      "pop    {r4-r11, pc}\n\t"
+      // A new chroma texel: its terms (chroma_terms) and table entries
+      "4:\n\t"
+      "mov    r6, r11\n\t"
+      "lsr    r12, r11, #16\n\t"
+      "uxth   r11, r11\n\t"
+      "ldr    lr, [sp, #20]\n\t"
+      "mla    r11, r12, lr, r11\n\t"
+      "ldr    r12, [sp, #24]\n\t"
+      "ldrb   r12, [r12, r11]\n\t"  // Cb
+      "ldr    lr, [sp, #28]\n\t"
+      "ldrb   lr, [lr, r11]\n\t"  // Cr
+      "ldr    r11, [sp, #32]\n\t"
+      "ldrsh  r7, [r11, lr, lsl #1]\n\t"  // r[Cr]
+      "add    r9, r11, #512\n\t"
+      "ldrsh  r9, [r9, r12, lsl #1]\n\t"  // b[Cb]
+      "add    r8, r11, #1024\n\t"
+      "ldr    r8, [r8, r12, lsl #2]\n\t"  // g_cb[Cb]
+      "add    r11, r11, #2048\n\t"
+      "ldr    r11, [r11, lr, lsl #2]\n\t"  // g_cr[Cr]
+      "add    r8, r8, r11\n\t"
+      "asr    r8, r8, #16\n\t"
+      "ldr    r11, [sp, #36]\n\t"
+      "add    r7, r11, r7, lsl #1\n\t"
+      "add    r8, r8, #768\n\t"
+      "add    r8, r11, r8, lsl #1\n\t"
+      "add    r9, r9, #1536\n\t"
+      "add    r9, r11, r9, lsl #1\n\t"
+      "b      2b\n\t");
+}
+#endif
+
 template <class Sampler, PixelFormat O, DepthFormat D>
 [[gnu::always_inline]] inline void affine_pixels(typename Depth<D>::T* ze, uint8_t* oe, int32_t len, const RowState& r,
                                                  const typename Sampler::Ctx& tex, const PieceEnds& ends) {
@@ -912,28 +1061,63 @@ template <class Sampler, PixelFormat O, DepthFormat D>
   int32_t q = r.q;
   const int32_t dq = r.dq;
   [[maybe_unused]] typename MemoOf<Sampler, kMemo>::T memo{};
+#if VDS_VIEW_RUN_ASM
+  constexpr bool kAsm = kMemo && O == PixelFormat::rgb565 && D == DepthFormat::d16;
+  [[maybe_unused]] ViewRun vr;
+  if constexpr (kAsm) {
+    vr.dq = dq;
+    vr.delta = delta;
+    vr.cstride = tex.cstride;
+    vr.cb = tex.cb;
+    vr.cr = tex.cr;
+    vr.chroma = &kChroma;
+    vr.pack = kPack565.v;
+    vr.y = tex.base;
+    vr.stride = tex.stride;
+    vr.key = ~0u;
+  }
+#endif
   // The piece's end points (exact, as piece_ends computed them).
   AffineRun a{r.n[0], r.n[1], r.w, hold_affine(ends.u0), hold_affine(ends.v0)};
   const int32_t ue = hold_affine(ends.u1), ve = hold_affine(ends.v1);
   int32_t i = -len;  // pixel len + i of the piece
   for (;;) {
-    // The run: pixels i .. stop - 1, stepped from the exact points at i
-    // and stop; the piece's last pixel alone at its exact point.
-    const int32_t stop = i + kAffineRun < -1 ? i + kAffineRun : (i < -1 ? -1 : 0);
-    int32_t su = a.u * 256, sv = a.v * 256, du = 0, dv = 0;
-    if (stop == -1) {  // the run to the last pixel
+    // The run: pixels i .. stop - 1 from the exact point at i. A full run
+    // steps toward the exact point kAffineRun pixels on; the last run (2 to
+    // kAffineRun + 1 pixels, or the piece's one pixel) reaches the exact
+    // point of the piece's last pixel.
+    const int32_t left = -i;  // the pixels left, the last one included
+    int32_t stop = 0, su = a.u * 256, sv = a.v * 256, du = 0, dv = 0;
+    if (left > kAffineRun + 1) {
+      stop = i + kAffineRun;
       if constexpr (kMemo) {
-        run_to(&a, stop - i, ue, ve, &su, &sv, &du, &dv);
+        run_steps(r, kAffineRun, &a, &su, &sv, &du, &dv);
       } else {
-        last_run(&a, stop - i, ue, ve, &su, &sv, &du, &dv);
+        next_run(r, kAffineRun, &a, &su, &sv, &du, &dv);
       }
-    } else if (stop != 0) {
+    } else if (left > 1) {
       if constexpr (kMemo) {
-        run_steps(r, stop - i, &a, &su, &sv, &du, &dv);
+        run_to(&a, left - 1, ue, ve, &su, &sv, &du, &dv);
       } else {
-        next_run(r, stop - i, &a, &su, &sv, &du, &dv);
+        last_run(&a, left - 1, ue, ve, &su, &sv, &du, &dv);
       }
     }
+#if VDS_VIEW_RUN_ASM
+    if constexpr (kAsm) {
+      vr.du = du;
+      vr.dv = dv;
+      vr.su = su;
+      vr.sv = sv;
+      vr.q = q;
+      vr.z = ze + i - 1;
+      vr.zlast = ze + stop - 1;
+      view_run(&vr);
+      q = vr.q;
+      i = stop;
+      if (i == 0) break;
+      continue;
+    }
+#endif
     do {
       const DT d = Depth<D>::value(q);
       if (d > ze[i]) {
