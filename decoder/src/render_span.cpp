@@ -856,7 +856,7 @@ struct MemoOf<S, true> {
 // the piece's last pixel, and linear between (the pixels between two exact
 // points step by their difference over the distance, carried with 8 more
 // fraction bits). A reciprocal per run instead of per pixel. Between two
-// points 8 pixels apart the homography's curvature moves a sample by a
+// points 16 pixels apart the homography's curvature moves a sample by a
 // small part of a texel except on surfaces seen nearly edge-on. The steps
 // need both points within +-kAffineLimit (the differences times 2^8 then
 // stay within int32): so is every point inside a texture (below
@@ -953,7 +953,7 @@ static_assert(offsetof(ChromaTables, r) == 0 && offsetof(ChromaTables, b) == 512
   __asm__ volatile(
       ".syntax unified\n\t"
       "push   {r4-r11, lr}\n\t"
-      "sub    sp, sp, #48\n\t"
+      "sub    sp, sp, #44\n\t"  // with the 36 bytes pushed: sp stays 8-byte aligned
       "str    r0, [sp, #40]\n\t"
       "ldmia  r0!, {r1-r10}\n\t"  // the cold words to [sp, #0..36]
       "stmia  sp, {r1-r10}\n\t"
@@ -1018,7 +1018,7 @@ static_assert(offsetof(ChromaTables, r) == 0 && offsetof(ChromaTables, b) == 512
       "ldr    r10, [sp, #40]\n\t"
       "add    r10, r10, #40\n\t"
       "stmia  r10, {r0-r9}\n\t"
-      "add    sp, sp, #48\n\t"
+      "add    sp, sp, #44\n\t"
       "pop    {r4-r11, pc}\n\t"
       // A new chroma texel: its terms (chroma_terms) and table entries
       "4:\n\t"
@@ -1075,6 +1075,7 @@ template <class Sampler, PixelFormat O, DepthFormat D>
     vr.y = tex.base;
     vr.stride = tex.stride;
     vr.key = ~0u;
+    vr.r565 = vr.g565 = vr.b565 = kPack565.v;  // never read before a texel sets them; valid anyway
   }
 #endif
   // The piece's end points (exact, as piece_ends computed them).
