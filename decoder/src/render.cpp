@@ -404,7 +404,7 @@ struct RenderFrame {
     }
     const uint16_t slot = free_slots != 0 ? r.setup_free_[--free_slots] : static_cast<uint16_t>(unused++);
     detail::PreparedPolygon* pp = setup_entry(slot);
-    prepare_polygon(detail::PolygonTarget{band.width, band.format, band.depth_format}, mat, sv, n, pp);
+    prepare_polygon(detail::PolygonTarget{band.width, band.height, band.format, band.depth_format}, mat, sv, n, pp);
     ++fresh;
     r.setup_tags_[scap - fresh] = g + 1;
     r.setup_slots_[scap - fresh] = slot;
@@ -697,6 +697,7 @@ Status Renderer::render(const Camera& cam, const DrawList& list, uint32_t clear_
     band.y0 = y0;
     band.y1 = y1;
     band.width = cfg_.width;
+    band.height = cfg_.height;
     band.color = cfg_.target ? color_ + static_cast<size_t>(y0) * color_stride_ : color_;
     band.color_stride = color_stride_;
     band.depth = depth_;

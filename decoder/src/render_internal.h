@@ -77,6 +77,7 @@ struct MaterialCtx {
 struct BandTarget {
   int32_t y0, y1;            // rows [y0, y1)
   int32_t width;
+  int32_t height;            // the frame's rows
   uint8_t* color;            // row y0
   uint32_t color_stride;     // bytes
   void* depth;               // row y0, `width` entries per row
@@ -93,7 +94,7 @@ bool texture_repeats(const Texture& t);
 
 // What a polygon's set-up depends on: the same for every band of a frame.
 struct PolygonTarget {
-  int32_t width;
+  int32_t width, height;  // the frame's
   PixelFormat format;
   DepthFormat depth_format;
 };

@@ -352,6 +352,31 @@ void fit_planes(PolySetup& s, VertexValues& vv, const ScreenVertex* v, const Fan
   s.b0 = vv.g + kn - kw;
 }
 
+// A plane in row units (PolySetup::fast_c*, fast_g*): its value at pixel
+// (dx, dy) from its reference pixel and its y step, each rounded; false when
+// either or the x step leaves int32 (the span start values then take the
+// planes).
+bool row_unit(const Plane& p, int32_t dx, int32_t dy, int32_t step, int32_t* c, int32_t* g) {
+  const int64_t half = int64_t{1} << (kPlaneFrac - 1);
+  const int64_t cv = wrap_add64(eval(p, dx, dy), half) >> kPlaneFrac;
+  const int64_t gv = wrap_add64(p.gy, half) >> kPlaneFrac;
+  if (cv < kI32Min || cv > kI32Max || gv < kI32Min || gv > kI32Max) return false;
+  if (step == INT32_MIN || step == INT32_MAX) return false;  // step16 saturated
+  *c = static_cast<int32_t>(cv);
+  *g = static_cast<int32_t>(gv);
+  return true;
+}
+bool fast_rows(const PolygonTarget& t, PolySetup& s) {
+  s.fast_xr = s.xr < 0 ? 0 : (s.xr >= t.width ? t.width - 1 : s.xr);
+  s.fast_yr = s.yr < 0 ? 0 : (s.yr >= t.height ? t.height - 1 : s.yr);
+  const int32_t dx = s.fast_xr - s.xr, dy = s.fast_yr - s.yr;
+  if (!row_unit(s.q, dx, dy, s.fast_dq, &s.fast_cq, &s.fast_gq)) return false;
+  if (s.proj && !row_unit(s.w, dx, dy, s.fast_dw, &s.fast_cw, &s.fast_gw)) return false;
+  for (int j = 0; j < s.nn; ++j)
+    if (!row_unit(s.n[j], dx, dy, s.fast_dn[j], &s.fast_cn[j], &s.fast_gn[j])) return false;
+  return true;
+}
+
 }  // namespace
 
 void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const ScreenVertex* v, int n, PreparedPolygon* pp) {
@@ -425,6 +450,7 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   else
     s.fast = true;  // flat: q only
 
+  if (s.fast && !fast_rows(target, s)) s.fast = false;
   s.fast_qlo = s.wlo > 1 ? s.wlo : 1;
   s.fast_qhi = s.whi < kQMax ? s.whi : kQMax;
   // Empty: no span of a non-projective polygon passes both checks anyway.
@@ -453,7 +479,7 @@ void draw_prepared(const BandTarget& band, const PreparedPolygon& pp, RenderStat
 
 void draw_polygon(const BandTarget& band, const MaterialCtx& mat, const ScreenVertex* v, int n, RenderStats& stats) {
   PreparedPolygon pp;
-  prepare_polygon(PolygonTarget{band.width, band.format, band.depth_format}, mat, v, n, &pp);
+  prepare_polygon(PolygonTarget{band.width, band.height, band.format, band.depth_format}, mat, v, n, &pp);
   if (pp.set_up && pp.row_end > band.y0 && pp.row_begin < band.y1) ++stats.setups;
   draw_prepared(band, pp, stats);
 }

@@ -560,9 +560,10 @@ void interpolant(int64_t start_q16, int64_t gx, int s, int32_t len, int64_t lo, 
 constexpr int64_t kNumLimit = (int64_t{1} << 30) + 4096;  // |numerator| bound of a span
 
 
-// Row units from a plane value: rounded, the 16 fraction bits dropped.
-inline int64_t row_value(const Plane& p, int32_t dx, int32_t dy) {
-  return wrap_add64(eval(p, dx, dy), int64_t{1} << (kPlaneFrac - 1)) >> kPlaneFrac;
+// A fast start value (PolySetup::fast_c*): c + step dx + g dy, exact in 64
+// bits (each product below 2^31 2^12).
+inline int64_t row_start(int32_t c, int32_t step, int32_t g, int32_t dx, int32_t dy) {
+  return int64_t{c} + int64_t{step} * dx + int64_t{g} * dy;
 }
 
 // v in [lo, hi] with one unsigned compare (no overflow: unsigned arithmetic).
@@ -577,9 +578,9 @@ inline bool in_range(int64_t v, int64_t lo, int64_t hi) {
 template <int NN, bool kProj>
 [[gnu::always_inline]] inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
   if (!s.fast) return false;
-  const int32_t dx = x - s.xr, dy = y - s.yr;
+  const int32_t dx = x - s.fast_xr, dy = y - s.fast_yr;
   const int64_t last = len - 1;
-  const int64_t q0 = row_value(s.q, dx, dy);
+  const int64_t q0 = row_start(s.fast_cq, s.fast_dq, s.fast_gq, dx, dy);
   const int64_t q1 = q0 + int64_t{s.fast_dq} * last;
   // q is also the divisor unless kProj: one check against both ranges.
   const int64_t qlo = NN > 0 && !kProj ? s.fast_qlo : 1, qhi = NN > 0 && !kProj ? s.fast_qhi : kQMax;
@@ -589,14 +590,14 @@ template <int NN, bool kProj>
   if constexpr (NN > 0) {
     int64_t w0 = q0, w1 = q1;
     if constexpr (kProj) {
-      w0 = row_value(s.w, dx, dy);
+      w0 = row_start(s.fast_cw, s.fast_dw, s.fast_gw, dx, dy);
       w1 = w0 + int64_t{s.fast_dw} * last;
       if (!in_range(w0, s.wlo, s.whi) || !in_range(w1, s.wlo, s.whi)) return false;
     }
     r.w = static_cast<int32_t>(w0);
     r.dw = s.fast_dw;
     for (int j = 0; j < NN; ++j) {
-      const int64_t n0 = row_value(s.n[j], dx, dy);
+      const int64_t n0 = row_start(s.fast_cn[j], s.fast_dn[j], s.fast_gn[j], dx, dy);
       const int64_t n1 = n0 + int64_t{s.fast_dn[j]} * last;
       if (!in_range(n0, -kNumLimit, kNumLimit) || !in_range(n1, -kNumLimit, kNumLimit)) return false;
       r.n[j] = static_cast<int32_t>(n0);

@@ -56,6 +56,16 @@ struct PolySetup {
   bool fast;
   int32_t fast_shb;
   int32_t fast_dq, fast_dw, fast_dn[3];
+  // The fast start values: each plane in row units with 32-bit
+  // coefficients, c + step dx + g dy from the reference pixel (the step
+  // above, c and g the plane's value there and its y step rounded to row
+  // units), evaluated exactly in 64 bits: a product and a sum, not the
+  // planes' 64-bit ones. A start is then off the plane by at most half a
+  // row unit for each pixel it lies from the reference pixel and one more;
+  // the reference pixel lies on the frame, so by less than the frame's
+  // width and height.
+  int32_t fast_xr, fast_yr;  // their reference pixel: the planes' own, moved onto the frame
+  int32_t fast_cq, fast_gq, fast_cw, fast_gw, fast_cn[3], fast_gn[3];
   int32_t wlo, whi;
   int32_t fast_qlo, fast_qhi;  // [1, kQMax] and [wlo, whi] together (q is W), not empty
 };

@@ -779,9 +779,9 @@ TEST(RenderGolden, FrameChecksums) {
     uint32_t crc;
   };
   const G golden[] = {
-      {TexFormat::rgb565, PixelFormat::rgb565, DepthFormat::d16, 16, 0x65e743a9u},
-      {TexFormat::xrgb8888, PixelFormat::rgb888, DepthFormat::d32, 180, 0x078975ceu},
-      {TexFormat::ycbcr420, PixelFormat::rgb888, DepthFormat::d16, 7, 0x7348120du},
+      {TexFormat::rgb565, PixelFormat::rgb565, DepthFormat::d16, 16, 0xb5279ebbu},
+      {TexFormat::xrgb8888, PixelFormat::rgb888, DepthFormat::d32, 180, 0x8c8f9113u},
+      {TexFormat::ycbcr420, PixelFormat::rgb888, DepthFormat::d16, 7, 0x53e772aau},
   };
   for (const G& g : golden) {
     const ClientScene cs(ref::client_textures(sc, g.tex), g.tex);
