@@ -50,7 +50,7 @@ struct PolySetup {
   LatticeCtx lat;  // mesh_colors
   // Fast span set-up (fast == true): the planes' own scale serves the whole
   // polygon (chosen from the values at its vertices with a margin), so a span
-  // start is (a0 + gx dx + gy dy + 2^15) >> 16 and the steps are fixed. A
+  // start comes from the row-unit planes below and the steps are fixed. A
   // span whose start and end values stay inside [wlo, whi] (divisor) and
   // +-kNumLimit (numerators) uses them; any other takes the per-span path.
   bool fast;

@@ -4,6 +4,7 @@
 // architectures); on the QEMU board it also prints instruction counts.
 #include <cstdint>
 
+#include "band_crc.h"
 #include "print.h"
 #include "vds/arena.h"
 #include "vds/board.h"
@@ -100,14 +101,6 @@ vds::Camera identity_camera(int32_t x, int32_t y, int32_t z, int32_t focal, int3
   return c;
 }
 
-struct BandCrc {
-  uint32_t crc;
-};
-bool crc_band(void* ctx, const vds::Band& b) {
-  auto* s = static_cast<BandCrc*>(ctx);
-  for (uint32_t y = 0; y < b.height; ++y) s->crc = vds::crc32c_update(s->crc, b.pixels + y * b.stride, b.width * 2u);
-  return true;
-}
 
 // false when the frame was not drawn or drew too little to test the loop.
 bool check_view_spans() {
@@ -156,14 +149,14 @@ bool check_view_spans() {
   cfg.depth = vds::DepthFormat::d16;
   vds::Arena arena(g_render_ws, sizeof g_render_ws);
   vds::Renderer renderer;
-  BandCrc sink{0};
+  uint32_t crc = 0;
   vds::Status st = renderer.init(cfg, arena);
   const uint64_t t0 = vds::board::instructions();
-  if (st == vds::Status::ok) st = renderer.render(screen, list, 0, crc_band, &sink);
+  if (st == vds::Status::ok) st = renderer.render(screen, list, 0, vds::fw::crc_band, &crc);
   const uint64_t spent = vds::board::instructions() - t0;
   const vds::RenderStats& s = renderer.stats();
   vds::board::log(Line().str("check view_spans status=").str(vds::status_name(st)).str(" pixels=").dec(s.pixels)
-                      .str(" crc=").hex32(sink.crc).str("\n").c_str());
+                      .str(" crc=").hex32(crc).str("\n").c_str());
   if (vds::board::instruction_resolution() != 0 && s.pixels)
     vds::board::log(Line().str("count view_spans instructions_per_pixel ").dec(spent / s.pixels).str("\n").c_str());
   // About 33,700 pixels drawn (the triangles overlap about five deep).
