@@ -377,6 +377,46 @@ bool fast_rows(const PolygonTarget& t, PolySetup& s) {
   return true;
 }
 
+// Whether a fast plane, c + step dx + g dy at pixel (xr + dx, yr + dy),
+// lies inside [lo, hi] at every pixel of a box (dx in [dx0, dx1], dy in
+// [dy0, dy1]): it is affine, so its extremes over the box lie at corners.
+// Each product is below 2^31 2^12 (the box lies on the frame).
+struct FastBox {
+  int32_t dx0, dx1, dy0, dy1;
+};
+bool fast_bounded(int32_t c, int32_t step, int32_t g, int64_t lo, int64_t hi, const FastBox& b) {
+  const int64_t x0 = int64_t{step} * b.dx0, x1 = int64_t{step} * b.dx1;
+  const int64_t y0 = int64_t{g} * b.dy0, y1 = int64_t{g} * b.dy1;
+  const int64_t low = c + (x0 < x1 ? x0 : x1) + (y0 < y1 ? y0 : y1);
+  const int64_t high = c + (x0 < x1 ? x1 : x0) + (y0 < y1 ? y1 : y0);
+  return low >= lo && high <= hi;
+}
+// Whether every fast start value of every pixel the polygon covers lies
+// inside the limits row_fast checks (PolySetup::fast_safe). The pixels
+// covered lie in the box of the outline's columns and rows on the frame (a
+// pixel is covered when its centre is inside).
+bool fast_safe(const PolygonTarget& t, const PolySetup& s, const ScreenVertex* v, int n, int32_t row_begin,
+               int32_t row_end) {
+  int32_t xmin = v[0].x, xmax = v[0].x;
+  for (int i = 1; i < n; ++i) {
+    xmin = v[i].x < xmin ? v[i].x : xmin;
+    xmax = v[i].x > xmax ? v[i].x : xmax;
+  }
+  const int32_t c0 = raster_row(xmin) > 0 ? raster_row(xmin) : 0;
+  const int32_t c1 = raster_row(xmax) < t.width - 1 ? raster_row(xmax) : t.width - 1;
+  const int32_t r0 = row_begin > 0 ? row_begin : 0;
+  const int32_t r1 = row_end < t.height - 1 ? row_end : t.height - 1;
+  if (c0 > c1 || r0 > r1) return false;
+  const FastBox b{c0 - s.fast_xr, c1 - s.fast_xr, r0 - s.fast_yr, r1 - s.fast_yr};
+  const bool q_is_w = s.nn > 0 && !s.proj;
+  if (!fast_bounded(s.fast_cq, s.fast_dq, s.fast_gq, q_is_w ? s.fast_qlo : 1, q_is_w ? s.fast_qhi : kQMax, b))
+    return false;
+  if (s.nn > 0 && s.proj && !fast_bounded(s.fast_cw, s.fast_dw, s.fast_gw, s.wlo, s.whi, b)) return false;
+  for (int j = 0; j < s.nn; ++j)
+    if (!fast_bounded(s.fast_cn[j], s.fast_dn[j], s.fast_gn[j], -kNumLimit, kNumLimit, b)) return false;
+  return true;
+}
+
 }  // namespace
 
 void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const ScreenVertex* v, int n, PreparedPolygon* pp) {
@@ -455,6 +495,7 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   s.fast_qhi = s.whi < kQMax ? s.whi : kQMax;
   // Empty: no span of a non-projective polygon passes both checks anyway.
   if (s.nn && !s.proj && s.fast_qlo > s.fast_qhi) s.fast = false;
+  s.fast_safe = s.fast && fast_safe(target, s, v, n, pp->row_begin, pp->row_end);
   pp->fn = select_span(target, m, repeat);
 }
 

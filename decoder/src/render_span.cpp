@@ -557,7 +557,6 @@ void interpolant(int64_t start_q16, int64_t gx, int s, int32_t len, int64_t lo, 
   *dv = static_cast<int32_t>(d);
 }
 
-constexpr int64_t kNumLimit = (int64_t{1} << 30) + 4096;  // |numerator| bound of a span
 
 
 // A fast start value (PolySetup::fast_c*): c + step dx + g dy, exact in 64
@@ -576,8 +575,50 @@ inline bool in_range(int64_t v, int64_t lo, int64_t hi) {
 // stay inside the limits the exponent was chosen for. false sends the span
 // to the general row_piece(). NN numerators, kProj a separate divisor.
 template <int NN, bool kProj>
+[[gnu::always_inline]] inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r);
+template <int NN, bool kProj>
+[[gnu::noinline]] bool row_fast_call(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r);
+
+// The fast start values of a polygon whose values all lie inside their
+// limits (PolySetup::fast_safe): each fits int32, so it is exact modulo 2^32.
+template <int NN, bool kProj>
+[[gnu::always_inline]] inline void row_safe(const PolySetup& s, int32_t y, int32_t x, RowState& r) {
+  const int32_t dx = x - s.fast_xr, dy = y - s.fast_yr;
+  const auto start = [dx, dy](int32_t c, int32_t step, int32_t g) {
+    return static_cast<int32_t>(static_cast<uint32_t>(c) + static_cast<uint32_t>(step) * static_cast<uint32_t>(dx) +
+                                static_cast<uint32_t>(g) * static_cast<uint32_t>(dy));
+  };
+  r.q = start(s.fast_cq, s.fast_dq, s.fast_gq);
+  r.dq = s.fast_dq;
+  if constexpr (NN > 0) {
+    if constexpr (kProj) {
+      r.w = start(s.fast_cw, s.fast_dw, s.fast_gw);
+      r.dw = s.fast_dw;
+    } else {
+      r.w = r.q;
+      r.dw = r.dq;
+    }
+    for (int j = 0; j < NN; ++j) {
+      r.n[j] = start(s.fast_cn[j], s.fast_dn[j], s.fast_gn[j]);
+      r.dn[j] = s.fast_dn[j];
+    }
+    r.sh_base = s.fast_shb;
+  }
+}
+
+template <int NN, bool kProj>
 [[gnu::always_inline]] inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
   if (!s.fast) return false;
+  if (s.fast_safe) {
+    row_safe<NN, kProj>(s, y, x, r);
+#ifdef VDS_CHECK_FAST_SAFE
+    PolySetup t = s;
+    t.fast_safe = false;
+    RowState r2;
+    if (!row_fast_call<NN, kProj>(t, y, x, len, r2)) __builtin_trap();
+#endif
+    return true;
+  }
   const int32_t dx = x - s.fast_xr, dy = y - s.fast_yr;
   const int64_t last = len - 1;
   const int64_t q0 = row_start(s.fast_cq, s.fast_dq, s.fast_gq, dx, dy);
@@ -1152,12 +1193,23 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
     // The start values are inlined into the loops of rgb565 textures drawn
     // to rgb565 (about 1 instruction per pixel less in the scenes of
     // bench/results/render.md), called from the others (code size).
-    bool fast;
-    if constexpr (Sampler::kInlineStart && !kProj) {
+    // A polygon whose start values need no checks takes them inline.
+    bool fast = true;
+    if (s.fast_safe) {
+      row_safe<2, kProj>(s, y, xa, r);
+    } else if constexpr (Sampler::kInlineStart && !kProj) {
       fast = row_fast<2, kProj>(s, y, xa, len, r);
     } else {
       fast = row_fast_call<2, kProj>(s, y, xa, len, r);
     }
+#ifdef VDS_CHECK_FAST_SAFE
+    if (s.fast_safe) {
+      PolySetup t = s;
+      t.fast_safe = false;
+      RowState r2;
+      if (!row_fast<2, kProj>(t, y, xa, len, r2)) __builtin_trap();
+    }
+#endif
     if (!fast) {
       while (!row_piece(s, y, xa, len, r)) len = (len + 1) >> 1;
     }

@@ -68,7 +68,15 @@ struct PolySetup {
   int32_t fast_cq, fast_gq, fast_cw, fast_gw, fast_cn[3], fast_gn[3];
   int32_t wlo, whi;
   int32_t fast_qlo, fast_qhi;  // [1, kQMax] and [wlo, whi] together (q is W), not empty
+  // The fast start values of every pixel the polygon covers lie inside
+  // those limits (checked once at set-up, at its vertices: fast_bounded in
+  // render_setup.cpp), so a span takes them without the checks.
+  bool fast_safe;
 };
+
+// The bound on a span's numerators (the fast set-up's check, row_piece's
+// range): their products with a reciprocal stay within int64 after the shift.
+constexpr int64_t kNumLimit = (int64_t{1} << 30) + 4096;
 
 // Rounded to nearest: r5 = round(r 31 / 255) = (r 249 + 1014) >> 11 and
 // g6 = round(g 63 / 255) = (g 253 + 505) >> 10, exact for every 8-bit value.
