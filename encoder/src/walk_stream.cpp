@@ -245,13 +245,17 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   wp.view_height = static_cast<uint16_t>(view_h);
   h.workspace_bytes = static_cast<uint32_t>(Player::walk_workspace_bytes(h, wp, kClientPlayerConfig));
   h.max_triangles = slots;
-  // The view updates, numbered in stream order; each has its own quality.
+  // The view updates, numbered in stream order; each has its own quality
+  // and the MCUs its image codes (none left out: a whole view).
   std::vector<std::vector<size_t>> update_of(n);
   std::vector<uint32_t> update_camera;
+  std::vector<std::vector<uint8_t>> update_region;
   for (size_t f = 0; f < n; ++f)
     for (const auto& u : vp.updates[f]) {
       update_of[f].push_back(update_camera.size());
       update_camera.push_back(u.camera_frame);
+      const bool whole = !o.regions || std::all_of(u.mcus.begin(), u.mcus.end(), [](uint8_t m) { return m != 0; });
+      update_region.push_back(whole ? std::vector<uint8_t>{} : u.mcus);
     }
   // Refinements: a view that serves at least 2 * refine_after frames gets,
   // refine_after frames after it arrives, a residual image at a higher
@@ -342,6 +346,20 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     }
     return it->second;
   };
+  // Update u's image at a quality: the view, or its region.
+  std::map<std::pair<size_t, int>, EncodedImage> coded_region;
+  const auto update_image = [&](size_t u, int q) -> const EncodedImage& {
+    if (update_region[u].empty()) return intra(update_camera[u], q);
+    auto it = coded_region.find({u, q});
+    if (it == coded_region.end()) {
+      ImageEncodeOptions io;
+      io.quality = q;
+      io.max_chunk_payload = 4096;
+      io.region = update_region[u];
+      it = coded_region.emplace(std::make_pair(u, q), encode_planes(view_planes.at(update_camera[u]), io)).first;
+    }
+    return it->second;
+  };
   StreamHeader hh = h;
   hh.max_chunk_payload = 4096;
   for (const auto& rec : wfrm) hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(rec.size()));
@@ -373,7 +391,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     for (size_t r = 0; r < record_start.size(); ++r) {
       const uint32_t f = static_cast<uint32_t>(record_start[r]);
       const uint32_t last = static_cast<uint32_t>(record_end(r) - 1);
-      for (size_t u : update_of[f]) p.push_back({kFraming + kWalkViewBytes + intra(update_camera[u], q[u]).coded_bytes(), f, f, false});
+      for (size_t u : update_of[f]) p.push_back({kFraming + kWalkViewBytes + update_image(u, q[u]).coded_bytes(), f, f, false});
       for (const Refine& rf : refines[f])
         p.push_back({kFraming + kWalkViewBytes + intra(rf.camera_frame, std::min(100, q[rf.update] + o.refine_delta)).coded_bytes(), f, f, false});
       p.push_back({kFraming + wfrm[r].size(), f, last, true});
@@ -396,11 +414,12 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     written.assign(1, WalkPiece{w.size(), 0, 0, false});
     res->view_bytes = res->geometry_bytes = res->frame_bytes = 0;
     res->view_updates = res->view_refinements = res->view_predicted = 0;
+    res->view_mcus = res->view_mcus_coded = 0;
     res->bytes_by_frame.assign(n, 0);
     // A view into a slot: WVUP with its camera's pose, then its image:
     // intra, or a residual against what the client then holds (its
     // prediction of the view, whichever is better; a refinement's base).
-    const auto put_view = [&](uint32_t slot, uint32_t camera_frame, int quality, bool refine) {
+    const auto put_view = [&](uint32_t slot, uint32_t camera_frame, size_t update, int quality, bool refine) {
       const size_t before = w.size();
       uint8_t vb[kWalkViewBytes];
       WalkViewUpdate u;
@@ -410,7 +429,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       walk_view_to_bytes(u, vb);
       w.add_chunk(chunk::kWalkView, vb);
       client.feed(w);
-      const EncodedImage* image = &intra(camera_frame, quality);
+      const EncodedImage* image = refine ? &intra(camera_frame, quality) : &update_image(update, quality);
       EncodedImage residual;
       if (refine || client.predicted()) {
         const Planes base = client.slot(static_cast<uint8_t>(slot));
@@ -418,6 +437,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
         ro.max_chunk_payload = 4096;
         ro.mode = ImageMode::residual;
         ro.prediction = &base;
+        if (!refine) ro.region = update_region[update];
         ro.quality = refine ? std::min(100, quality + o.refine_delta) : quality;
         residual = encode_planes(view_planes.at(camera_frame), ro);
         // Rate and distortion together: about 3.5 dB a doubling of bytes
@@ -438,11 +458,14 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       const uint32_t last = static_cast<uint32_t>(record_end(r) - 1);
       for (size_t k = 0; k < vp.updates[f].size(); ++k) {
         const size_t u = update_of[f][k];
-        written.push_back({put_view(vp.updates[f][k].slot, update_camera[u], q[u], false), f, f, false});
+        written.push_back({put_view(vp.updates[f][k].slot, update_camera[u], u, q[u], false), f, f, false});
         ++res->view_updates;
+        res->view_mcus += vp.updates[f][k].mcus.size();
+        res->view_mcus_coded += update_region[u].empty() ? vp.updates[f][k].mcus.size()
+                                                         : static_cast<size_t>(std::count(update_region[u].begin(), update_region[u].end(), uint8_t{1}));
       }
       for (const Refine& rf : refines[f]) {
-        written.push_back({put_view(rf.slot, rf.camera_frame, q[rf.update], true), f, f, false});
+        written.push_back({put_view(rf.slot, rf.camera_frame, rf.update, q[rf.update], true), f, f, false});
         ++res->view_refinements;
       }
       const size_t before = w.size();

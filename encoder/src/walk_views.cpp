@@ -190,11 +190,61 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     }
     return worst;
   };
+  // The MCUs of a view a polygon's part on a screen reads (Update::mcus):
+  // the part frame f's screen shows, in front of the view's near plane,
+  // projected into the view at frame g with the client's camera; every
+  // MCU its outline, widened by the margin, overlaps.
+  const int mw = (vw + 15) / 16, mh = (vh + 15) / 16;
+  const auto mark = [&](std::vector<uint8_t>& mcus, size_t f, size_t g, uint32_t id) {
+    std::vector<P3> poly = corners(id);
+    std::vector<Plane> planes;
+    frustum(scams[f], o.width, o.height, &planes);
+    planes.push_back({vscams[g].forward, vscams[g].position, o.near_z * 1.01});
+    for (const Plane& pl : planes) {
+      clip(poly, pl);
+      if (poly.empty()) return;
+    }
+    std::vector<std::array<double, 2>> q;
+    for (const P3& p : poly) {
+      int32_t x, y;
+      if (!vds::camera_project(vcams[g], vds::camera_transform(vcams[g], {q16(p[0]), q16(p[1]), q16(p[2])}), &x, &y)) {
+        std::fill(mcus.begin(), mcus.end(), uint8_t{1});  // cannot tell: all of it
+        return;
+      }
+      q.push_back({x / 256.0, y / 256.0});
+    }
+    const double m = o.region_margin;
+    double x0 = q[0][0], x1 = q[0][0], y0 = q[0][1], y1 = q[0][1];
+    double area2 = 0;
+    for (size_t i = 0; i < q.size(); ++i) {
+      x0 = std::min(x0, q[i][0]), x1 = std::max(x1, q[i][0]);
+      y0 = std::min(y0, q[i][1]), y1 = std::max(y1, q[i][1]);
+      const auto& b = q[(i + 1) % q.size()];
+      area2 += q[i][0] * b[1] - b[0] * q[i][1];
+    }
+    const int c0 = std::max(0, static_cast<int>(std::floor((x0 - m) / 16))), c1 = std::min(mw - 1, static_cast<int>(std::floor((x1 + m) / 16)));
+    const int r0 = std::max(0, static_cast<int>(std::floor((y0 - m) / 16))), r1 = std::min(mh - 1, static_cast<int>(std::floor((y1 + m) / 16)));
+    for (int r = r0; r <= r1; ++r)
+      for (int c = c0; c <= c1; ++c) {
+        // The MCU's box, widened, against the outline's edges (a box wholly
+        // outside one edge misses the convex outline; a flat outline: its box).
+        const double bx0 = c * 16 - m, bx1 = (c + 1) * 16 + m, by0 = r * 16 - m, by1 = (r + 1) * 16 + m;
+        bool hit = true;
+        for (size_t i = 0; i < q.size() && hit && std::fabs(area2) > 1e-9; ++i) {
+          const auto& a = q[i];
+          const auto& b = q[(i + 1) % q.size()];
+          const auto side = [&](double x, double y) { return ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) * area2; };
+          if (side(bx0, by0) < 0 && side(bx1, by0) < 0 && side(bx0, by1) < 0 && side(bx1, by1) < 0) hit = false;
+        }
+        if (hit) mcus[static_cast<size_t>(r * mw + c)] = 1;
+      }
+  };
   const double limit = o.threshold;
   WalkViewPlan plan;
   plan.updates.resize(n);
   plan.choice.resize(n);
   std::vector<int64_t> held(static_cast<size_t>(o.slots), -1);  // the camera frame of each slot's view
+  std::vector<WalkViewPlan::Update*> holder(static_cast<size_t>(o.slots), nullptr);  // the update that put it there
   // Whether the views `v` leave frame f unserved: more than tolerance_px
   // of its pixels with no view within the threshold, or (occlusion_updates)
   // more than occlusion_tolerance_px served only by occluded views.
@@ -247,8 +297,10 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
         if (run >= best_run) best = g, best_run = run;
       }
       held[victim] = static_cast<int64_t>(best);
-      plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(best)});
+      plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(best), std::vector<uint8_t>(static_cast<size_t>(mw * mh), 0)});
     }
+    // (Each frame's updates are whole: pointers into them stay valid.)
+    for (WalkViewPlan::Update& u : plan.updates[f]) holder[u.slot] = &u;
     // Each polygon's view: the smallest factor, among the views that are
     // not occluded there if any serves it.
     for (const auto& [id, px] : visible[f]) {
@@ -263,6 +315,7 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
         if (pick < 0 || (pick_occluded && !occ) || (occ == pick_occluded && fk < q)) q = fk, pick = static_cast<int8_t>(k), pick_occluded = occ;
       }
       plan.choice[f].push_back(pick);
+      if (pick >= 0) mark(holder[static_cast<size_t>(pick)]->mcus, f, static_cast<size_t>(held[static_cast<size_t>(pick)]), id);
       plan.pixels += px;
       if (pick < 0) plan.pixels_unserved += px;
       if (q <= limit) plan.pixels_within += px;

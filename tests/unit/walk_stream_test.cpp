@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <numeric>
@@ -85,6 +86,36 @@ std::pair<vds::enc::WalkEncodeResult, vds::enc::WalkEncodeResult> same_pictures(
   EXPECT_EQ(b.frame_crc, a.frame_crc);
   EXPECT_EQ(vds::enc::client_frame_crcs(b.stream), b.frame_crc);
   return {std::move(a), std::move(b)};
+}
+
+TEST(WalkStream, RegionUpdatesCodeOnlyWhatTheClientReadsAndShowTheSamePictures) {
+  // A view update's image codes only the MCUs the frames it serves read:
+  // fewer MCUs and bytes, and, as the rest is never read, the same pictures
+  // as whole views at the same quality (up to the coded MCUs' own coding:
+  // their neighbours and contexts differ).
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
+  vds::enc::WalkEncodeOptions o;
+  o.quality = 40;
+  o.regions = false;
+  const auto whole = vds::enc::encode_walk(room, path, o);
+  o.regions = true;
+  const auto region = vds::enc::encode_walk(room, path, o);
+  ASSERT_EQ(whole.view_mcus_coded, whole.view_mcus);
+  ASSERT_EQ(region.view_mcus, whole.view_mcus);
+  EXPECT_LT(region.view_mcus_coded, region.view_mcus);
+  EXPECT_LT(region.view_bytes, whole.view_bytes);
+  EXPECT_EQ(vds::enc::client_frame_crcs(region.stream), region.frame_crc);
+  EXPECT_NEAR(region.psnr_rgb, whole.psnr_rgb, 0.1);
+  ASSERT_EQ(region.frame_psnr.size(), whole.frame_psnr.size());
+  double most = 0;
+  for (size_t f = 0; f < whole.frame_psnr.size(); ++f) {
+    EXPECT_NEAR(region.frame_psnr[f], whole.frame_psnr[f], 0.05) << "frame " << f;
+    most = std::max(most, std::fabs(region.frame_psnr[f] - whole.frame_psnr[f]));
+  }
+  std::printf("room, 60 frames at quality 40: %zu of %zu MCUs coded, views %zu bytes (whole: %zu), PSNR %.2f dB (whole: %.2f), "
+              "frames within %.3f dB\n",
+              region.view_mcus_coded, region.view_mcus, region.view_bytes, whole.view_bytes, region.psnr_rgb, whole.psnr_rgb, most);
 }
 
 TEST(WalkStream, RecordsOfSeveralFramesShowWhatRecordsOfOneShow) {

@@ -9,7 +9,10 @@
 // Y'CbCr 4:2:0 planes; a WVUP naming a slot's own camera again may carry a
 // residual image that refines what the slot holds, and one with its
 // "predict" bit has the client draw the view from what it holds first
-// (predict_view), which the image may then be a residual against.
+// (predict_view), which the image may then be a residual against. Any of
+// them may be a region image: the MCUs it does not code keep what the slot
+// held (the encoder leaves out only MCUs no frame reads while the view
+// serves).
 #include "vds/homography.h"
 #include "vds/player.h"
 #include "vds/render.h"
@@ -349,7 +352,7 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
       if (type == chunk::kImageHeader) {
         ImageHeader ih;
         if (w.image_open || image_header_from_bytes(payload, size, &ih) != Status::ok || ih.width != t.width ||
-            ih.height != t.height || ih.chroma != ChromaFormat::yuv420 || ih.region() || (ih.residual() && !w.pending_refines && !w.pending_predicted))
+            ih.height != t.height || ih.chroma != ChromaFormat::yuv420 || (ih.residual() && !w.pending_refines && !w.pending_predicted))
           refuse(Status::malformed, "a view's image must be a 4:2:0 image of the views' size, a residual only on a prediction or its own view");
         else
           w.image_open = true;

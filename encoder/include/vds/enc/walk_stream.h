@@ -45,6 +45,9 @@ struct WalkEncodeOptions {
   // are coded as a residual against it when that pays (rate and
   // distortion); measured not to pay on the figure maps (docs/walkthrough.md).
   bool predict = false;
+  // View updates code only the MCUs the client reads while the view serves
+  // (WalkViewPlan::Update::mcus: region images); false: whole views.
+  bool regions = true;
   double tolerance = 0.005;  // share of a frame's pixels that may go without a view within the threshold
   // Occluded views (WalkViewOptions::occlusion_margin, occlusion_updates;
   // a margin over 1: no occlusion test), and the share of a frame's pixels
@@ -78,6 +81,7 @@ struct WalkEncodeResult {
   std::vector<WalkPiece> pieces;  // the stream as the client takes it (vds/enc/walk_schedule.h)
   size_t view_updates = 0, view_refinements = 0;
   size_t view_predicted = 0;  // view updates coded as a residual against the client's prediction
+  size_t view_mcus = 0, view_mcus_coded = 0;  // the updates' MCUs, and those their images code
   // Bytes by part: header (HEAD, WLKP), views (WVUP and the images), the
   // records' geometry, and the rest of the records (pose, views, framing).
   size_t header_bytes = 0, view_bytes = 0, geometry_bytes = 0, frame_bytes = 0;

@@ -56,12 +56,22 @@ struct WalkViewOptions {
   double occlusion_margin = 2;
   bool occlusion_updates = false;
   size_t occlusion_tolerance_px = 0;
+  // Texels around a polygon's footprint in a view counted as read (Update::
+  // mcus): the bilinear filter's neighbour and the client's fixed-point
+  // cameras.
+  double region_margin = 3;
 };
 
 struct WalkViewPlan {
   struct Update {
     uint32_t slot;
     uint32_t camera_frame;  // the path frame whose camera the view is rendered at
+    // The view's MCUs (16 x 16 texels, raster order) the client samples
+    // while the view is in its slot: non-zero where the part of a polygon
+    // the plan draws from it, on the screen of a frame it does so, lies in
+    // the view, widened by WalkViewOptions::region_margin texels. The rest
+    // of the view is never read (a region update need not code it).
+    std::vector<uint8_t> mcus;
   };
   std::vector<std::vector<Update>> updates;  // per frame: views to have arrived by that frame
   // Per frame, per visible polygon (as given): the slot that serves it, -1 for none.
