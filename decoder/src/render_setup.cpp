@@ -495,7 +495,9 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   s.fast_qhi = s.whi < kQMax ? s.whi : kQMax;
   // Empty: no span of a non-projective polygon passes both checks anyway.
   if (s.nn && !s.proj && s.fast_qlo > s.fast_qhi) s.fast = false;
-  s.fast_safe = s.fast && fast_safe(target, s, v, n, pp->row_begin, pp->row_end);
+  // (View-mapped polygons only: on the other materials' larger polygons the
+  // check at set-up cost more than the spans saved, bench/results/render.md.)
+  s.fast_safe = s.fast && s.proj && fast_safe(target, s, v, n, pp->row_begin, pp->row_end);
   pp->fn = select_span(target, m, repeat);
 }
 

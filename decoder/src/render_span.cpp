@@ -609,7 +609,7 @@ template <int NN, bool kProj>
 template <int NN, bool kProj>
 [[gnu::always_inline]] inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
   if (!s.fast) return false;
-  if (s.fast_safe) {
+  if (kProj && s.fast_safe) {
     row_safe<NN, kProj>(s, y, x, r);
 #ifdef VDS_CHECK_FAST_SAFE
     PolySetup t = s;
@@ -880,6 +880,16 @@ template <class S>
 constexpr bool chroma_memo() {
   if constexpr (requires { S::kChromaMemo; }) {
     return S::kChromaMemo;
+  } else {
+    return false;
+  }
+}
+// Whether a sampler's variant for pieces inside the texture keeps its
+// chroma texel (the walkthrough's views).
+template <class S>
+constexpr bool memo_inside() {
+  if constexpr (S::kHasInside) {
+    return chroma_memo<typename S::Inside>();
   } else {
     return false;
   }
@@ -1193,9 +1203,12 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
     // The start values are inlined into the loops of rgb565 textures drawn
     // to rgb565 (about 1 instruction per pixel less in the scenes of
     // bench/results/render.md), called from the others (code size).
-    // A polygon whose start values need no checks takes them inline.
+    // A polygon whose start values need no checks takes them inline in the
+    // walkthrough's loop (view-mapped Y'CbCr sampled with the chroma memo);
+    // in the others row_fast takes them without the checks.
+    constexpr bool kInlineSafe = kProj && memo_inside<Sampler>();
     bool fast = true;
-    if (s.fast_safe) {
+    if (kInlineSafe && s.fast_safe) {
       row_safe<2, kProj>(s, y, xa, r);
     } else if constexpr (Sampler::kInlineStart && !kProj) {
       fast = row_fast<2, kProj>(s, y, xa, len, r);

@@ -69,8 +69,9 @@ struct PolySetup {
   int32_t wlo, whi;
   int32_t fast_qlo, fast_qhi;  // [1, kQMax] and [wlo, whi] together (q is W), not empty
   // The fast start values of every pixel the polygon covers lie inside
-  // those limits (checked once at set-up, at its vertices: fast_bounded in
-  // render_setup.cpp), so a span takes them without the checks.
+  // those limits (checked once at set-up over the box of its columns and
+  // rows on the frame: fast_safe in render_setup.cpp; view-mapped polygons
+  // only), so a span takes them without the checks.
   bool fast_safe;
 };
 
