@@ -839,11 +839,13 @@ template <class Sampler, PixelFormat O, DepthFormat D>
 // The sample coordinates of pixel k of a piece, as span_pixels computes them.
 template <bool kProj>
 inline void piece_uv(const RowState& r, int32_t k, int32_t* u, int32_t* v) {
-  // Inside the piece no value wraps (row_fast and row_piece check both ends).
-  const int32_t q = static_cast<int32_t>(r.q + int64_t{r.dq} * k);
-  const int32_t w = static_cast<int32_t>(r.w + int64_t{r.dw} * k);
-  sample_uv(static_cast<int32_t>(r.n[0] + int64_t{r.dn[0]} * k), static_cast<int32_t>(r.n[1] + int64_t{r.dn[1]} * k),
-            kProj ? w : q, r.sh_base, u, v);
+  // Inside the piece every value fits int32 (row_fast and row_piece check
+  // both ends, or fast_safe all of the polygon's), so 32-bit arithmetic
+  // modulo 2^32 gives it exactly.
+  const auto at = [k](int32_t a, int32_t d) {
+    return static_cast<int32_t>(static_cast<uint32_t>(a) + static_cast<uint32_t>(d) * static_cast<uint32_t>(k));
+  };
+  sample_uv(at(r.n[0], r.dn[0]), at(r.n[1], r.dn[1]), kProj ? at(r.w, r.dw) : at(r.q, r.dq), r.sh_base, u, v);
 }
 
 // Whether every pixel of the piece samples inside the box. Over a piece the
@@ -858,11 +860,16 @@ struct PieceEnds {
   int32_t u0, v0, u1, v1;
 };
 template <bool kProj>
-[[gnu::noinline]] PieceEnds piece_ends(const RowState& r, int32_t len) {
+[[gnu::always_inline]] inline PieceEnds piece_ends_inline(const RowState& r, int32_t len) {
   PieceEnds p;
   piece_uv<kProj>(r, 0, &p.u0, &p.v0);
   piece_uv<kProj>(r, len - 1, &p.u1, &p.v1);
   return p;
+}
+// (A call of its own, but in the walkthrough's loop: code size.)
+template <bool kProj>
+[[gnu::noinline]] PieceEnds piece_ends(const RowState& r, int32_t len) {
+  return piece_ends_inline<kProj>(r, len);
 }
 inline bool ends_inside(const PieceEnds& p, const UvBox& b) {
   const int32_t far = (b.uhi > b.vhi ? b.uhi : b.vhi);
@@ -1233,7 +1240,7 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
     // without the clamps (the same texels: about 20 Cortex-M4 instructions
     // a pixel less for bilinear 4:2:0).
     if constexpr (kProj) {
-      const PieceEnds ends = piece_ends<true>(r, len);
+      const PieceEnds ends = kInlineSafe ? piece_ends_inline<true>(r, len) : piece_ends<true>(r, len);
       if constexpr (Sampler::kHasInside) {
         if (ends_inside(ends, Sampler::inside_box(tex))) {
           affine_pixels<typename Sampler::Inside, O, D>(ze, oe, len, r, tex, ends);
