@@ -30,15 +30,15 @@ struct Stream {
 Stream valid_walk() {
   vds::enc::WalkEncodeOptions o;
   o.quality = 20;
-  o.width = 64;
-  o.height = 48;
+  o.width = 128;  // (views two thirds of that each side: some of their MCUs unread, region images)
+  o.height = 96;
   o.refine_delta = 30;  // residual refinements too
   o.refine_after = 2;
   o.predict = true;  // and updates against the client's prediction
   o.threshold = 1.35;
   const auto r = vds::enc::encode_walk(vds::test::walk_room(), vds::test::walk_room_path(8), o);
-  if (r.view_predicted == 0 || r.view_refinements == 0) {
-    std::fprintf(stderr, "fuzz_walk_stream: the seed stream lacks predicted updates or refinements\n");
+  if (r.view_predicted == 0 || r.view_refinements == 0 || r.view_mcus_coded == r.view_mcus) {
+    std::fprintf(stderr, "fuzz_walk_stream: the seed stream lacks predicted updates, refinements or region images\n");
     std::abort();
   }
   Stream s;
