@@ -17,6 +17,10 @@ inline uint64_t abs64(int64_t v) { return v < 0 ? 0 - static_cast<uint64_t>(v) :
 inline int64_t wrap_add64(int64_t a, int64_t b) { return static_cast<int64_t>(static_cast<uint64_t>(a) + static_cast<uint64_t>(b)); }
 inline int64_t wrap_mul64(int64_t a, int64_t b) { return static_cast<int64_t>(static_cast<uint64_t>(a) * static_cast<uint64_t>(b)); }
 inline int32_t wrap_add32(int32_t a, int32_t b) { return static_cast<int32_t>(static_cast<uint32_t>(a) + static_cast<uint32_t>(b)); }
+// a + d k modulo 2^32: exact whenever the true value fits int32.
+inline int32_t wrap_mad32(int32_t a, int32_t d, int32_t k) {
+  return static_cast<int32_t>(static_cast<uint32_t>(a) + static_cast<uint32_t>(d) * static_cast<uint32_t>(k));
+}
 
 constexpr int64_t kSat62 = int64_t{1} << 62;
 

@@ -118,7 +118,8 @@ namespace {
 // --- Stage 1: where the polygon lies ---------------------------------------
 // Rows and columns the polygon can touch (pixel centres inside its box) and
 // its outline. false: nothing of it is on the target.
-bool place(const PolygonTarget& target, const ScreenVertex* v, int n, PreparedPolygon* pp) {
+// *x_min and *x_max: the outline's extremes (Q24.8), for fast_safe.
+bool place(const PolygonTarget& target, const ScreenVertex* v, int n, PreparedPolygon* pp, int32_t* x_min, int32_t* x_max) {
   int32_t xmin = v[0].x, xmax = v[0].x, ymin = v[0].y, ymax = v[0].y;
   for (int i = 1; i < n; ++i) {
     xmin = v[i].x < xmin ? v[i].x : xmin;
@@ -128,6 +129,8 @@ bool place(const PolygonTarget& target, const ScreenVertex* v, int n, PreparedPo
   }
   pp->row_begin = raster_row(ymin);
   pp->row_end = raster_row(ymax);
+  *x_min = xmin;
+  *x_max = xmax;
   if (xmin < -kRasterCoordLimit || xmax > kRasterCoordLimit || ymin < -kRasterCoordLimit || ymax > kRasterCoordLimit) {
     return false;  // cannot happen after guard-band clipping; kept as a hard limit
   }
@@ -394,14 +397,8 @@ bool fast_bounded(int32_t c, int32_t step, int32_t g, int64_t lo, int64_t hi, co
 // Whether every fast start value of every pixel the polygon covers lies
 // inside the limits row_fast checks (PolySetup::fast_safe). The pixels
 // covered lie in the box of the outline's columns and rows on the frame (a
-// pixel is covered when its centre is inside).
-bool fast_safe(const PolygonTarget& t, const PolySetup& s, const ScreenVertex* v, int n, int32_t row_begin,
-               int32_t row_end) {
-  int32_t xmin = v[0].x, xmax = v[0].x;
-  for (int i = 1; i < n; ++i) {
-    xmin = v[i].x < xmin ? v[i].x : xmin;
-    xmax = v[i].x > xmax ? v[i].x : xmax;
-  }
+// pixel is covered when its centre is inside): x in [xmin, xmax] (Q24.8).
+bool fast_safe(const PolygonTarget& t, const PolySetup& s, int32_t xmin, int32_t xmax, int32_t row_begin, int32_t row_end) {
   const int32_t c0 = raster_row(xmin) > 0 ? raster_row(xmin) : 0;
   const int32_t c1 = raster_row(xmax) < t.width - 1 ? raster_row(xmax) : t.width - 1;
   const int32_t r0 = row_begin > 0 ? row_begin : 0;
@@ -424,7 +421,8 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   pp->culled = false;
   pp->set_up = false;
   pp->n = n;
-  if (!place(target, v, n, pp)) return;
+  int32_t xmin, xmax;
+  if (!place(target, v, n, pp, &xmin, &xmax)) return;
   const Fan fan = fan_triangle(v, n);
   const Mesh& m = *mat.mesh;
   if (fan.area == 0 || fan.best == 0 || (m.cull == Cull::back && fan.area > 0) || (m.cull == Cull::front && fan.area < 0)) {
@@ -497,7 +495,7 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   if (s.nn && !s.proj && s.fast_qlo > s.fast_qhi) s.fast = false;
   // (View-mapped polygons only: on the other materials' larger polygons the
   // check at set-up cost more than the spans saved, bench/results/render.md.)
-  s.fast_safe = s.fast && s.proj && fast_safe(target, s, v, n, pp->row_begin, pp->row_end);
+  s.fast_safe = s.fast && s.proj && fast_safe(target, s, xmin, xmax, pp->row_begin, pp->row_end);
   pp->fn = select_span(target, m, repeat);
 }
 

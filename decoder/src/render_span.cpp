@@ -581,13 +581,19 @@ template <int NN, bool kProj>
 
 // The fast start values of a polygon whose values all lie inside their
 // limits (PolySetup::fast_safe): each fits int32, so it is exact modulo 2^32.
+// (Built with VDS_CHECK_FAST_SAFE it traps where the checks row_fast skips
+// for such a polygon would fail.)
 template <int NN, bool kProj>
-[[gnu::always_inline]] inline void row_safe(const PolySetup& s, int32_t y, int32_t x, RowState& r) {
+[[gnu::always_inline]] inline void row_safe(const PolySetup& s, int32_t y, int32_t x, [[maybe_unused]] int32_t len,
+                                            RowState& r) {
+#ifdef VDS_CHECK_FAST_SAFE
+  PolySetup t = s;
+  t.fast_safe = false;
+  RowState checked;
+  if (!row_fast_call<NN, kProj>(t, y, x, len, checked)) __builtin_trap();
+#endif
   const int32_t dx = x - s.fast_xr, dy = y - s.fast_yr;
-  const auto start = [dx, dy](int32_t c, int32_t step, int32_t g) {
-    return static_cast<int32_t>(static_cast<uint32_t>(c) + static_cast<uint32_t>(step) * static_cast<uint32_t>(dx) +
-                                static_cast<uint32_t>(g) * static_cast<uint32_t>(dy));
-  };
+  const auto start = [dx, dy](int32_t c, int32_t step, int32_t g) { return wrap_mad32(wrap_mad32(c, step, dx), g, dy); };
   r.q = start(s.fast_cq, s.fast_dq, s.fast_gq);
   r.dq = s.fast_dq;
   if constexpr (NN > 0) {
@@ -610,13 +616,7 @@ template <int NN, bool kProj>
 [[gnu::always_inline]] inline bool row_fast(const PolySetup& s, int32_t y, int32_t x, int32_t len, RowState& r) {
   if (!s.fast) return false;
   if (kProj && s.fast_safe) {
-    row_safe<NN, kProj>(s, y, x, r);
-#ifdef VDS_CHECK_FAST_SAFE
-    PolySetup t = s;
-    t.fast_safe = false;
-    RowState r2;
-    if (!row_fast_call<NN, kProj>(t, y, x, len, r2)) __builtin_trap();
-#endif
+    row_safe<NN, kProj>(s, y, x, len, r);
     return true;
   }
   const int32_t dx = x - s.fast_xr, dy = y - s.fast_yr;
@@ -842,10 +842,8 @@ inline void piece_uv(const RowState& r, int32_t k, int32_t* u, int32_t* v) {
   // Inside the piece every value fits int32 (row_fast and row_piece check
   // both ends, or fast_safe all of the polygon's), so 32-bit arithmetic
   // modulo 2^32 gives it exactly.
-  const auto at = [k](int32_t a, int32_t d) {
-    return static_cast<int32_t>(static_cast<uint32_t>(a) + static_cast<uint32_t>(d) * static_cast<uint32_t>(k));
-  };
-  sample_uv(at(r.n[0], r.dn[0]), at(r.n[1], r.dn[1]), kProj ? at(r.w, r.dw) : at(r.q, r.dq), r.sh_base, u, v);
+  sample_uv(wrap_mad32(r.n[0], r.dn[0], k), wrap_mad32(r.n[1], r.dn[1], k),
+            kProj ? wrap_mad32(r.w, r.dw, k) : wrap_mad32(r.q, r.dq, k), r.sh_base, u, v);
 }
 
 // Whether every pixel of the piece samples inside the box. Over a piece the
@@ -951,10 +949,9 @@ inline int32_t hold_affine(int32_t x) { return x < -kAffineLimit ? -kAffineLimit
 // moved there.
 [[gnu::always_inline]] inline void run_steps(const RowState& r, int32_t n, AffineRun* a, int32_t* su, int32_t* sv,
                                              int32_t* du, int32_t* dv) {
-  const uint32_t un = static_cast<uint32_t>(n);
-  a->nu = wrap_add32(a->nu, static_cast<int32_t>(un * static_cast<uint32_t>(r.dn[0])));
-  a->nv = wrap_add32(a->nv, static_cast<int32_t>(un * static_cast<uint32_t>(r.dn[1])));
-  a->w = wrap_add32(a->w, static_cast<int32_t>(un * static_cast<uint32_t>(r.dw)));
+  a->nu = wrap_mad32(a->nu, r.dn[0], n);
+  a->nv = wrap_mad32(a->nv, r.dn[1], n);
+  a->w = wrap_mad32(a->w, r.dw, n);
   int32_t u1, v1;
   sample_uv(a->nu, a->nv, a->w, r.sh_base, &u1, &v1);
   run_to(a, n, hold_affine(u1), hold_affine(v1), su, sv, du, dv);
@@ -1216,20 +1213,12 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
     constexpr bool kInlineSafe = kProj && memo_inside<Sampler>();
     bool fast = true;
     if (kInlineSafe && s.fast_safe) {
-      row_safe<2, kProj>(s, y, xa, r);
+      row_safe<2, kProj>(s, y, xa, len, r);
     } else if constexpr (Sampler::kInlineStart && !kProj) {
       fast = row_fast<2, kProj>(s, y, xa, len, r);
     } else {
       fast = row_fast_call<2, kProj>(s, y, xa, len, r);
     }
-#ifdef VDS_CHECK_FAST_SAFE
-    if (s.fast_safe) {
-      PolySetup t = s;
-      t.fast_safe = false;
-      RowState r2;
-      if (!row_fast<2, kProj>(t, y, xa, len, r2)) __builtin_trap();
-    }
-#endif
     if (!fast) {
       while (!row_piece(s, y, xa, len, r)) len = (len + 1) >> 1;
     }

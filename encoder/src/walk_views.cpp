@@ -157,20 +157,24 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     const double in_view = seen_share(id, rcams[g], shown->second);
     return in_view >= 0 && in_view < on - o.occlusion_margin;
   };
+  // The part of polygon id frame f's screen shows, in front of the near
+  // plane of the view at frame g (empty: none).
+  const auto screen_part = [&](size_t f, size_t g, uint32_t id) {
+    std::vector<P3> poly = corners(id);
+    std::vector<Plane> planes;
+    frustum(scams[f], o.width, o.height, &planes);
+    planes.push_back({vscams[g].forward, vscams[g].position, o.near_z * 1.01});
+    for (const Plane& pl : planes) {
+      clip(poly, pl);
+      if (poly.empty()) break;
+    }
+    return poly;
+  };
   const auto factor = [&](size_t f, size_t g, uint32_t id) {
     const auto shown = shows[g].find(id);
     if (shown == shows[g].end()) return inf;
-    std::vector<P3> poly = corners(id);
-    // Clip against the screen's frustum and the view's near plane.
-    const SceneCamera& sc = scams[f];
-    const SceneCamera& vc = vscams[g];
-    std::vector<Plane> planes;
-    frustum(sc, o.width, o.height, &planes);
-    planes.push_back({vc.forward, vc.position, o.near_z * 1.01});
-    for (const Plane& pl : planes) {
-      clip(poly, pl);
-      if (poly.empty()) return inf;
-    }
+    const std::vector<P3> poly = screen_part(f, g, id);
+    if (poly.empty()) return inf;
     Vec3<Q16_16> tri[3];
     for (int k = 0; k < 3; ++k) {
       const auto& v = s.vertices[s.indices[3 * static_cast<size_t>(id) + static_cast<size_t>(k)]].pos;
@@ -196,14 +200,8 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   // MCU its outline, widened by the margin, overlaps.
   const int mw = (vw + 15) / 16, mh = (vh + 15) / 16;
   const auto mark = [&](std::vector<uint8_t>& mcus, size_t f, size_t g, uint32_t id) {
-    std::vector<P3> poly = corners(id);
-    std::vector<Plane> planes;
-    frustum(scams[f], o.width, o.height, &planes);
-    planes.push_back({vscams[g].forward, vscams[g].position, o.near_z * 1.01});
-    for (const Plane& pl : planes) {
-      clip(poly, pl);
-      if (poly.empty()) return;
-    }
+    const std::vector<P3> poly = screen_part(f, g, id);
+    if (poly.empty()) return;
     std::vector<std::array<double, 2>> q;
     for (const P3& p : poly) {
       int32_t x, y;
