@@ -34,9 +34,12 @@ Status walk_camera(const StreamHeader& h, const WalkPose& pose, Camera* out) {
   return Status::ok;
 }
 
-Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPose& pose, Camera* out) {
+Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPose& pose, Camera* out, uint8_t zoom) {
+  if (zoom < kWalkZoomUnit || zoom > kWalkMaxZoom) return Status::malformed;
+  const int64_t focal = static_cast<int64_t>(w.view_focal_q16) * zoom / kWalkZoomUnit;
+  if (focal <= 0 || focal > INT32_MAX) return Status::malformed;
   StreamHeader v = h;
-  v.focal_x_q16 = v.focal_y_q16 = w.view_focal_q16;
+  v.focal_x_q16 = v.focal_y_q16 = static_cast<int32_t>(focal);
   v.center_x_q16 = static_cast<int32_t>(w.view_width) << 15;
   v.center_y_q16 = static_cast<int32_t>(w.view_height) << 15;
   return walk_camera(v, pose, out);
@@ -80,7 +83,9 @@ void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]) {
 }
 
 Status walk_view_from_bytes(const uint8_t* p, uint32_t size, WalkViewUpdate* out) {
-  if (size != kWalkViewBytes) return Status::malformed;
+  if (size != kWalkViewBytes && size != kWalkViewMaxBytes) return Status::malformed;
+  out->zoom = size == kWalkViewMaxBytes ? p[17] : kWalkZoomUnit;
+  if (size == kWalkViewMaxBytes && (out->zoom <= kWalkZoomUnit || out->zoom > kWalkMaxZoom)) return Status::malformed;
   out->slot = p[0] & static_cast<uint8_t>(~kWalkViewPredict);
   out->predict = (p[0] & kWalkViewPredict) != 0;
   out->pose.position = {Q16_16::from_raw(load_le32s(p + 1)), Q16_16::from_raw(load_le32s(p + 5)), Q16_16::from_raw(load_le32s(p + 9))};
@@ -89,13 +94,16 @@ Status walk_view_from_bytes(const uint8_t* p, uint32_t size, WalkViewUpdate* out
   return Status::ok;
 }
 
-void walk_view_to_bytes(const WalkViewUpdate& u, uint8_t out[kWalkViewBytes]) {
+uint32_t walk_view_to_bytes(const WalkViewUpdate& u, uint8_t out[kWalkViewMaxBytes]) {
   out[0] = static_cast<uint8_t>(u.slot | (u.predict ? kWalkViewPredict : 0));
   store_le32(out + 1, static_cast<uint32_t>(u.pose.position.x.raw()));
   store_le32(out + 5, static_cast<uint32_t>(u.pose.position.y.raw()));
   store_le32(out + 9, static_cast<uint32_t>(u.pose.position.z.raw()));
   store_le16(out + 13, u.pose.yaw);
   store_le16(out + 15, u.pose.pitch);
+  if (u.zoom == kWalkZoomUnit) return kWalkViewBytes;
+  out[17] = u.zoom;
+  return kWalkViewMaxBytes;
 }
 
 void WalkFrameState::reset() {

@@ -27,8 +27,9 @@ struct EncodeWalkOptions {
   double rate = 16, threshold = 18, widen = -1, view_scale = -1, occlusion = -1, occlusion_tolerance = -1;
   double shape_tolerance = -1, vertex_tolerance = -1;  // metres
   int lookahead = -1, preroll = -1, window = -1, max_sends = -1;
+  double zoom_run = -1;
   bool predict = false, keep_triangles = false, no_occlusion_updates = false, whole_views = false;
-  int views = 2, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
+  int views = 2, zoom = -1, zoom_min_run = -1, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
 };
 
 void run_encode_walk(const EncodeWalkOptions& o) {
@@ -56,6 +57,9 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.frames_per_record = o.frames_per_record;
   wo.predict = o.predict;
   wo.regions = !o.whole_views;
+  if (o.zoom >= 0) wo.zoom = o.zoom;
+  if (o.zoom_min_run >= 0) wo.zoom_min_run = o.zoom_min_run;
+  if (o.zoom_run >= 0) wo.zoom_run = o.zoom_run;
   if (o.vertex_tolerance >= 0) wo.vertex_tolerance_m = o.vertex_tolerance;
   if (o.preroll >= 0) wo.preroll_ms = static_cast<uint32_t>(o.preroll);
   if (o.window >= 0) wo.buffer_bytes = static_cast<size_t>(o.window);
@@ -95,10 +99,10 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   for (int q : r.view_quality) qmin = std::min(qmin, q), qmax = std::max(qmax, q);
   if (r.view_quality.empty()) qmin = qmax = 0;
   std::printf("%s: %zu frames (%.1f s), %zu bytes = %.2f kbit/s (target %.2f): header %zu, views %zu (%zu updates at quality %d to %d, "
-              "mean %d, %zu of them residuals against the client's prediction, %zu refinements; %zu of their %zu MCUs coded), "
+              "mean %d, %zu of them zoomed, %zu residuals against the client's prediction, %zu refinements; %zu of their %zu MCUs coded), "
               "geometry %zu, frames %zu\n",
               o.out.c_str(), path.frames.size(), secs, r.stream.size(), r.kbps, o.rate, r.header_bytes, r.view_bytes,
-              r.view_updates, qmin, qmax, r.quality, r.view_predicted, r.view_refinements, r.view_mcus_coded, r.view_mcus,
+              r.view_updates, qmin, qmax, r.quality, r.view_zoomed, r.view_predicted, r.view_refinements, r.view_mcus_coded, r.view_mcus,
               r.geometry_bytes, r.frame_bytes);
   if (r.rate_bytes != 0)
     std::printf("  schedule: pre-roll %.3f s at %u bytes/s into a %u-byte window: every frame's data arrives by its time; "
@@ -142,6 +146,12 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--frames-per-record", o->frames_per_record, "Most frames a WFRM record holds (default 8)")
       ->check(CLI::Range(1, static_cast<int>(kWalkMaxFramesPerRecord)));
   sub->add_flag("--predict", o->predict, "View updates may be residuals against the client's prediction of the view");
+  sub->add_option("--zoom", o->zoom,
+                  "Zoomed view updates: a view whose focal length is the views' times Z / 16 where it serves long enough (16: none)")
+      ->check(CLI::Range(16, 64));
+  sub->add_option("--zoom-run", o->zoom_run, "A zoomed view serves at least this share of the frames the unzoomed one would")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--zoom-min-run", o->zoom_min_run, "... and at least this many frames")->check(CLI::Range(1, 1000));
   sub->add_flag("--whole-views", o->whole_views, "View updates code the whole view, not only the MCUs the client reads while it serves");
   sub->add_option("--lookahead", o->lookahead, "Frames ahead a view's camera may come from (default 20)")->check(CLI::Range(0, 200));
   sub->add_option("--widen", o->widen, "tan(half the views' field of view) / tan(half the screen's) (default 1.5)")

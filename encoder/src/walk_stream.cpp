@@ -189,6 +189,9 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vo.occlusion_margin = o.occlusion_margin;
   vo.occlusion_updates = o.occlusion_updates;
   vo.occlusion_tolerance_px = static_cast<size_t>(o.occlusion_tolerance * o.width * o.height);
+  vo.zoom = o.zoom;
+  vo.zoom_run = o.zoom_run;
+  vo.zoom_min_run = o.zoom_min_run;
   vo.width = o.width;
   vo.height = o.height;
   // Views see wider than the screen (a pan stays inside a view longer):
@@ -210,17 +213,25 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   // 3. The views, rendered at the client's cameras.
   std::vector<WalkPose> poses(n);
   for (size_t f = 0; f < n; ++f) poses[f] = walk_pose(path.frames[f]);
+  // A view's camera is named by an index: frame g at the views' own focal
+  // length is g, zoomed n + g (WalkViewOptions::zoom).
+  const auto camera_of = [&](const WalkViewPlan::Update& u) { return u.camera_frame + (u.zoom != 16 ? static_cast<uint32_t>(n) : 0u); };
+  const auto frame_of = [&](uint32_t j) { return j % static_cast<uint32_t>(n); };
+  const auto zoom_of = [&](uint32_t j) { return j >= n ? static_cast<uint8_t>(o.zoom) : kWalkZoomUnit; };
+  const auto wvup_bytes = [&](uint32_t j) -> size_t { return zoom_of(j) != kWalkZoomUnit ? kWalkViewMaxBytes : kWalkViewBytes; };
   // (As Y'CbCr planes, the form the image codec takes.)
   std::map<uint32_t, Planes> view_planes;
   for (const auto& ups : vp.updates)
-    for (const auto& u : ups) view_planes[u.camera_frame];
+    for (const auto& u : ups) view_planes[camera_of(u)];
   size_t done = 0;
   RenderOptions view_ro = ro;
   view_ro.width = view_w;
   view_ro.height = view_h;
   const SceneRenderer view_renderer(s, images, view_ro);
-  for (auto& [g, planes] : view_planes) {
-    planes = rgb_to_planes(view_renderer.render(from_walk_pose(poses[g]), view_hfov).rgb, ChromaFormat::yuv420);
+  const double zoomed_hfov = 2 * std::atan(std::tan(view_hfov * kDeg / 2) * kWalkZoomUnit / std::max(16, o.zoom)) / kDeg;
+  for (auto& [j, planes] : view_planes) {
+    planes = rgb_to_planes(view_renderer.render(from_walk_pose(poses[frame_of(j)]), j >= n ? zoomed_hfov : view_hfov).rgb,
+                           ChromaFormat::yuv420);
     progress("views", ++done, view_planes.size());
   }
   // 4. The header and the parts that do not depend on the views' quality.
@@ -253,7 +264,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   for (size_t f = 0; f < n; ++f)
     for (const auto& u : vp.updates[f]) {
       update_of[f].push_back(update_camera.size());
-      update_camera.push_back(u.camera_frame);
+      update_camera.push_back(camera_of(u));
       const bool whole = !o.regions || std::all_of(u.mcus.begin(), u.mcus.end(), [](uint8_t m) { return m != 0; });
       update_region.push_back(whole ? std::vector<uint8_t>{} : u.mcus);
     }
@@ -261,7 +272,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   // refine_after frames after it arrives, a residual image at a higher
   // quality against what the client holds of it.
   struct Refine {
-    uint32_t slot, camera_frame;
+    uint32_t slot, camera;  // camera: as update_camera names it
     size_t update;  // the update it refines
   };
   std::vector<std::vector<Refine>> refines(n);
@@ -275,7 +286,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
             if (v.slot == u.slot) next = g;
         const size_t at = f + static_cast<size_t>(o.refine_after);
         if (next - f >= 2 * static_cast<size_t>(o.refine_after) && at < n)
-          refines[at].push_back({u.slot, u.camera_frame, update_of[f][k]});
+          refines[at].push_back({u.slot, camera_of(u), update_of[f][k]});
       }
   }
   // Records: a frame with view updates or refinements starts one (they
@@ -391,9 +402,9 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     for (size_t r = 0; r < record_start.size(); ++r) {
       const uint32_t f = static_cast<uint32_t>(record_start[r]);
       const uint32_t last = static_cast<uint32_t>(record_end(r) - 1);
-      for (size_t u : update_of[f]) p.push_back({kFraming + kWalkViewBytes + update_image(u, q[u]).coded_bytes(), f, f, false});
+      for (size_t u : update_of[f]) p.push_back({kFraming + wvup_bytes(update_camera[u]) + update_image(u, q[u]).coded_bytes(), f, f, false});
       for (const Refine& rf : refines[f])
-        p.push_back({kFraming + kWalkViewBytes + intra(rf.camera_frame, std::min(100, q[rf.update] + o.refine_delta)).coded_bytes(), f, f, false});
+        p.push_back({kFraming + wvup_bytes(rf.camera) + intra(rf.camera, std::min(100, q[rf.update] + o.refine_delta)).coded_bytes(), f, f, false});
       p.push_back({kFraming + wfrm[r].size(), f, last, true});
     }
     return p;
@@ -413,23 +424,23 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     res->header_bytes = w.size();
     written.assign(1, WalkPiece{w.size(), 0, 0, false});
     res->view_bytes = res->geometry_bytes = res->frame_bytes = 0;
-    res->view_updates = res->view_refinements = res->view_predicted = 0;
+    res->view_updates = res->view_refinements = res->view_predicted = res->view_zoomed = 0;
     res->view_mcus = res->view_mcus_coded = 0;
     res->bytes_by_frame.assign(n, 0);
     // A view into a slot: WVUP with its camera's pose, then its image:
     // intra, or a residual against what the client then holds (its
     // prediction of the view, whichever is better; a refinement's base).
-    const auto put_view = [&](uint32_t slot, uint32_t camera_frame, size_t update, int quality, bool refine) {
+    const auto put_view = [&](uint32_t slot, uint32_t camera, size_t update, int quality, bool refine) {
       const size_t before = w.size();
-      uint8_t vb[kWalkViewBytes];
+      uint8_t vb[kWalkViewMaxBytes];
       WalkViewUpdate u;
       u.slot = static_cast<uint8_t>(slot);
+      u.zoom = zoom_of(camera);
       u.predict = o.predict && !refine;
-      u.pose = poses[camera_frame];
-      walk_view_to_bytes(u, vb);
-      w.add_chunk(chunk::kWalkView, vb);
+      u.pose = poses[frame_of(camera)];
+      w.add_chunk(chunk::kWalkView, std::span<const uint8_t>(vb, walk_view_to_bytes(u, vb)));
       client.feed(w);
-      const EncodedImage* image = refine ? &intra(camera_frame, quality) : &update_image(update, quality);
+      const EncodedImage* image = refine ? &intra(camera, quality) : &update_image(update, quality);
       EncodedImage residual;
       if (refine || client.predicted()) {
         const Planes base = client.slot(static_cast<uint8_t>(slot));
@@ -439,7 +450,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
         ro.prediction = &base;
         if (!refine) ro.region = update_region[update];
         ro.quality = refine ? std::min(100, quality + o.refine_delta) : quality;
-        residual = encode_planes(view_planes.at(camera_frame), ro);
+        residual = encode_planes(view_planes.at(camera), ro);
         // Rate and distortion together: about 3.5 dB a doubling of bytes
         // is where these images' curves run.
         const auto merit = [](const EncodedImage& e) { return e.psnr - 3.5 * std::log2(static_cast<double>(e.coded_bytes())); };
@@ -460,12 +471,13 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
         const size_t u = update_of[f][k];
         written.push_back({put_view(vp.updates[f][k].slot, update_camera[u], u, q[u], false), f, f, false});
         ++res->view_updates;
+        res->view_zoomed += vp.updates[f][k].zoom != kWalkZoomUnit ? 1 : 0;
         res->view_mcus += vp.updates[f][k].mcus.size();
         res->view_mcus_coded += update_region[u].empty() ? vp.updates[f][k].mcus.size()
                                                          : static_cast<size_t>(std::count(update_region[u].begin(), update_region[u].end(), uint8_t{1}));
       }
       for (const Refine& rf : refines[f]) {
-        written.push_back({put_view(rf.slot, rf.camera_frame, rf.update, q[rf.update], true), f, f, false});
+        written.push_back({put_view(rf.slot, rf.camera, rf.update, q[rf.update], true), f, f, false});
         ++res->view_refinements;
       }
       const size_t before = w.size();

@@ -51,6 +51,10 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   if (view_visible != nullptr && view_visible->size() != n) throw std::invalid_argument("plan_walk_views: one view visibility list per frame");
   const int vw = o.view_width > 0 ? o.view_width : o.width, vh = o.view_height > 0 ? o.view_height : o.height;
   // Each frame's camera as the screen and as a view: the client's and the scene's.
+  if (o.zoom < 16 || o.zoom > 64) throw std::invalid_argument("plan_walk_views: a zoom of 16 to 64");
+  // A view's camera is named by an index: frame g at the views' own focal
+  // length is g, zoomed (WalkViewOptions::zoom) n + g.
+  const int zooms = o.zoom > 16 ? 2 : 1;
   std::vector<vds::Camera> cams, vcams;
   std::vector<SceneCamera> scams, vscams;
   for (const CameraPose& p : path.frames) {
@@ -58,6 +62,16 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     vcams.push_back(client_camera(p, view_hfov, vw, vh, o.near_z, o.far_z));
     scams.push_back(scene_camera(p, path.hfov_deg, o.width, o.height));
     vscams.push_back(scene_camera(p, view_hfov, vw, vh));
+  }
+  if (zooms > 1) {
+    const double kDeg = 3.14159265358979323846 / 180;
+    const double zoomed_hfov = 2 * std::atan(std::tan(view_hfov * kDeg / 2) * 16 / o.zoom) / kDeg;
+    for (size_t g = 0; g < n; ++g) {
+      vds::Camera c = vcams[g];  // the client's: the views' focal length times zoom / 16
+      c.fx = c.fy = Q16_16::from_raw(static_cast<int32_t>(static_cast<int64_t>(c.fx.raw()) * o.zoom / 16));
+      vcams.push_back(c);
+      vscams.push_back(scene_camera(path.frames[g], zoomed_hfov, vw, vh));
+    }
   }
   // Polygons the view at each frame's camera shows, with the pixels they
   // cover there (at the frame's size), for "does view v show polygon p";
@@ -147,7 +161,8 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   // Whether the view at frame g sees a clearly smaller share of the
   // polygon than frame f's screen does: something stands in front of it
   // there, which the view would draw onto it.
-  const auto occluded = [&](size_t f, size_t g, uint32_t id) {
+  const auto occluded = [&](size_t f, size_t j, uint32_t id) {
+    const size_t g = j % n;  // (a zoomed view's visibility: its frame's, cut by its image's bounds)
     if (f == g || !(o.occlusion_margin <= 1)) return false;
     const auto shown = shows[g].find(id);
     const auto sf = on_screen[f].find(id);
@@ -171,8 +186,8 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     return poly;
   };
   const auto factor = [&](size_t f, size_t g, uint32_t id) {
-    const auto shown = shows[g].find(id);
-    if (shown == shows[g].end()) return inf;
+    const auto shown = shows[g % n].find(id);
+    if (shown == shows[g % n].end()) return inf;
     const std::vector<P3> poly = screen_part(f, g, id);
     if (poly.empty()) return inf;
     Vec3<Q16_16> tri[3];
@@ -284,18 +299,23 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
       // The camera, from this frame up to `lookahead` ahead, with which the
       // views serve the most frames from this one on (the frame itself
       // always serves itself; ties: the later camera).
-      size_t best = f, best_run = 0;
+      // A zoomed view instead when it serves long enough (WalkViewOptions::zoom).
+      size_t best[2] = {f, f}, best_run[2] = {0, 0};
       const size_t last = std::min(n - 1, f + static_cast<size_t>(o.lookahead));
-      for (size_t g = f; g <= last; ++g) {
-        std::vector<int64_t> trial = held;
-        trial[victim] = static_cast<int64_t>(g);
-        if (unserved(f, trial)) continue;
-        size_t run = 1;
-        while (f + run < n && run <= 2 * static_cast<size_t>(o.lookahead) && !unserved(f + run, trial)) ++run;
-        if (run >= best_run) best = g, best_run = run;
-      }
-      held[victim] = static_cast<int64_t>(best);
-      plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(best), std::vector<uint8_t>(static_cast<size_t>(mw * mh), 0)});
+      for (int z = 0; z < zooms; ++z)
+        for (size_t g = f; g <= last; ++g) {
+          std::vector<int64_t> trial = held;
+          trial[victim] = static_cast<int64_t>(g + static_cast<size_t>(z) * n);
+          if (unserved(f, trial)) continue;
+          size_t run = 1;
+          while (f + run < n && run <= 2 * static_cast<size_t>(o.lookahead) && !unserved(f + run, trial)) ++run;
+          if (run >= best_run[z]) best[z] = g, best_run[z] = run;
+        }
+      const bool zoomed = zooms > 1 && best_run[1] >= static_cast<size_t>(std::max(1, o.zoom_min_run)) &&
+                          static_cast<double>(best_run[1]) >= o.zoom_run * static_cast<double>(best_run[0]);
+      held[victim] = static_cast<int64_t>(zoomed ? best[1] + n : best[0]);
+      plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(zoomed ? best[1] : best[0]),
+                                 zoomed ? static_cast<uint8_t>(o.zoom) : uint8_t{16}, std::vector<uint8_t>(static_cast<size_t>(mw * mh), 0)});
     }
     // (Each frame's updates are whole: pointers into them stay valid.)
     for (WalkViewPlan::Update& u : plan.updates[f]) holder[u.slot] = &u;

@@ -33,12 +33,18 @@ Stream valid_walk() {
   o.width = 128;  // (views two thirds of that each side: some of their MCUs unread, region images)
   o.height = 96;
   o.refine_delta = 30;  // residual refinements too
-  o.refine_after = 2;
+  o.refine_after = 1;
   o.predict = true;  // and updates against the client's prediction
-  o.threshold = 1.35;
+  o.threshold = 1.6;
+  o.zoom = 20;  // and zoomed views (18-byte WVUPs; within the threshold)
+  o.zoom_min_run = 1;
+  o.zoom_run = 0;
   const auto r = vds::enc::encode_walk(vds::test::walk_room(), vds::test::walk_room_path(8), o);
-  if (r.view_predicted == 0 || r.view_refinements == 0 || r.view_mcus_coded == r.view_mcus) {
-    std::fprintf(stderr, "fuzz_walk_stream: the seed stream lacks predicted updates, refinements or region images\n");
+  if (r.view_predicted == 0 || r.view_refinements == 0 || r.view_mcus_coded == r.view_mcus || r.view_zoomed == 0) {
+    std::fprintf(stderr,
+                 "fuzz_walk_stream: the seed stream lacks predicted updates (%zu), refinements (%zu), region images (%zu of %zu "
+                 "MCUs) or zoomed views (%zu)\n",
+                 r.view_predicted, r.view_refinements, r.view_mcus_coded, r.view_mcus, r.view_zoomed);
     std::abort();
   }
   Stream s;

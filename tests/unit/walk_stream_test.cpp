@@ -31,7 +31,10 @@ TEST(WalkStream, ARoomPlaysEndToEndWithinItsRate) {
   vds::enc::WalkEncodeOptions o;
   o.rate_kbps = 24;
   const auto r = vds::enc::encode_walk(room, path, o, true);
-  EXPECT_LE(r.kbps, 24.0);
+  // Within the rate: no more bytes than the link carries by the last
+  // frame's time, the stated pre-roll (at most the 1 s asked for) included.
+  EXPECT_LE(r.preroll_ms, 1000u);
+  EXPECT_LE(r.stream.size() * 8.0, 24000.0 * (r.preroll_ms / 1000.0 + 60 / path.fps));
   EXPECT_GT(r.view_updates, 0u);
   ASSERT_EQ(r.frames.size(), 60u);
   ASSERT_EQ(r.frame_crc.size(), 60u);
@@ -49,8 +52,8 @@ TEST(WalkStream, ARoomPlaysEndToEndWithinItsRate) {
   const auto again = vds::enc::encode_walk(room, path, o);
   EXPECT_EQ(again.stream, r.stream);
   EXPECT_EQ(vds::enc::client_frame_crcs(r.stream), r.frame_crc);
-  std::printf("room, 60 frames: %.2f kbit/s, %zu view updates at quality %d, PSNR %.2f dB\n", r.kbps, r.view_updates, r.quality,
-              r.psnr_rgb);
+  std::printf("room, 60 frames: %.2f kbit/s, pre-roll %u ms, %zu view updates (%zu zoomed) at quality %d, PSNR %.2f dB\n", r.kbps,
+              r.preroll_ms, r.view_updates, r.view_zoomed, r.quality, r.psnr_rgb);
 }
 
 TEST(WalkStream, RefinementsAddToTheViewsTheClientHolds) {
@@ -116,6 +119,39 @@ TEST(WalkStream, RegionUpdatesCodeOnlyWhatTheClientReadsAndShowTheSamePictures) 
   std::printf("room, 60 frames at quality 40: %zu of %zu MCUs coded, views %zu bytes (whole: %zu), PSNR %.2f dB (whole: %.2f), "
               "frames within %.3f dB\n",
               region.view_mcus_coded, region.view_mcus, region.view_bytes, whole.view_bytes, region.psnr_rgb, whole.psnr_rgb, most);
+}
+
+TEST(WalkStream, ZoomedViewsShowFinerTexelsWhereTheyServeLongEnough) {
+  // Zoomed view updates (a narrower view at the same size: finer texels)
+  // where they serve long enough: the client draws from them what the
+  // encoder's replay draws, and the frames they serve are sharper than
+  // with the views' own focal length at the same quality.
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(60);
+  vds::enc::WalkEncodeOptions o;
+  o.quality = 60;
+  o.zoom = 16;
+  const auto plain = vds::enc::encode_walk(room, path, o);
+  o.zoom = 24;
+  const auto zoomed = vds::enc::encode_walk(room, path, o);
+  EXPECT_EQ(plain.view_zoomed, 0u);
+  ASSERT_GT(zoomed.view_zoomed, 0u);
+  EXPECT_EQ(vds::enc::client_frame_crcs(zoomed.stream), zoomed.frame_crc);
+  EXPECT_GT(zoomed.psnr_rgb, plain.psnr_rgb + 0.2);
+  // Every WVUP is 17 bytes but the zoomed ones, 18.
+  size_t wvup18 = 0;
+  const std::vector<uint8_t>& st = zoomed.stream;
+  for (size_t at = vds::kPreambleBytes; at + vds::kChunkHeadBytes <= st.size();) {
+    const uint32_t type = vds::load_le32(&st[at]), len = vds::load_le32(&st[at + 4]);
+    if (type == vds::chunk::kWalkView) {
+      ASSERT_TRUE(len == vds::kWalkViewBytes || len == vds::kWalkViewMaxBytes) << len;
+      wvup18 += len == vds::kWalkViewMaxBytes;
+    }
+    at += vds::kChunkHeadBytes + len + vds::kChunkTailBytes;
+  }
+  EXPECT_EQ(wvup18, zoomed.view_zoomed);
+  std::printf("room, 60 frames at quality 60: %zu of %zu views zoomed, PSNR %.2f dB (none zoomed: %.2f), views %zu bytes (%zu)\n",
+              zoomed.view_zoomed, zoomed.view_updates, zoomed.psnr_rgb, plain.psnr_rgb, zoomed.view_bytes, plain.view_bytes);
 }
 
 TEST(WalkStream, RecordsOfSeveralFramesShowWhatRecordsOfOneShow) {
@@ -441,6 +477,44 @@ TEST(WalkStream, RecordsRoundTripAndRefuseBadFields) {
   b[4] = 3;  // a grid that is not a power of two
   EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b, &back), vds::Status::malformed);
   EXPECT_EQ(vds::walk_params_from_bytes(b, sizeof b - 1, &back), vds::Status::malformed);
+  // View updates: 17 bytes at the views' own focal length, 18 with a zoom.
+  vds::WalkViewUpdate vu;
+  vu.slot = 1;
+  vu.pose = vds::enc::walk_pose(p);
+  uint8_t vb[vds::kWalkViewMaxBytes];
+  ASSERT_EQ(vds::walk_view_to_bytes(vu, vb), vds::kWalkViewBytes);
+  vds::WalkViewUpdate vback;
+  ASSERT_EQ(vds::walk_view_from_bytes(vb, vds::kWalkViewBytes, &vback), vds::Status::ok);
+  EXPECT_EQ(vback.zoom, vds::kWalkZoomUnit);
+  vu.zoom = 24;
+  vu.predict = true;
+  ASSERT_EQ(vds::walk_view_to_bytes(vu, vb), vds::kWalkViewMaxBytes);
+  ASSERT_EQ(vds::walk_view_from_bytes(vb, vds::kWalkViewMaxBytes, &vback), vds::Status::ok);
+  EXPECT_EQ(vback.zoom, 24);
+  EXPECT_EQ(vback.slot, 1);
+  EXPECT_TRUE(vback.predict);
+  EXPECT_EQ(vback.pose.yaw, vu.pose.yaw);
+  EXPECT_EQ(vback.pose.position.z.raw(), vu.pose.position.z.raw());
+  for (const uint8_t z : {0, 15, 16, 65, 255}) {  // a zoom byte that zooms out, does not zoom, or past 4 times
+    vb[17] = z;
+    EXPECT_EQ(vds::walk_view_from_bytes(vb, vds::kWalkViewMaxBytes, &vback), vds::Status::malformed) << int{z};
+  }
+  EXPECT_EQ(vds::walk_view_from_bytes(vb, vds::kWalkViewBytes + 2, &vback), vds::Status::malformed);
+  EXPECT_EQ(vds::walk_view_from_bytes(vb, vds::kWalkViewBytes - 1, &vback), vds::Status::malformed);
+  // A zoomed view's camera: the views' focal length times zoom / 16, the rest the same.
+  vds::StreamHeader hh = vds::enc::default_header(vds::StreamMode::walkthrough, 240, 180);
+  hh.focal_x_q16 = hh.focal_y_q16 = 120 << 16;
+  hh.center_x_q16 = 120 << 16;
+  hh.center_y_q16 = 90 << 16;
+  hh.near_q16 = 1 << 14;
+  hh.far_q16 = 1 << 26;
+  vds::Camera wide, zoomed;
+  ASSERT_EQ(vds::walk_view_camera(hh, w, vu.pose, &wide), vds::Status::ok);
+  ASSERT_EQ(vds::walk_view_camera(hh, w, vu.pose, &zoomed, 24), vds::Status::ok);
+  EXPECT_EQ(zoomed.fx.raw(), wide.fx.raw() / 16 * 24);
+  EXPECT_EQ(zoomed.cx.raw(), wide.cx.raw());
+  EXPECT_EQ(zoomed.position.x.raw(), wide.position.x.raw());
+  EXPECT_EQ(vds::walk_view_camera(hh, w, vu.pose, &zoomed, 65), vds::Status::malformed);
   // Random frame records: a status, and views always in range.
   vds::test::Xorshift32 rng;
   const uint16_t hot[4] = {0, 3, 5, 9};

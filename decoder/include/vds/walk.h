@@ -70,25 +70,33 @@ struct WalkParams {
 };
 constexpr uint32_t kWalkParamsBytes = 28;
 constexpr uint32_t kWalkMaxPrerollMs = 600000;  // ten minutes
-// The camera of a view: walk_camera with the views' focal length and
-// their centre as the principal point.
-Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPose& pose, Camera* out);
+// The camera of a view: walk_camera with the views' focal length times
+// zoom / 16 (kWalkZoomUnit: the WLKP focal length) and their centre as the
+// principal point.
+constexpr uint8_t kWalkZoomUnit = 16, kWalkMaxZoom = 64;
+Status walk_view_camera(const StreamHeader& h, const WalkParams& w, const WalkPose& pose, Camera* out,
+                        uint8_t zoom = kWalkZoomUnit);
 Status walk_params_from_bytes(const uint8_t* p, uint32_t size, WalkParams* out);
 void walk_params_to_bytes(const WalkParams& w, uint8_t out[kWalkParamsBytes]);
 
-// WVUP payload (17 bytes): u8 view slot (bits 0..6) and "predict" (bit
-// 7: the client draws its prediction of the view into the slot before the
-// image, which may then be a residual against it), then the pose: i32 x,
-// y, z (raw Q16.16), u16 yaw, u16 pitch.
+// WVUP payload (17 or 18 bytes): u8 view slot (bits 0..6) and "predict"
+// (bit 7: the client draws its prediction of the view into the slot before
+// the image, which may then be a residual against it), then the pose: i32
+// x, y, z (raw Q16.16), u16 yaw, u16 pitch; then, in an 18-byte payload,
+// u8 zoom (17..64: the view's focal length is WLKP's times zoom / 16, a
+// narrower view with finer texels; 17 bytes: 16, WLKP's own).
 constexpr uint32_t kWalkViewBytes = 17;
+constexpr uint32_t kWalkViewMaxBytes = 18;
 constexpr uint8_t kWalkViewPredict = 0x80;
 struct WalkViewUpdate {
   uint8_t slot = 0;
   bool predict = false;
   WalkPose pose;
+  uint8_t zoom = kWalkZoomUnit;
 };
 Status walk_view_from_bytes(const uint8_t* p, uint32_t size, WalkViewUpdate* out);
-void walk_view_to_bytes(const WalkViewUpdate& u, uint8_t out[kWalkViewBytes]);
+// The payload's size (17 when the zoom is 16, else 18).
+uint32_t walk_view_to_bytes(const WalkViewUpdate& u, uint8_t out[kWalkViewMaxBytes]);
 
 // Bypass bins naming a view other than a triangle's last in a frame
 // record: ceil(log2(views - 1)).

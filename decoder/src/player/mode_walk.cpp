@@ -5,7 +5,8 @@
 // drawn as it is read by mapping each hot triangle from the stored view
 // the record names for it (Shading::view_mapped, the screen -> view
 // homography of its plane).
-// Views arrive as WVUP and an intra vds image decoded into the view's
+// Views arrive as WVUP (the view's pose, and a zoom: its focal length
+// times zoom / 16) and an intra vds image decoded into the view's
 // Y'CbCr 4:2:0 planes; a WVUP naming a slot's own camera again may carry a
 // residual image that refines what the slot holds, and one with its
 // "predict" bit has the client draw the view from what it holds first
@@ -327,7 +328,7 @@ ChunkResult on_chunk(Player& p, uint32_t type, const uint8_t* payload, uint32_t 
     if (w.pending >= 0) refuse(Status::malformed, "a view update before the last one's image is whole");
     else if (walk_view_from_bytes(payload, size, &u) != Status::ok || u.slot >= w.params.views)
       refuse(Status::malformed, "WVUP is not valid");
-    else if (walk_view_camera(p.header(), w.params, u.pose, &w.pending_cam) != Status::ok)
+    else if (walk_view_camera(p.header(), w.params, u.pose, &w.pending_cam, u.zoom) != Status::ok)
       refuse(Status::malformed, "WVUP's camera is not valid");
     else {
       w.pending = u.slot;

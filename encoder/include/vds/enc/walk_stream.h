@@ -45,6 +45,13 @@ struct WalkEncodeOptions {
   // are coded as a residual against it when that pays (rate and
   // distortion); measured not to pay on the figure maps (docs/walkthrough.md).
   bool predict = false;
+  // Zoomed view updates (WalkViewOptions::zoom, zoom_run, zoom_min_run; a
+  // zoom of 16: none). 24: with views 1.5 times wider than the screen, a
+  // zoomed view sees what the screen sees, with texels 1.5 times finer
+  // (measured in docs/walkthrough.md, "Zoomed views").
+  int zoom = 24;
+  double zoom_run = 0.3;
+  int zoom_min_run = 10;
   // View updates code only the MCUs the client reads while the view serves
   // (WalkViewPlan::Update::mcus: region images); false: whole views.
   bool regions = true;
@@ -81,6 +88,7 @@ struct WalkEncodeResult {
   std::vector<WalkPiece> pieces;  // the stream as the client takes it (vds/enc/walk_schedule.h)
   size_t view_updates = 0, view_refinements = 0;
   size_t view_predicted = 0;  // view updates coded as a residual against the client's prediction
+  size_t view_zoomed = 0;     // view updates of a zoomed view (WalkEncodeOptions::zoom)
   size_t view_mcus = 0, view_mcus_coded = 0;  // the updates' MCUs, and those their images code
   // Bytes by part: header (HEAD, WLKP), views (WVUP and the images), the
   // records' geometry, and the rest of the records (pose, views, framing).

@@ -60,12 +60,22 @@ struct WalkViewOptions {
   // mcus): the bilinear filter's neighbour and the client's fixed-point
   // cameras.
   double region_margin = 3;
+  // Zoomed views: an update may instead take a view whose focal length is
+  // `zoom` / 16 times the views' (narrower, with finer texels: at 24, views
+  // 1.5 times wider than the screen see what the screen sees) when, from
+  // the best camera for it, it serves at least `zoom_run` of the frames the
+  // best view at the views' own focal length would, and at least
+  // `zoom_min_run` frames (16: never).
+  int zoom = 16;
+  double zoom_run = 0.5;
+  int zoom_min_run = 10;
 };
 
 struct WalkViewPlan {
   struct Update {
     uint32_t slot;
     uint32_t camera_frame;  // the path frame whose camera the view is rendered at
+    uint8_t zoom = 16;      // its focal length: the views' times zoom / 16
     // The view's MCUs (16 x 16 texels, raster order) the client samples
     // while the view is in its slot: non-zero where the part of a polygon
     // the plan draws from it, on the screen of a frame it does so, lies in
