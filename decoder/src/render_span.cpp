@@ -557,8 +557,6 @@ void interpolant(int64_t start_q16, int64_t gx, int s, int32_t len, int64_t lo, 
   *dv = static_cast<int32_t>(d);
 }
 
-
-
 // A fast start value (PolySetup::fast_c*): c + step dx + g dy, exact in 64
 // bits (each product below 2^31 2^12).
 inline int64_t row_start(int32_t c, int32_t step, int32_t g, int32_t dx, int32_t dy) {

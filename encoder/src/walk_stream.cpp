@@ -196,10 +196,9 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vo.height = o.height;
   // Views see wider than the screen (a pan stays inside a view longer):
   // what a view at each frame's camera shows.
-  const double kDeg = 3.14159265358979323846 / 180;
   // (No wider than the client's smallest focal length allows.)
   const double widen = std::clamp(o.view_widen, 1.0, std::max(1.0, sc.focal * view_w / o.width / kCameraMinFocalPx));
-  const double view_hfov = 2 * std::atan(widen * std::tan(path.hfov_deg * kDeg / 2)) / kDeg;
+  const double view_hfov = scaled_hfov(path.hfov_deg, widen);
   vo.view_hfov_deg = view_hfov;
   vo.view_width = view_w;
   vo.view_height = view_h;
@@ -215,7 +214,9 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   for (size_t f = 0; f < n; ++f) poses[f] = walk_pose(path.frames[f]);
   // A view's camera is named by an index: frame g at the views' own focal
   // length is g, zoomed n + g (WalkViewOptions::zoom).
-  const auto camera_of = [&](const WalkViewPlan::Update& u) { return u.camera_frame + (u.zoom != 16 ? static_cast<uint32_t>(n) : 0u); };
+  const auto camera_of = [&](const WalkViewPlan::Update& u) {
+    return u.camera_frame + (u.zoom != kWalkZoomUnit ? static_cast<uint32_t>(n) : 0u);
+  };
   const auto frame_of = [&](uint32_t j) { return j % static_cast<uint32_t>(n); };
   const auto zoom_of = [&](uint32_t j) { return j >= n ? static_cast<uint8_t>(o.zoom) : kWalkZoomUnit; };
   const auto wvup_bytes = [&](uint32_t j) -> size_t { return zoom_of(j) != kWalkZoomUnit ? kWalkViewMaxBytes : kWalkViewBytes; };
@@ -228,7 +229,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   view_ro.width = view_w;
   view_ro.height = view_h;
   const SceneRenderer view_renderer(s, images, view_ro);
-  const double zoomed_hfov = 2 * std::atan(std::tan(view_hfov * kDeg / 2) * kWalkZoomUnit / std::max(16, o.zoom)) / kDeg;
+  const double zoomed_hfov = scaled_hfov(view_hfov, static_cast<double>(kWalkZoomUnit) / o.zoom);
   for (auto& [j, planes] : view_planes) {
     planes = rgb_to_planes(view_renderer.render(from_walk_pose(poses[frame_of(j)]), j >= n ? zoomed_hfov : view_hfov).rgb,
                            ChromaFormat::yuv420);
@@ -345,16 +346,21 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     wfrm[r] = e.finish();
   }
   // 5. The views' qualities under the rate control, then the stream.
+  // A view image's options: its quality, the MCUs it codes (none: all),
+  // chunks of at most kViewChunkPayload bytes.
+  constexpr uint32_t kViewChunkPayload = 4096;
+  const auto view_options = [&](int q, const std::vector<uint8_t>& region) {
+    ImageEncodeOptions io;
+    io.quality = q;
+    io.max_chunk_payload = kViewChunkPayload;
+    io.region = region;
+    return io;
+  };
   // Each view's intra image at a quality, coded once.
   std::map<std::pair<uint32_t, int>, EncodedImage> coded;
   const auto intra = [&](uint32_t g, int q) -> const EncodedImage& {
     auto it = coded.find({g, q});
-    if (it == coded.end()) {
-      ImageEncodeOptions io;
-      io.quality = q;
-      io.max_chunk_payload = 4096;
-      it = coded.emplace(std::make_pair(g, q), encode_planes(view_planes.at(g), io)).first;
-    }
+    if (it == coded.end()) it = coded.emplace(std::make_pair(g, q), encode_planes(view_planes.at(g), view_options(q, {}))).first;
     return it->second;
   };
   // Update u's image at a quality: the view, or its region.
@@ -363,16 +369,13 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     if (update_region[u].empty()) return intra(update_camera[u], q);
     auto it = coded_region.find({u, q});
     if (it == coded_region.end()) {
-      ImageEncodeOptions io;
-      io.quality = q;
-      io.max_chunk_payload = 4096;
-      io.region = update_region[u];
+      const ImageEncodeOptions io = view_options(q, update_region[u]);
       it = coded_region.emplace(std::make_pair(u, q), encode_planes(view_planes.at(update_camera[u]), io)).first;
     }
     return it->second;
   };
   StreamHeader hh = h;
-  hh.max_chunk_payload = 4096;
+  hh.max_chunk_payload = kViewChunkPayload;
   for (const auto& rec : wfrm) hh.max_chunk_payload = std::max<uint32_t>(hh.max_chunk_payload, static_cast<uint32_t>(rec.size()));
   constexpr size_t kFraming = kChunkHeadBytes + kChunkTailBytes;
   size_t header_bytes = 0;
@@ -444,12 +447,10 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
       EncodedImage residual;
       if (refine || client.predicted()) {
         const Planes base = client.slot(static_cast<uint8_t>(slot));
-        ImageEncodeOptions ro;
-        ro.max_chunk_payload = 4096;
+        ImageEncodeOptions ro = refine ? view_options(std::min(100, quality + o.refine_delta), {})
+                                       : view_options(quality, update_region[update]);
         ro.mode = ImageMode::residual;
         ro.prediction = &base;
-        if (!refine) ro.region = update_region[update];
-        ro.quality = refine ? std::min(100, quality + o.refine_delta) : quality;
         residual = encode_planes(view_planes.at(camera), ro);
         // Rate and distortion together: about 3.5 dB a doubling of bytes
         // is where these images' curves run.

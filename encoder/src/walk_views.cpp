@@ -25,6 +25,11 @@ Q2_30 q30(double v) { return Q2_30::from_raw(static_cast<int32_t>(std::lround(st
 
 }  // namespace
 
+double scaled_hfov(double hfov_deg, double ratio) {
+  const double deg = 3.14159265358979323846 / 180;
+  return 2 * std::atan(ratio * std::tan(hfov_deg * deg / 2)) / deg;
+}
+
 vds::Camera client_camera(const CameraPose& pose, double hfov_deg, int width, int height, double near_z, double far_z) {
   const SceneCamera c = scene_camera(pose, hfov_deg, width, height);
   vds::Camera k{};
@@ -51,10 +56,10 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   if (view_visible != nullptr && view_visible->size() != n) throw std::invalid_argument("plan_walk_views: one view visibility list per frame");
   const int vw = o.view_width > 0 ? o.view_width : o.width, vh = o.view_height > 0 ? o.view_height : o.height;
   // Each frame's camera as the screen and as a view: the client's and the scene's.
-  if (o.zoom < 16 || o.zoom > 64) throw std::invalid_argument("plan_walk_views: a zoom of 16 to 64");
+  if (o.zoom < kWalkZoomUnit || o.zoom > kWalkMaxZoom) throw std::invalid_argument("plan_walk_views: a zoom of 16 to 64");
   // A view's camera is named by an index: frame g at the views' own focal
   // length is g, zoomed (WalkViewOptions::zoom) n + g.
-  const int zooms = o.zoom > 16 ? 2 : 1;
+  const int zooms = o.zoom > kWalkZoomUnit ? 2 : 1;
   std::vector<vds::Camera> cams, vcams;
   std::vector<SceneCamera> scams, vscams;
   for (const CameraPose& p : path.frames) {
@@ -64,11 +69,10 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     vscams.push_back(scene_camera(p, view_hfov, vw, vh));
   }
   if (zooms > 1) {
-    const double kDeg = 3.14159265358979323846 / 180;
-    const double zoomed_hfov = 2 * std::atan(std::tan(view_hfov * kDeg / 2) * 16 / o.zoom) / kDeg;
+    const double zoomed_hfov = scaled_hfov(view_hfov, static_cast<double>(kWalkZoomUnit) / o.zoom);
     for (size_t g = 0; g < n; ++g) {
       vds::Camera c = vcams[g];  // the client's: the views' focal length times zoom / 16
-      c.fx = c.fy = Q16_16::from_raw(static_cast<int32_t>(static_cast<int64_t>(c.fx.raw()) * o.zoom / 16));
+      c.fx = c.fy = Q16_16::from_raw(static_cast<int32_t>(static_cast<int64_t>(c.fx.raw()) * o.zoom / kWalkZoomUnit));
       vcams.push_back(c);
       vscams.push_back(scene_camera(path.frames[g], zoomed_hfov, vw, vh));
     }
@@ -256,7 +260,7 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   WalkViewPlan plan;
   plan.updates.resize(n);
   plan.choice.resize(n);
-  std::vector<int64_t> held(static_cast<size_t>(o.slots), -1);  // the camera frame of each slot's view
+  std::vector<int64_t> held(static_cast<size_t>(o.slots), -1);  // the camera (index, above) of each slot's view
   std::vector<WalkViewPlan::Update*> holder(static_cast<size_t>(o.slots), nullptr);  // the update that put it there
   // Whether the views `v` leave frame f unserved: more than tolerance_px
   // of its pixels with no view within the threshold, or (occlusion_updates)
@@ -315,7 +319,7 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
                           static_cast<double>(best_run[1]) >= o.zoom_run * static_cast<double>(best_run[0]);
       held[victim] = static_cast<int64_t>(zoomed ? best[1] + n : best[0]);
       plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(zoomed ? best[1] : best[0]),
-                                 zoomed ? static_cast<uint8_t>(o.zoom) : uint8_t{16}, std::vector<uint8_t>(static_cast<size_t>(mw * mh), 0)});
+                                 zoomed ? static_cast<uint8_t>(o.zoom) : kWalkZoomUnit, std::vector<uint8_t>(static_cast<size_t>(mw * mh), 0)});
     }
     // (Each frame's updates are whole: pointers into them stay valid.)
     for (WalkViewPlan::Update& u : plan.updates[f]) holder[u.slot] = &u;

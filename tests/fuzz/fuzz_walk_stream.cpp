@@ -18,6 +18,7 @@
 #include "vds/enc/walk_stream.h"
 #include "vds/player.h"
 #include "vds/walk.h"
+#include "stream_chunks.h"
 #include "walk_room.h"
 
 namespace {
@@ -48,17 +49,12 @@ Stream valid_walk() {
     std::abort();
   }
   Stream s;
-  // Split the stream into its chunks by the container layout.
-  size_t at = vds::kPreambleBytes;
   bool first = true;
-  while (at + vds::kChunkHeadBytes <= r.stream.size()) {
-    const uint32_t type = vds::load_le32(&r.stream[at]), len = vds::load_le32(&r.stream[at + 4]);
-    const std::vector<uint8_t> payload(r.stream.begin() + static_cast<std::ptrdiff_t>(at + 8),
-                                       r.stream.begin() + static_cast<std::ptrdiff_t>(at + 8 + len));
-    if (first) vds::header_from_bytes(payload.data(), len, r.stream[4], r.stream[5], &s.header);
-    else if (type != vds::chunk::kEnd) s.chunks.emplace_back(type, payload);
+  for (const vds::test::ChunkAt& c : vds::test::stream_chunks(r.stream)) {
+    const std::vector<uint8_t> payload = c.bytes(r.stream);
+    if (first) vds::header_from_bytes(payload.data(), c.size, r.stream[4], r.stream[5], &s.header);
+    else if (c.type != vds::chunk::kEnd) s.chunks.emplace_back(c.type, payload);
     first = false;
-    at += vds::kChunkHeadBytes + len + vds::kChunkTailBytes;
   }
   return s;
 }

@@ -17,6 +17,7 @@
 #include "vds/enc/stream_writer.h"
 #include "vds/image.h"
 #include "golden_hash.h"
+#include "stream_chunks.h"
 #include "xorshift.h"
 
 namespace {
@@ -69,16 +70,13 @@ Planes client_planes(const EncodedImage& e, const Planes* prediction = nullptr) 
 // container's framing: an 8-byte preamble, then type, size, payload, CRC).
 EncodedImage image_chunks_of(const std::vector<uint8_t>& s) {
   EncodedImage e;
-  for (size_t at = vds::kPreambleBytes; at + vds::kChunkHeadBytes <= s.size();) {
-    const uint32_t type = vds::load_le32(&s[at]), size = vds::load_le32(&s[at + 4]);
-    const std::vector<uint8_t> payload(s.begin() + static_cast<ptrdiff_t>(at + vds::kChunkHeadBytes),
-                                       s.begin() + static_cast<ptrdiff_t>(at + vds::kChunkHeadBytes + size));
-    if (type == vds::chunk::kImageHeader) {
+  for (const vds::test::ChunkAt& c : vds::test::stream_chunks(s)) {
+    const std::vector<uint8_t> payload = c.bytes(s);
+    if (c.type == vds::chunk::kImageHeader) {
       e.imgh = payload;
-      EXPECT_EQ(vds::image_header_from_bytes(payload.data(), size, &e.header), Status::ok);
+      EXPECT_EQ(vds::image_header_from_bytes(payload.data(), c.size, &e.header), Status::ok);
     }
-    if (type == vds::chunk::kImageData) e.imgd.push_back(payload);
-    at += vds::kChunkHeadBytes + size + vds::kChunkTailBytes;
+    if (c.type == vds::chunk::kImageData) e.imgd.push_back(payload);
   }
   return e;
 }

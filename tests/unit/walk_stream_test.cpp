@@ -20,6 +20,7 @@
 #include "vds/crc32c.h"
 #include "vds/player.h"
 #include "vds/walk.h"
+#include "stream_chunks.h"
 #include "walk_room.h"
 #include "xorshift.h"
 
@@ -140,14 +141,10 @@ TEST(WalkStream, ZoomedViewsShowFinerTexelsWhereTheyServeLongEnough) {
   EXPECT_GT(zoomed.psnr_rgb, plain.psnr_rgb + 0.2);
   // Every WVUP is 17 bytes but the zoomed ones, 18.
   size_t wvup18 = 0;
-  const std::vector<uint8_t>& st = zoomed.stream;
-  for (size_t at = vds::kPreambleBytes; at + vds::kChunkHeadBytes <= st.size();) {
-    const uint32_t type = vds::load_le32(&st[at]), len = vds::load_le32(&st[at + 4]);
-    if (type == vds::chunk::kWalkView) {
-      ASSERT_TRUE(len == vds::kWalkViewBytes || len == vds::kWalkViewMaxBytes) << len;
-      wvup18 += len == vds::kWalkViewMaxBytes;
-    }
-    at += vds::kChunkHeadBytes + len + vds::kChunkTailBytes;
+  for (const vds::test::ChunkAt& c : vds::test::stream_chunks(zoomed.stream)) {
+    if (c.type != vds::chunk::kWalkView) continue;
+    ASSERT_TRUE(c.size == vds::kWalkViewBytes || c.size == vds::kWalkViewMaxBytes) << c.size;
+    wvup18 += c.size == vds::kWalkViewMaxBytes;
   }
   EXPECT_EQ(wvup18, zoomed.view_zoomed);
   std::printf("room, 60 frames at quality 60: %zu of %zu views zoomed, PSNR %.2f dB (none zoomed: %.2f), views %zu bytes (%zu)\n",
@@ -264,15 +261,13 @@ TEST(WalkStream, PredictedViewUpdatesAreResidualsTheClientAddsToItsPrediction) {
   // Clear every WVUP's "predict" bit (and mend the chunk's CRC).
   std::vector<uint8_t> bad = r.stream;
   size_t cleared = 0;
-  for (size_t at = vds::kPreambleBytes; at + vds::kChunkHeadBytes <= bad.size();) {
-    const uint32_t type = vds::load_le32(&bad[at]), len = vds::load_le32(&bad[at + 4]);
-    const size_t body = at + vds::kChunkHeadBytes;
-    if (type == vds::chunk::kWalkView && (bad[body] & vds::kWalkViewPredict)) {
+  for (const vds::test::ChunkAt& c : vds::test::stream_chunks(bad)) {
+    const size_t body = c.payload();
+    if (c.type == vds::chunk::kWalkView && (bad[body] & vds::kWalkViewPredict)) {
       bad[body] &= static_cast<uint8_t>(~vds::kWalkViewPredict);
-      vds::store_le32(&bad[body + len], vds::crc32c(&bad[at], vds::kChunkHeadBytes + len));
+      vds::store_le32(&bad[body + c.size], vds::crc32c(&bad[c.at], vds::kChunkHeadBytes + c.size));
       ++cleared;
     }
-    at = body + len + vds::kChunkTailBytes;
   }
   ASSERT_GT(cleared, 0u);
   EXPECT_THROW(vds::enc::client_frame_crcs(bad), std::runtime_error);

@@ -29,12 +29,17 @@
 #include "vds/enc/camera_path.h"
 #include "vds/enc/scene.h"
 #include "vds/render_camera.h"
+#include "vds/walk.h"
 
 namespace vds::enc {
 
 // The client's fixed-point camera for a pose (vds/enc/scene_render.h's
 // camera model), with clip distances in scene units.
 vds::Camera client_camera(const CameraPose& pose, double hfov_deg, int width, int height, double near_z, double far_z);
+
+// The field of view (degrees) whose half angle's tangent is `ratio` times
+// hfov_deg's: views `ratio` times wider, or a zoom's narrower ones (16 / zoom).
+double scaled_hfov(double hfov_deg, double ratio);
 
 struct WalkViewOptions {
   int slots = 2;
@@ -66,7 +71,7 @@ struct WalkViewOptions {
   // the best camera for it, it serves at least `zoom_run` of the frames the
   // best view at the views' own focal length would, and at least
   // `zoom_min_run` frames (16: never).
-  int zoom = 16;
+  int zoom = kWalkZoomUnit;
   double zoom_run = 0.5;
   int zoom_min_run = 10;
 };
@@ -75,7 +80,7 @@ struct WalkViewPlan {
   struct Update {
     uint32_t slot;
     uint32_t camera_frame;  // the path frame whose camera the view is rendered at
-    uint8_t zoom = 16;      // its focal length: the views' times zoom / 16
+    uint8_t zoom = kWalkZoomUnit;  // its focal length: the views' times zoom / 16
     // The view's MCUs (16 x 16 texels, raster order) the client samples
     // while the view is in its slot: non-zero where the part of a polygon
     // the plan draws from it, on the screen of a frame it does so, lies in
