@@ -25,6 +25,7 @@ constexpr double kWalkShapeToleranceM = 1.0 / 16;
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, per_frame, size = "240x180";
   double rate = 16, threshold = 18, widen = -1, view_scale = -1, occlusion = -1, occlusion_tolerance = -1;
+  int min_pixels = -1;
   double shape_tolerance = -1, vertex_tolerance = -1;  // metres
   int lookahead = -1, preroll = -1, window = -1, max_sends = -1;
   double zoom_run = -1;
@@ -69,6 +70,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   if (o.occlusion >= 0) wo.occlusion_margin = o.occlusion;
   if (o.no_occlusion_updates) wo.occlusion_updates = false;
   if (o.occlusion_tolerance >= 0) wo.occlusion_tolerance = o.occlusion_tolerance;
+  if (o.min_pixels >= 0) wo.min_pixels = static_cast<uint32_t>(o.min_pixels);
   if (o.view_scale > 0) wo.view_scale = o.view_scale;
   if (o.refine_delta >= 0) wo.refine_delta = o.refine_delta;
   if (o.refine_after >= 0) wo.refine_after = o.refine_after;
@@ -164,6 +166,10 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--occlusion-tolerance", o->occlusion_tolerance,
                   "The share of a frame's pixels that only occluded views may serve before a view update (default 0.02)")
       ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--min-pixels", o->min_pixels,
+                  "A triangle covering fewer of a frame's pixels than this is not drawn there where a larger one "
+                  "the frame shows lies behind it (default 16; 0: every triangle a frame shows is drawn)")
+      ->check(CLI::Range(0, 1000));
   sub->add_flag("--no-occlusion-updates", o->no_occlusion_updates,
                 "No view updates for occluded views (they only lose to views that are not occluded)");
   sub->add_flag("--keep-triangles", o->keep_triangles,

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <unordered_set>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -314,10 +315,12 @@ class Frame {
     }
   }
 
-  void visibility(Target& t) const {
+  // The nearest triangle at each sample, of those `skip` (if given) does not mark.
+  void visibility(Target& t, const std::vector<bool>* skip = nullptr) const {
     t.iz.assign(static_cast<size_t>(t.w) * t.h, 0.0f);
     t.tri.assign(static_cast<size_t>(t.w) * t.h, kNoTriangle);
     raster_all(t, false, [&](uint32_t tri, size_t idx, double x, double y) {
+      if (skip != nullptr && (*skip)[tri]) return;
       const Interp in = interpolate(setups_[tri], t, x, y);
       if (!(in.iz > t.iz[idx])) return;
       if (P.tris[tri].alpha_test && shade(tri, in, true).alpha < 127.5f) return;
@@ -512,6 +515,17 @@ SceneFrame SceneRenderer::render(const CameraPose& pose, double hfov_deg) const 
   // Visibility at the output's pixel centres.
   Target v{opt_.width, opt_.height, cam.focal, cam.cx, cam.cy, {}, {}};
   fr.visibility(v);
+  if (opt_.min_pixels > 1) {
+    // Again without the triangles covering fewer than min_pixels pixels.
+    std::vector<uint32_t> cover(fr.setups().size(), 0);
+    for (uint32_t id : v.tri)
+      if (id != kNoTriangle) ++cover[id];
+    std::vector<bool> small(cover.size());
+    for (size_t i = 0; i < cover.size(); ++i) small[i] = cover[i] > 0 && cover[i] < opt_.min_pixels;
+    Target large{opt_.width, opt_.height, cam.focal, cam.cx, cam.cy, {}, {}};
+    fr.visibility(large, &small);
+    out.large_ids = std::move(large.tri);
+  }
   out.ids = std::move(v.tri);
   out.depth.resize(v.iz.size());
   for (size_t i = 0; i < v.iz.size(); ++i)
@@ -519,11 +533,8 @@ SceneFrame SceneRenderer::render(const CameraPose& pose, double hfov_deg) const 
   return out;
 }
 
-std::vector<std::pair<uint32_t, uint32_t>> visible_triangles(const SceneFrame& f) {
-  std::vector<uint32_t> ids;
-  ids.reserve(f.ids.size());
-  for (uint32_t id : f.ids)
-    if (id != kNoTriangle) ids.push_back(id);
+namespace {
+std::vector<std::pair<uint32_t, uint32_t>> count_ids(std::vector<uint32_t> ids) {
   std::sort(ids.begin(), ids.end());
   std::vector<std::pair<uint32_t, uint32_t>> out;
   for (size_t i = 0; i < ids.size();) {
@@ -533,6 +544,37 @@ std::vector<std::pair<uint32_t, uint32_t>> visible_triangles(const SceneFrame& f
     i = j;
   }
   return out;
+}
+}  // namespace
+
+std::vector<std::pair<uint32_t, uint32_t>> visible_triangles(const SceneFrame& f) {
+  std::vector<uint32_t> ids;
+  ids.reserve(f.ids.size());
+  for (uint32_t id : f.ids)
+    if (id != kNoTriangle) ids.push_back(id);
+  return count_ids(std::move(ids));
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> visible_large_triangles(const SceneFrame& f) {
+  if (f.large_ids.empty()) return visible_triangles(f);
+  if (f.large_ids.size() != f.ids.size()) throw std::invalid_argument("visible_large_triangles: large_ids of another size");
+  // A small triangle is one whose pixels large_ids does not show it at. It
+  // stays where what lies behind it is nothing, or a triangle the frame
+  // does not show elsewhere (the view through a grille of small ones).
+  std::unordered_set<uint32_t> shown;
+  for (size_t i = 0; i < f.ids.size(); ++i)
+    if (f.ids[i] != kNoTriangle && f.ids[i] == f.large_ids[i]) shown.insert(f.ids[i]);
+  std::unordered_set<uint32_t> stays;
+  for (size_t i = 0; i < f.ids.size(); ++i)
+    if (f.ids[i] != kNoTriangle && f.large_ids[i] != f.ids[i] && shown.count(f.large_ids[i]) == 0) stays.insert(f.ids[i]);
+  std::vector<uint32_t> ids;
+  ids.reserve(f.ids.size());
+  for (size_t i = 0; i < f.ids.size(); ++i) {
+    const uint32_t id = f.ids[i];
+    if (id == kNoTriangle) continue;
+    ids.push_back(f.large_ids[i] == id || stays.count(id) != 0 ? id : f.large_ids[i]);
+  }
+  return count_ids(std::move(ids));
 }
 
 void render_path(const SceneRenderer& r, const CameraPath& path, int threads,

@@ -149,6 +149,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   RenderOptions ro;
   ro.width = o.width;
   ro.height = o.height;
+  ro.min_pixels = geometry ? 0 : o.min_pixels;  // the client leaves out small triangles where that opens no hole
   const std::vector<io::Image> images = load_scene_images(s);
   const SceneRenderer renderer(s, images, ro);
   const SceneCamera sc = scene_camera(path.frames[0], path.hfov_deg, o.width, o.height);  // the screen's intrinsics
@@ -162,16 +163,17 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> visible(n);
   render_path(renderer, path, o.threads, [&](size_t f, const SceneFrame& fr) {
     truth[f] = fr.rgb;
-    if (!geometry) visible[f] = visible_triangles(fr);
+    if (!geometry) visible[f] = visible_large_triangles(fr);
   }, [&](size_t done) { progress("ground truth", done, n); });
   RenderOptions vro = ro;
   vro.supersample = 1;
   vro.max_aniso = 1;
+  vro.min_pixels = o.min_pixels;
   if (geometry) {
     // What the client's triangles show, pixel by pixel (the alpha-tested
     // ones cut out as the scene's are).
     const SceneRenderer ids(drawn, images, vro);
-    render_path(ids, path, o.threads, [&](size_t f, const SceneFrame& fr) { visible[f] = visible_triangles(fr); },
+    render_path(ids, path, o.threads, [&](size_t f, const SceneFrame& fr) { visible[f] = visible_large_triangles(fr); },
                 [&](size_t done) { progress("visibility", done, n); });
   }
   // 2. Geometry and views.
@@ -204,7 +206,9 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vo.view_height = view_h;
   CameraPath wide = path;
   wide.hfov_deg = view_hfov;
-  const SceneRenderer view_vis(drawn, {}, vro);
+  RenderOptions view_vis_ro = vro;
+  view_vis_ro.min_pixels = 0;
+  const SceneRenderer view_vis(drawn, {}, view_vis_ro);
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> view_visible(n);
   render_path(view_vis, wide, o.threads, [&](size_t f, const SceneFrame& fr) { view_visible[f] = visible_triangles(fr); },
               [&](size_t done) { progress("view visibility", done, n); });
@@ -226,6 +230,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     for (const auto& u : ups) view_planes[camera_of(u)];
   size_t done = 0;
   RenderOptions view_ro = ro;
+  view_ro.min_pixels = 0;
   view_ro.width = view_w;
   view_ro.height = view_h;
   const SceneRenderer view_renderer(s, images, view_ro);

@@ -175,7 +175,7 @@ TEST(SceneRender, BackFacesAlphaTestAndAdditiveSurfaces) {
   for (uint32_t id : r.render({200, 0, 0, 180, 0}, 90).ids) EXPECT_EQ(id, vds::enc::kNoTriangle);
   // Two-sided by its shader: drawn.
   s.textures[0].two_sided = true;
-  EXPECT_NE(SceneRenderer(s, {solid(8, 8, 200, 100, 50)}).render({200, 0, 0, 180, 0}, 90).ids[centre(SceneFrame{Image(240, 180, 3), {}, {}})],
+  EXPECT_NE(SceneRenderer(s, {solid(8, 8, 200, 100, 50)}).render({200, 0, 0, 180, 0}, 90).ids[centre(SceneFrame{Image(240, 180, 3), {}, {}, {}})],
             vds::enc::kNoTriangle);
   // Alpha-tested with a transparent texture: cut out of the image and the visibility.
   s.textures[0].blend = vds::enc::ShaderBlend::alpha_test;
@@ -190,6 +190,56 @@ TEST(SceneRender, BackFacesAlphaTestAndAdditiveSurfaces) {
   EXPECT_EQ(add.rgb.at(120, 90, 2), 160);
   EXPECT_LT(add.ids[centre(add)], 2u);
   EXPECT_NEAR(add.depth[centre(add)], 100.0f, 1e-3f);
+}
+
+// A quad facing -x at distance x: y from y0 to y1, z from z0 to z1.
+void add_facing_quad(Scene& s, float x, float y0, float y1, float z0, float z1) {
+  add_quad(s, {x, y1, z0}, {x, y0, z0}, {x, y0, z1}, {x, y1, z1}, {-1, 0, 0}, 0);
+}
+
+TEST(SceneRender, SmallTrianglesLeaveTheirPixelsToTheLargeOnesBehindThemWhereNoHoleOpens) {
+  Scene s;
+  s.textures.resize(1);
+  add_facing_quad(s, 100, -100, 100, -100, 0);  // 0, 1: a wall filling the lower half of the view
+  add_facing_quad(s, 50, -1, 1, -21, -19);      // 2, 3: a small quad in front of it
+  add_facing_quad(s, 50, -1, 1, 19, 21);        // 4, 5: a small quad with nothing behind it
+  add_facing_quad(s, 50, 15, 17, 19, 21);       // 6, 7: a small quad ...
+  add_facing_quad(s, 90, 27, 30.6f, 34.2f, 37.8f);  // 8, 9: ... hiding a larger one behind it, shown nowhere else
+  vds::enc::RenderOptions o;
+  o.supersample = 1;
+  o.min_pixels = 16;
+  const SceneFrame f = SceneRenderer(s, {solid(4, 4, 255, 255, 255)}, o).render({0, 0, 0, 0, 0}, 90);
+  ASSERT_EQ(f.large_ids.size(), f.ids.size());
+  const auto cover = [](const std::vector<std::pair<uint32_t, uint32_t>>& v) {
+    std::vector<uint32_t> c(10, 0);
+    for (const auto& [id, px] : v) {
+      EXPECT_LT(id, 10u);
+      if (id < 10) c[id] = px;
+    }
+    return c;
+  };
+  const std::vector<uint32_t> all = cover(vds::enc::visible_triangles(f));
+  const std::vector<uint32_t> large = cover(vds::enc::visible_large_triangles(f));
+  for (uint32_t id = 2; id < 8; ++id) {
+    EXPECT_GT(all[id], 0u) << id;
+    EXPECT_LT(all[id], 16u) << id;
+  }
+  EXPECT_EQ(all[8] + all[9], 0u);  // hidden
+  size_t behind_small = 0;          // pixels of 6 and 7 where 8 or 9 lies behind
+  for (size_t i = 0; i < f.ids.size(); ++i)
+    if ((f.ids[i] == 6 || f.ids[i] == 7) && (f.large_ids[i] == 8 || f.large_ids[i] == 9)) ++behind_small;
+  EXPECT_GT(behind_small, 0u);
+  // The quad in front of the wall is left out: its pixels are the wall's.
+  EXPECT_EQ(large[2] + large[3], 0u);
+  EXPECT_EQ(large[0] + large[1], all[0] + all[1] + all[2] + all[3]);
+  // The others stay (a hole where nothing is behind; a triangle the frame
+  // does not otherwise show), and the one behind them is not drawn.
+  for (uint32_t id = 4; id < 8; ++id) EXPECT_EQ(large[id], all[id]) << id;
+  EXPECT_EQ(large[8] + large[9], 0u);
+  // Without min_pixels: no large_ids, and the same triangles either way.
+  const SceneFrame plain = SceneRenderer(s, {solid(4, 4, 255, 255, 255)}).render({0, 0, 0, 0, 0}, 90);
+  EXPECT_TRUE(plain.large_ids.empty());
+  EXPECT_EQ(vds::enc::visible_large_triangles(plain), vds::enc::visible_triangles(plain));
 }
 
 TEST(SceneRender, TrianglesCrossingTheNearPlaneAreClipped) {

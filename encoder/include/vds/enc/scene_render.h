@@ -33,6 +33,9 @@ struct RenderOptions {
                             // r_mapOverBrightBits), for scenes with Scene::overbright
   double near_m = 1.0 / 32;  // the near clipping plane, metres (a Quake map unit)
   double near_z = 0;         // the same in the scene's units (set by SceneRenderer)
+  // Over 1: each frame also says which triangle each pixel shows once the
+  // triangles covering fewer pixels than this are left out (SceneFrame::large_ids).
+  uint32_t min_pixels = 0;
 };
 
 struct SceneCamera {
@@ -49,10 +52,23 @@ struct SceneFrame {
   io::Image rgb;               // width x height RGB
   std::vector<uint32_t> ids;   // triangle (Scene::indices / 3) seen at each pixel centre, kNoTriangle for none
   std::vector<float> depth;    // its camera-space z (map units), +infinity for none
+  // With RenderOptions::min_pixels m > 1: the triangle seen at each pixel
+  // centre when those covering fewer than m pixels of `ids` are left out.
+  std::vector<uint32_t> large_ids;
 };
 
 // The triangles a frame shows, each with the pixels it covers, by triangle.
 std::vector<std::pair<uint32_t, uint32_t>> visible_triangles(const SceneFrame& f);
+
+// The same for a client that leaves out the small triangles (covering
+// fewer pixels than the frame's RenderOptions::min_pixels) wherever large
+// triangles the frame shows lie behind each of their pixels: those pixels
+// count for the triangles behind. A small triangle stays if at one of its
+// pixels nothing large lies behind it (leaving it out would open a hole),
+// or a large triangle the frame does not show elsewhere (it would be drawn
+// for the small one's pixels alone, seen through a grille of them). Frames
+// rendered without min_pixels: visible_triangles(f).
+std::vector<std::pair<uint32_t, uint32_t>> visible_large_triangles(const SceneFrame& f);
 
 class SceneRenderer {
  public:

@@ -35,6 +35,12 @@ struct WalkEncodeOptions {
   int refine_delta = 0;     // a refinement's quality above the views' (0: none; they did not pay on oa_dm4: docs/walkthrough.md)
   int refine_after = 10;    // frames after a view arrives; views serving at least twice that are refined
   int window = 2;         // hot: visible within this many frames either side
+  // A triangle covering fewer of a frame's pixels than this is not drawn
+  // there where a larger one the frame shows lies behind each of its
+  // pixels (visible_large_triangles; 0: every triangle a frame shows is
+  // drawn). On the figure maps' tours: fewer triangle slots and set-ups at
+  // the same pictures (docs/walkthrough.md, "Small triangles").
+  uint32_t min_pixels = 16;
   int max_sends = 0;      // polygons a frame sends at most before the rest go a frame earlier (0: no limit)
   int frames_per_record = kWalkMaxFramesPerRecord;  // most frames a WFRM record holds
   // Metres a vertex may move to the grid the geometry is sent on: the
