@@ -3,7 +3,7 @@
 // texture update within the link's bytes, and what the client then holds
 // drawn next to the ground truth. Prints the paper's compression ratios and
 // the rendered PSNR; with --out, writes per-frame figures (frames.csv), a
-// contact sheet (truth | vds) and, with --frames-png, every frame.
+// contact sheet (truth | vds) and, with --frames-png, every frame and its truth.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -88,6 +88,8 @@ void run(const FlyOptions& o) {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%04zu.png", f);
       io::save_png((std::filesystem::path(o.out) / name).string(), client);
+      std::snprintf(name, sizeof name, "truth_%04zu.png", f);
+      io::save_png((std::filesystem::path(o.out) / name).string(), truth);
     }
   };
   fo.progress = [&](size_t done) {
@@ -203,15 +205,19 @@ void run_encode(const FlyOptions& o) {
     std::vector<io::Image> sheet;
     const size_t tiles = std::min<size_t>(8, shown.size());
     if (!o.out.empty()) std::filesystem::create_directories(o.out);
+    std::vector<double> per_frame(shown.size());
     for (size_t f = 0; f < shown.size(); ++f) {
       const io::Image g = truth.render(r.flight[f], path.hfov_deg);
-      sum += io::psnr(g, shown[f]);
+      per_frame[f] = io::psnr(g, shown[f]);
+      sum += per_frame[f];
       for (size_t k = 0; k < tiles; ++k)
         if (sheet_frame(k, tiles, shown.size()) == f) sheet.push_back(io::side_by_side({&g, &shown[f]}));
       if (o.frames_png && !o.out.empty()) {
         char name[32];
         std::snprintf(name, sizeof name, "frame_%04zu.png", f);
         io::save_png((std::filesystem::path(o.out) / name).string(), shown[f]);
+        std::snprintf(name, sizeof name, "truth_%04zu.png", f);
+        io::save_png((std::filesystem::path(o.out) / name).string(), g);
       }
     }
     std::printf("  what the client shows against the ground truth: mean %.2f dB\n", sum / static_cast<double>(shown.size()));
@@ -220,7 +226,13 @@ void run_encode(const FlyOptions& o) {
       for (const io::Image& im : sheet) ptrs.push_back(&im);
       const std::string sheet_path = (std::filesystem::path(o.out) / "sheet.png").string();
       io::save_png(sheet_path, io::grid(ptrs, 2));
-      std::printf("  %s (ground truth | client)\n", sheet_path.c_str());
+      const std::string csv_path = (std::filesystem::path(o.out) / "frames.csv").string();
+      std::FILE* csv = std::fopen(csv_path.c_str(), "w");
+      if (csv == nullptr) throw std::runtime_error(csv_path + ": cannot be written");
+      std::fprintf(csv, "frame,psnr\n");
+      for (size_t f = 0; f < per_frame.size(); ++f) std::fprintf(csv, "%zu,%.4f\n", f, per_frame[f]);
+      if (std::fclose(csv) != 0) throw std::runtime_error(csv_path + ": cannot be written");
+      std::printf("  %s (ground truth | client), %s (each frame's PSNR)\n", sheet_path.c_str(), csv_path.c_str());
     }
   }
 }
@@ -303,7 +315,7 @@ void map_options(CLI::App* sub, FlyOptions* o) {
   sub->add_option("--quantiser", o->quantiser, "Quantiser scale, 1..62 (default 4)")->check(CLI::Range(1, 62));
   sub->add_option("--detail", o->detail, "Scale of every mask cutoff (default 1.25)")->check(kPositive);
   sub->add_option("--out", o->out, "Folder for frames.csv and the contact sheet");
-  sub->add_flag("--frames-png", o->frames_png, "With --out: every frame the client shows, as PNG");
+  sub->add_flag("--frames-png", o->frames_png, "With --out: every frame the client shows and its ground truth, as PNG (frame_NNNN.png, truth_NNNN.png)");
 }
 
 // The terrain client's sizes (encode-terrain, serve-terrain); the store's
