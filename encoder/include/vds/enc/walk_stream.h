@@ -38,8 +38,8 @@ struct WalkEncodeOptions {
   // A triangle covering fewer of a frame's pixels than this is not drawn
   // there where a larger one the frame shows lies behind each of its
   // pixels (visible_large_triangles; 0: every triangle a frame shows is
-  // drawn). On the figure maps' tours: fewer triangle slots and set-ups at
-  // the same pictures (docs/walkthrough.md, "Small triangles").
+  // drawn). On the figure maps' tours: fewer triangle slots and set-ups,
+  // the pooled PSNR the same or higher (docs/walkthrough.md, "Small triangles").
   uint32_t min_pixels = 16;
   int max_sends = 0;      // polygons a frame sends at most before the rest go a frame earlier (0: no limit)
   int frames_per_record = kWalkMaxFramesPerRecord;  // most frames a WFRM record holds
