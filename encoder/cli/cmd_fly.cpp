@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <numeric>
 #include <string>
 
 #include "board_run.h"
@@ -63,6 +64,25 @@ enc::CameraPath load_flight(const FlyOptions& o, const enc::TerrainCoding& t) {
   return enc::terrain_flyover(t, o.frames, o.fps);
 }
 
+// --frames-png: frame f as the client showed it and its ground truth.
+void save_frame_pngs(const std::string& out, size_t f, const io::Image& client, const io::Image& truth) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%04zu.png", f);
+  io::save_png((std::filesystem::path(out) / name).string(), client);
+  std::snprintf(name, sizeof name, "truth_%04zu.png", f);
+  io::save_png((std::filesystem::path(out) / name).string(), truth);
+}
+
+// The contact sheet's pairs (ground truth | client), two a row, as
+// out/sheet.png; its path.
+std::string save_sheet(const std::string& out, const std::vector<io::Image>& sheet) {
+  std::vector<const io::Image*> ptrs;
+  for (const io::Image& im : sheet) ptrs.push_back(&im);
+  const std::string path = (std::filesystem::path(out) / "sheet.png").string();
+  io::save_png(path, io::grid(ptrs, 2));
+  return path;
+}
+
 void run(const FlyOptions& o) {
   const enc::TerrainMap map = load_map(o);
   const enc::TerrainCoding t = enc::code_terrain(map, o.quantiser);
@@ -84,13 +104,7 @@ void run(const FlyOptions& o) {
     bool pick = false;
     for (size_t k = 0; k < tiles; ++k) pick = pick || sheet_frame(k, tiles, path.frames.size()) == f;
     if (pick) sheet.push_back(io::side_by_side({&truth, &client}));
-    if (o.frames_png && !o.out.empty()) {
-      char name[32];
-      std::snprintf(name, sizeof name, "frame_%04zu.png", f);
-      io::save_png((std::filesystem::path(o.out) / name).string(), client);
-      std::snprintf(name, sizeof name, "truth_%04zu.png", f);
-      io::save_png((std::filesystem::path(o.out) / name).string(), truth);
-    }
+    if (o.frames_png && !o.out.empty()) save_frame_pngs(o.out, f, client, truth);
   };
   fo.progress = [&](size_t done) {
     if (done % 25 == 0 || done == path.frames.size()) std::fprintf(stderr, "\r  frame %zu of %zu", done, path.frames.size());
@@ -154,10 +168,7 @@ void run(const FlyOptions& o) {
         << f.held << ',' << f.update.needed << ',' << f.update.needed_blocks << ',' << f.psnr << ','
         << f.psnr_client_renderer << '\n';
   }
-  std::vector<const io::Image*> ptrs;
-  for (const io::Image& im : sheet) ptrs.push_back(&im);
-  const std::string sheet_path = (std::filesystem::path(o.out) / "sheet.png").string();
-  io::save_png(sheet_path, io::grid(ptrs, 2));
+  const std::string sheet_path = save_sheet(o.out, sheet);
   std::printf("  %s/frames.csv, %s (ground truth | vds)\n", o.out.c_str(), sheet_path.c_str());
 }
 
@@ -201,7 +212,6 @@ void run_encode(const FlyOptions& o) {
   std::printf("  the client library plays it: %zu frames (CRCs hashed: %08x)\n", crcs.size(), all);
   if (o.psnr || !o.out.empty()) {
     const enc::TerrainTruth truth(t, so.width, so.height);
-    double sum = 0;
     std::vector<io::Image> sheet;
     const size_t tiles = std::min<size_t>(8, shown.size());
     if (!o.out.empty()) std::filesystem::create_directories(o.out);
@@ -209,23 +219,14 @@ void run_encode(const FlyOptions& o) {
     for (size_t f = 0; f < shown.size(); ++f) {
       const io::Image g = truth.render(r.flight[f], path.hfov_deg);
       per_frame[f] = io::psnr(g, shown[f]);
-      sum += per_frame[f];
       for (size_t k = 0; k < tiles; ++k)
         if (sheet_frame(k, tiles, shown.size()) == f) sheet.push_back(io::side_by_side({&g, &shown[f]}));
-      if (o.frames_png && !o.out.empty()) {
-        char name[32];
-        std::snprintf(name, sizeof name, "frame_%04zu.png", f);
-        io::save_png((std::filesystem::path(o.out) / name).string(), shown[f]);
-        std::snprintf(name, sizeof name, "truth_%04zu.png", f);
-        io::save_png((std::filesystem::path(o.out) / name).string(), g);
-      }
+      if (o.frames_png && !o.out.empty()) save_frame_pngs(o.out, f, shown[f], g);
     }
-    std::printf("  what the client shows against the ground truth: mean %.2f dB\n", sum / static_cast<double>(shown.size()));
+    std::printf("  what the client shows against the ground truth: mean %.2f dB\n",
+                std::accumulate(per_frame.begin(), per_frame.end(), 0.0) / static_cast<double>(shown.size()));
     if (!o.out.empty()) {
-      std::vector<const io::Image*> ptrs;
-      for (const io::Image& im : sheet) ptrs.push_back(&im);
-      const std::string sheet_path = (std::filesystem::path(o.out) / "sheet.png").string();
-      io::save_png(sheet_path, io::grid(ptrs, 2));
+      const std::string sheet_path = save_sheet(o.out, sheet);
       const std::string csv_path = (std::filesystem::path(o.out) / "frames.csv").string();
       std::FILE* csv = std::fopen(csv_path.c_str(), "w");
       if (csv == nullptr) throw std::runtime_error(csv_path + ": cannot be written");

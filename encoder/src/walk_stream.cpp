@@ -149,9 +149,12 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   RenderOptions ro;
   ro.width = o.width;
   ro.height = o.height;
-  ro.min_pixels = geometry ? 0 : o.min_pixels;  // the client leaves out small triangles where that opens no hole
   const std::vector<io::Image> images = load_scene_images(s);
-  const SceneRenderer renderer(s, images, ro);
+  // What the client draws: a frame leaves out small triangles where that
+  // opens no hole (the second ID buffer of the visibility the plans use).
+  RenderOptions truth_ro = ro;
+  truth_ro.min_pixels = geometry ? 0 : o.min_pixels;
+  const SceneRenderer renderer(s, images, truth_ro);
   const SceneCamera sc = scene_camera(path.frames[0], path.hfov_deg, o.width, o.height);  // the screen's intrinsics
   // The views' size.
   if (!(o.view_scale > 0 && o.view_scale <= 1)) throw std::invalid_argument("encode_walk: a view scale in (0, 1]");
@@ -168,11 +171,12 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   RenderOptions vro = ro;
   vro.supersample = 1;
   vro.max_aniso = 1;
-  vro.min_pixels = o.min_pixels;
   if (geometry) {
     // What the client's triangles show, pixel by pixel (the alpha-tested
     // ones cut out as the scene's are).
-    const SceneRenderer ids(drawn, images, vro);
+    RenderOptions ids_ro = vro;
+    ids_ro.min_pixels = o.min_pixels;
+    const SceneRenderer ids(drawn, images, ids_ro);
     render_path(ids, path, o.threads, [&](size_t f, const SceneFrame& fr) { visible[f] = visible_large_triangles(fr); },
                 [&](size_t done) { progress("visibility", done, n); });
   }
@@ -206,9 +210,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vo.view_height = view_h;
   CameraPath wide = path;
   wide.hfov_deg = view_hfov;
-  RenderOptions view_vis_ro = vro;
-  view_vis_ro.min_pixels = 0;
-  const SceneRenderer view_vis(drawn, {}, view_vis_ro);
+  const SceneRenderer view_vis(drawn, {}, vro);
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> view_visible(n);
   render_path(view_vis, wide, o.threads, [&](size_t f, const SceneFrame& fr) { view_visible[f] = visible_triangles(fr); },
               [&](size_t done) { progress("view visibility", done, n); });
@@ -230,7 +232,6 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     for (const auto& u : ups) view_planes[camera_of(u)];
   size_t done = 0;
   RenderOptions view_ro = ro;
-  view_ro.min_pixels = 0;
   view_ro.width = view_w;
   view_ro.height = view_h;
   const SceneRenderer view_renderer(s, images, view_ro);
