@@ -24,12 +24,12 @@ constexpr double kWalkShapeToleranceM = 1.0 / 16;
 
 struct EncodeWalkOptions {
   std::string scene, path, out, y4m, per_frame, size = "240x180";
-  double rate = 16, threshold = 18, widen = -1, view_scale = -1, occlusion = -1, occlusion_tolerance = -1;
+  double rate = 16, threshold = 18, widen = -1, view_scale = -1, occlusion = -1, occlusion_tolerance = -1, occlusion_share = -1;
   int min_pixels = -1;
   double shape_tolerance = -1, vertex_tolerance = -1;  // metres
-  int lookahead = -1, preroll = -1, window = -1, max_sends = -1;
+  int lookahead = -1, preroll = -1, window = -1, max_sends = -1, hot_window = -1;
   double zoom_run = -1;
-  bool predict = false, keep_triangles = false, no_occlusion_updates = false, whole_views = false;
+  bool predict = false, keep_triangles = false, no_occlusion_updates = false, whole_views = false, area_occlusion = false;
   int views = 2, zoom = -1, zoom_min_run = -1, quality = -1, refine_delta = -1, refine_after = -1, frames_per_record = kWalkMaxFramesPerRecord;
 };
 
@@ -56,6 +56,7 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   wo.threshold = o.threshold;
   wo.quality = o.quality;
   wo.frames_per_record = o.frames_per_record;
+  if (o.hot_window >= 0) wo.window = o.hot_window;
   wo.predict = o.predict;
   wo.regions = !o.whole_views;
   if (o.zoom >= 0) wo.zoom = o.zoom;
@@ -70,6 +71,8 @@ void run_encode_walk(const EncodeWalkOptions& o) {
   if (o.occlusion >= 0) wo.occlusion_margin = o.occlusion;
   if (o.no_occlusion_updates) wo.occlusion_updates = false;
   if (o.occlusion_tolerance >= 0) wo.occlusion_tolerance = o.occlusion_tolerance;
+  if (o.occlusion_share >= 0) wo.occlusion_share = o.occlusion_share;
+  if (o.area_occlusion) wo.pixel_occlusion = false;
   if (o.min_pixels >= 0) wo.min_pixels = static_cast<uint32_t>(o.min_pixels);
   if (o.view_scale > 0) wo.view_scale = o.view_scale;
   if (o.refine_delta >= 0) wo.refine_delta = o.refine_delta;
@@ -142,6 +145,9 @@ void add_encode_walk(CLI::App& app) {
       ->check(CLI::Range(0, static_cast<int>(kWalkMaxPrerollMs)));
   sub->add_option("--max-sends", o->max_sends, "Polygons a frame sends at most; the rest go earlier where their slots allow (0: no limit)")
       ->check(CLI::Range(0, 100000));
+  sub->add_option("--hot-window", o->hot_window,
+                  "A triangle is drawn in the frames within this many either side of those it shows in (default 2)")
+      ->check(CLI::Range(0, 60));
   sub->add_option("--window", o->window, "The client's stream window, bytes (default 4096: the client firmware's)")
       ->check(CLI::Range(256, 1 << 24));
   sub->add_option("--quality", o->quality, "The views' image quality (default: each view's, by the rate control)")->check(CLI::Range(0, 100));
@@ -159,12 +165,19 @@ void add_encode_walk(CLI::App& app) {
   sub->add_option("--widen", o->widen, "tan(half the views' field of view) / tan(half the screen's) (default 1.5)")
       ->check(CLI::Range(1.0, 4.0));
   sub->add_option("--view-scale", o->view_scale, "The views' size over the frame's, each side (default 2/3)")->check(CLI::Range(0.1, 1.0));
+  sub->add_option("--occlusion-share", o->occlusion_share,
+                  "A view that sees something else in front of more than this share of a polygon's pixels on the screen is "
+                  "occluded for it: another view draws it if one serves it (default 0.1)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_flag("--area-occlusion", o->area_occlusion,
+                "Tell occluded views by the share of each polygon's area they see (--occlusion-margin), not pixel by pixel");
   sub->add_option("--occlusion-margin", o->occlusion,
-                  "A view seeing this much less of a polygon than the screen does (share of its area) is occluded for it: "
-                  "another view draws it if one serves it (default 0.5; over 1: no such test)")
+                  "With --area-occlusion: a view seeing this much less of a polygon than the screen does (share of its area) "
+                  "is occluded for it (default 0.5; over 1: no such test)")
       ->check(CLI::Range(0.0, 2.0));
   sub->add_option("--occlusion-tolerance", o->occlusion_tolerance,
-                  "The share of a frame's pixels that only occluded views may serve before a view update (default 0.02)")
+                  "The share of a frame's pixels that occluded views may hide before a view update (default 0.01; "
+                  "with --area-occlusion: that only occluded views serve, 0.02 measured best there)")
       ->check(CLI::Range(0.0, 1.0));
   sub->add_option("--min-pixels", o->min_pixels,
                   "A triangle covering fewer of a frame's pixels than this is not drawn there where a larger one "

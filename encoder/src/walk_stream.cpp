@@ -164,9 +164,27 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   const int view_h = std::min(o.height, std::max(16, static_cast<int>(std::ceil(o.height * scale / 2 - 1e-9)) * 2));
   std::vector<io::Image> truth(n);
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> visible(n);
+  // The visibility buffers for the per-pixel occlusion test, every second
+  // pixel each way (WalkViewBuffers): what the client draws at each.
+  WalkViewBuffers buffers;
+  buffers.step = 2;
+  buffers.width = (o.width + 1) / 2;
+  buffers.height = (o.height + 1) / 2;
+  if (o.pixel_occlusion) {
+    buffers.screen_ids.resize(n);
+    buffers.view_ids.resize(n);
+    buffers.view_depth.resize(n);
+  }
+  const auto keep_screen = [&](size_t f, const SceneFrame& fr) {
+    if (o.pixel_occlusion)
+      buffers.screen_ids[f] = walk_buffer_samples(fr.large_ids.empty() ? fr.ids : fr.large_ids, o.width, o.height, buffers.step);
+  };
   render_path(renderer, path, o.threads, [&](size_t f, const SceneFrame& fr) {
     truth[f] = fr.rgb;
-    if (!geometry) visible[f] = visible_large_triangles(fr);
+    if (!geometry) {
+      visible[f] = visible_large_triangles(fr);
+      keep_screen(f, fr);
+    }
   }, [&](size_t done) { progress("ground truth", done, n); });
   RenderOptions vro = ro;
   vro.supersample = 1;
@@ -177,8 +195,10 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     RenderOptions ids_ro = vro;
     ids_ro.min_pixels = o.min_pixels;
     const SceneRenderer ids(drawn, images, ids_ro);
-    render_path(ids, path, o.threads, [&](size_t f, const SceneFrame& fr) { visible[f] = visible_large_triangles(fr); },
-                [&](size_t done) { progress("visibility", done, n); });
+    render_path(ids, path, o.threads, [&](size_t f, const SceneFrame& fr) {
+      visible[f] = visible_large_triangles(fr);
+      keep_screen(f, fr);
+    }, [&](size_t done) { progress("visibility", done, n); });
   }
   // 2. Geometry and views.
   std::vector<std::vector<uint32_t>> ids(n);
@@ -212,9 +232,15 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   wide.hfov_deg = view_hfov;
   const SceneRenderer view_vis(drawn, {}, vro);
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> view_visible(n);
-  render_path(view_vis, wide, o.threads, [&](size_t f, const SceneFrame& fr) { view_visible[f] = visible_triangles(fr); },
-              [&](size_t done) { progress("view visibility", done, n); });
-  const WalkViewPlan vp = plan_walk_views(drawn, path, visible, vo, &view_visible);
+  render_path(view_vis, wide, o.threads, [&](size_t f, const SceneFrame& fr) {
+    view_visible[f] = visible_triangles(fr);
+    if (o.pixel_occlusion) {
+      buffers.view_ids[f] = walk_buffer_samples(fr.ids, o.width, o.height, buffers.step);
+      buffers.view_depth[f] = walk_buffer_samples(fr.depth, o.width, o.height, buffers.step);
+    }
+  }, [&](size_t done) { progress("view visibility", done, n); });
+  vo.occlusion_share = o.occlusion_share;
+  const WalkViewPlan vp = plan_walk_views(drawn, path, visible, vo, &view_visible, o.pixel_occlusion ? &buffers : nullptr);
   // 3. The views, rendered at the client's cameras.
   std::vector<WalkPose> poses(n);
   for (size_t f = 0; f < n; ++f) poses[f] = walk_pose(path.frames[f]);

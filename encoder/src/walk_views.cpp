@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -47,7 +48,8 @@ vds::Camera client_camera(const CameraPose& pose, double hfov_deg, int width, in
 
 WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
                              const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>& visible,
-                             const WalkViewOptions& o, const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>* view_visible) {
+                             const WalkViewOptions& o, const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>* view_visible,
+                             const WalkViewBuffers* buffers) {
   const size_t n = path.frames.size();
   if (visible.size() != n) throw std::invalid_argument("plan_walk_views: one visibility list per frame");
   if (o.slots < 1 || o.slots > 127 || o.lookahead < 0 || !(o.threshold > 0))
@@ -55,6 +57,15 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   const double view_hfov = o.view_hfov_deg > 0 ? o.view_hfov_deg : path.hfov_deg;
   if (view_visible != nullptr && view_visible->size() != n) throw std::invalid_argument("plan_walk_views: one view visibility list per frame");
   const int vw = o.view_width > 0 ? o.view_width : o.width, vh = o.view_height > 0 ? o.view_height : o.height;
+  if (buffers != nullptr) {
+    const WalkViewBuffers& b = *buffers;
+    const size_t samples = static_cast<size_t>(b.width) * static_cast<size_t>(b.height);
+    bool ok = b.step >= 1 && b.width == (o.width + b.step - 1) / b.step && b.height == (o.height + b.step - 1) / b.step &&
+              b.screen_ids.size() == n && b.view_ids.size() == n && b.view_depth.size() == n;
+    for (size_t f = 0; ok && f < n; ++f)
+      ok = b.screen_ids[f].size() == samples && b.view_ids[f].size() == samples && b.view_depth[f].size() == samples;
+    if (!ok) throw std::invalid_argument("plan_walk_views: visibility buffers of another size");
+  }
   // Each frame's camera as the screen and as a view: the client's and the scene's.
   if (o.zoom < kWalkZoomUnit || o.zoom > kWalkMaxZoom) throw std::invalid_argument("plan_walk_views: a zoom of 16 to 64");
   // A view's camera is named by an index: frame g at the views' own focal
@@ -162,11 +173,88 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
     const double a = area_px(poly, c);
     return a >= 24 ? std::min(1.0, px / a) : -1.0;
   };
+  // Per-pixel occlusion (buffers): for the screen of frame f and the view
+  // at frame g's camera, per polygon, its samples on the screen that land
+  // inside the view and those of them behind something else there: the
+  // view's depth at the sample it lands on is nearer than the polygon's
+  // plane along that sample's ray (so a neighbour in the same plane hides
+  // nothing). Kept for the frames the planner is still looking at.
+  struct Hidden {
+    uint32_t seen = 0, hidden = 0;
+  };
+  std::map<std::pair<size_t, size_t>, std::unordered_map<uint32_t, Hidden>> hidden_cache;
+  const auto hidden_of = [&](size_t f, size_t g) -> const std::unordered_map<uint32_t, Hidden>& {
+    auto [it, fresh] = hidden_cache.try_emplace({f, g});
+    if (!fresh) return it->second;
+    const WalkViewBuffers& b = *buffers;
+    const SceneCamera& sf = scams[f];
+    const SceneCamera& vg = rcams[g];
+    const auto dot = [](const P3& a, const P3& c) { return a[0] * c[0] + a[1] * c[1] + a[2] * c[2]; };
+    const auto ray = [&](const SceneCamera& c, double x, double y) {
+      return comb(comb(c.forward, 1, c.right, (x - c.cx) / c.focal), 1, c.down, (y - c.cy) / c.focal);
+    };
+    // Camera-space z along `dir` (forward component 1) from `from` to the plane (normal m through p0); <= 0: none.
+    const auto to_plane = [&](const P3& from, const P3& dir, const P3& m, const P3& p0) {
+      const double den = dot(m, dir);
+      if (std::fabs(den) < 1e-12) return -1.0;
+      return dot(m, P3{p0[0] - from[0], p0[1] - from[1], p0[2] - from[2]}) / den;
+    };
+    const std::vector<uint32_t>& ids = b.screen_ids[f];
+    for (int j = 0; j < b.height; ++j)
+      for (int i = 0; i < b.width; ++i) {
+        const uint32_t id = ids[static_cast<size_t>(j) * static_cast<size_t>(b.width) + static_cast<size_t>(i)];
+        if (id == kNoTriangle || 3 * static_cast<size_t>(id) + 2 >= s.indices.size()) continue;
+        const auto& a = s.vertices[s.indices[3 * static_cast<size_t>(id)]].pos;
+        const auto& b1 = s.vertices[s.indices[3 * static_cast<size_t>(id) + 1]].pos;
+        const auto& c1 = s.vertices[s.indices[3 * static_cast<size_t>(id) + 2]].pos;
+        const P3 p0{a[0], a[1], a[2]};
+        const P3 e1{b1[0] - a[0], b1[1] - a[1], b1[2] - a[2]}, e2{c1[0] - a[0], c1[1] - a[1], c1[2] - a[2]};
+        const P3 m{e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        const P3 d = ray(sf, b.step * i + 0.5, b.step * j + 0.5);
+        const double t = to_plane(sf.position, d, m, p0);
+        if (!(t > 0)) continue;
+        const P3 x = comb(sf.position, 1, d, t);
+        const P3 r{x[0] - vg.position[0], x[1] - vg.position[1], x[2] - vg.position[2]};
+        const double z = dot(r, vg.forward);
+        if (!(z > o.near_z)) continue;
+        const double u = vg.cx + vg.focal * dot(r, vg.right) / z, v = vg.cy + vg.focal * dot(r, vg.down) / z;
+        if (!(u >= 0 && v >= 0 && u < o.width && v < o.height)) continue;
+        Hidden& h = it->second[id];
+        ++h.seen;
+        // Hidden where the four samples around the point all show
+        // something nearer (an edge where the polygon meets a wall in
+        // front of its plane's extension hides at most two of them).
+        const int iu = static_cast<int>(std::floor(u / b.step - 0.5)), iv = static_cast<int>(std::floor(v / b.step - 0.5));
+        bool all = true;
+        for (int q = 0; q < 4 && all; ++q) {
+          const int su = std::clamp(iu + (q & 1), 0, b.width - 1), sv = std::clamp(iv + (q >> 1), 0, b.height - 1);
+          const size_t k = static_cast<size_t>(sv) * static_cast<size_t>(b.width) + static_cast<size_t>(su);
+          if (b.view_ids[g][k] == id) {
+            all = false;
+            break;
+          }
+          const double zp = to_plane(vg.position, ray(vg, b.step * su + 0.5, b.step * sv + 0.5), m, p0);
+          all = zp > 0 && b.view_depth[g][k] < zp * 0.98;
+        }
+        if (all) ++h.hidden;
+      }
+    return it->second;
+  };
+  // The share of polygon id's pixels on frame f's screen that the view at
+  // frame g (a camera index, zoomed or not) sees something else in front of.
+  const auto hidden_share = [&](size_t f, size_t j, uint32_t id) {
+    const size_t g = j % n;
+    if (f == g) return 0.0;
+    const auto& m = hidden_of(f, g);
+    const auto e = m.find(id);
+    return e == m.end() || e->second.seen == 0 ? 0.0 : static_cast<double>(e->second.hidden) / e->second.seen;
+  };
   // Whether the view at frame g sees a clearly smaller share of the
   // polygon than frame f's screen does: something stands in front of it
   // there, which the view would draw onto it.
   const auto occluded = [&](size_t f, size_t j, uint32_t id) {
     const size_t g = j % n;  // (a zoomed view's visibility: its frame's, cut by its image's bounds)
+    if (buffers != nullptr) return hidden_share(f, j, id) > o.occlusion_share;
     if (f == g || !(o.occlusion_margin <= 1)) return false;
     const auto shown = shows[g].find(id);
     const auto sf = on_screen[f].find(id);
@@ -265,15 +353,25 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   // Whether the views `v` leave frame f unserved: more than tolerance_px
   // of its pixels with no view within the threshold, or (occlusion_updates)
   // more than occlusion_tolerance_px served only by occluded views.
+  // With the buffers, a polygon's occluded pixels are those its least
+  // hidden serving view hides.
   const auto unserved = [&](size_t f, const std::vector<int64_t>& v) {
-    size_t px_out = 0, px_occluded = 0;
+    size_t px_out = 0;
+    double px_occluded = 0;
     for (const auto& entry : visible[f]) {
       const uint32_t id = entry.first;
       bool served = false, clear = false;
+      double least = 1;
       for (const int64_t g : v) {
         if (g < 0 || factor(f, static_cast<size_t>(g), id) > limit) continue;
         served = true;
-        if (!o.occlusion_updates || !occluded(f, static_cast<size_t>(g), id)) {
+        if (!o.occlusion_updates) {
+          clear = true;
+          break;
+        }
+        if (buffers != nullptr) {
+          least = std::min(least, hidden_share(f, static_cast<size_t>(g), id));
+        } else if (!occluded(f, static_cast<size_t>(g), id)) {
           clear = true;
           break;
         }
@@ -281,12 +379,14 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
       if (!served) {
         px_out += entry.second;
       } else if (!clear) {
-        px_occluded += entry.second;
+        px_occluded += entry.second * (buffers != nullptr ? least : 1.0);
       }
     }
-    return px_out > o.tolerance_px || px_occluded > o.occlusion_tolerance_px;
+    return px_out > o.tolerance_px || px_occluded > static_cast<double>(o.occlusion_tolerance_px);
   };
   for (size_t f = 0; f < n; ++f) {
+    // (The planner looks at frames from f on only.)
+    hidden_cache.erase(hidden_cache.begin(), hidden_cache.lower_bound({f, 0}));
     if (unserved(f, held)) {
       // An empty slot is filled first; else the slot whose view serves the
       // fewest of this frame's pixels goes.
@@ -317,6 +417,8 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
         }
       const bool zoomed = zooms > 1 && best_run[1] >= static_cast<size_t>(std::max(1, o.zoom_min_run)) &&
                           static_cast<double>(best_run[1]) >= o.zoom_run * static_cast<double>(best_run[0]);
+      // An update for occluded pixels alone that serves too few frames is
+      // not worth its bytes: the occluded views go on drawing.
       held[victim] = static_cast<int64_t>(zoomed ? best[1] + n : best[0]);
       plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(zoomed ? best[1] : best[0]),
                                  zoomed ? static_cast<uint8_t>(o.zoom) : kWalkZoomUnit, std::vector<uint8_t>(static_cast<size_t>(mw * mh), 0)});
@@ -329,12 +431,16 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
       int8_t pick = -1;
       double q = std::numeric_limits<double>::infinity();
       bool pick_occluded = true;
+      double pick_hidden = 0;
       for (size_t k = 0; k < held.size(); ++k) {
         if (held[k] < 0) continue;
         const double fk = factor(f, static_cast<size_t>(held[k]), id);
         if (fk == inf) continue;
         const bool occ = occluded(f, static_cast<size_t>(held[k]), id);
-        if (pick < 0 || (pick_occluded && !occ) || (occ == pick_occluded && fk < q)) q = fk, pick = static_cast<int8_t>(k), pick_occluded = occ;
+        // (Of two occluded views, with the buffers, the one hiding less.)
+        const double hk = occ && buffers != nullptr ? hidden_share(f, static_cast<size_t>(held[k]), id) : 0;
+        if (pick < 0 || (pick_occluded && !occ) || (occ == pick_occluded && (hk < pick_hidden || (hk == pick_hidden && fk < q))))
+          q = fk, pick = static_cast<int8_t>(k), pick_occluded = occ, pick_hidden = hk;
       }
       plan.choice[f].push_back(pick);
       if (pick >= 0) mark(holder[static_cast<size_t>(pick)]->mcus, f, static_cast<size_t>(held[static_cast<size_t>(pick)]), id);

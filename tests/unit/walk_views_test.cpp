@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <stdexcept>
 #include <vector>
 
 #include "vds/enc/camera_tour.h"
@@ -61,21 +62,50 @@ void add_quad(vds::enc::Scene& s, const std::array<std::array<float, 3>, 4>& c, 
   s.surfaces.push_back(f);
 }
 
-TEST(WalkViews, AViewThatSeesAPolygonOnlyPastWhatStandsInFrontOfItDoesNotServeIt) {
-  // A wall at x = 300 facing the origin, and a screen at x = 150 hiding
-  // its half y > 0 from the origin. Frame 0 looks at the wall from the
-  // origin; frame 1 from x = 200, in front of the screen, sees the whole
-  // wall. The view taken at frame 0 shows the wall's triangles (half of
-  // each): drawn onto frame 1 it would paint the screen onto the wall, so
-  // it cannot serve frame 1 and a view update comes there.
+// A scene of one grey texture.
+vds::enc::Scene grey_scene() {
   vds::enc::Scene s;
   vds::enc::SceneTexture t;
   t.name = "grey";
   s.textures.push_back(t);
+  return s;
+}
+
+// A wall at x = 300 facing the origin, and a screen at x = 150 hiding its
+// half y > 0 from the origin. Frame 0 looks at the wall from the origin;
+// frame 1 from x = 200, in front of the screen, sees the whole wall.
+vds::enc::Scene wall_and_screen(vds::enc::CameraPath* path) {
+  vds::enc::Scene s = grey_scene();
   add_quad(s, {{{300, 150, -150}, {300, -150, -150}, {300, -150, 150}, {300, 150, 150}}}, {-1, 0, 0});
   add_quad(s, {{{150, 150, -150}, {150, 0, -150}, {150, 0, 150}, {150, 150, 150}}}, {-1, 0, 0});
+  path->frames = {{0, 0, 0, 0, 0}, {200, 0, 0, 0, 0}};
+  return s;
+}
+
+// The visibility buffers of a path for the per-pixel occlusion test: the
+// screen and the views (as wide as the screen) at each frame's camera.
+vds::enc::WalkViewBuffers buffers_of(const vds::enc::SceneRenderer& r, const vds::enc::CameraPath& path, Visible* vis) {
+  vds::enc::WalkViewBuffers b;
+  b.step = 2;
+  b.width = 120;
+  b.height = 90;
+  for (const auto& pose : path.frames) {
+    const vds::enc::SceneFrame fr = r.render(pose, path.hfov_deg);
+    vis->push_back(vds::enc::visible_triangles(fr));
+    b.screen_ids.push_back(vds::enc::walk_buffer_samples(fr.ids, 240, 180, 2));
+    b.view_ids.push_back(b.screen_ids.back());
+    b.view_depth.push_back(vds::enc::walk_buffer_samples(fr.depth, 240, 180, 2));
+  }
+  return b;
+}
+
+TEST(WalkViews, AViewThatSeesAPolygonOnlyPastWhatStandsInFrontOfItDoesNotServeIt) {
+  // wall_and_screen: the view taken at frame 0 shows the wall's triangles
+  // (half of each): drawn onto frame 1 it would paint the screen onto the
+  // wall, so it cannot serve frame 1 and a view update comes there — by
+  // shares of area and pixel by pixel.
   vds::enc::CameraPath path;
-  path.frames = {{0, 0, 0, 0, 0}, {200, 0, 0, 0, 0}};
+  const vds::enc::Scene s = wall_and_screen(&path);
   vds::enc::RenderOptions ro;
   ro.supersample = 1;
   const vds::enc::SceneRenderer r(s, {}, ro);
@@ -106,6 +136,70 @@ TEST(WalkViews, AViewThatSeesAPolygonOnlyPastWhatStandsInFrontOfItDoesNotServeIt
   EXPECT_TRUE(tolerated.updates[1].empty());
   ASSERT_EQ(tolerated.choice[1].size(), 2u);
   for (const int8_t c : tolerated.choice[1]) EXPECT_EQ(c, 0);
+  // Pixel by pixel (the buffers): the view hides half of the wall's pixels
+  // on frame 1's screen, more than the share that makes it occluded and
+  // than the 1,000 of them tolerated.
+  Visible vis2;
+  const vds::enc::WalkViewBuffers b = buffers_of(r, path, &vis2);
+  o.occlusion_tolerance_px = 1000;
+  const auto per_pixel = vds::enc::plan_walk_views(s, path, vis2, o, nullptr, &b);
+  ASSERT_EQ(per_pixel.updates[1].size(), 1u);
+  EXPECT_EQ(per_pixel.updates[1][0].camera_frame, 1u);
+  // Buffers of another size are refused.
+  vds::enc::WalkViewBuffers wrong = b;
+  wrong.width = 100;
+  EXPECT_THROW(vds::enc::plan_walk_views(s, path, vis2, o, nullptr, &wrong), std::invalid_argument);
+}
+
+TEST(WalkViews, PixelByPixelAThinPostCountsTheWallPixelsItHidesAndAnEdgeHidesNone) {
+  // A wall at x = 300 standing on a floor at z = -100 (a concave edge
+  // where they meet), and a thin post at x = 150 in front of the wall.
+  // Frame 0 looks from the origin; frame 1 from x = 200, past the post,
+  // turned a little. The view taken at frame 0 hides the wall only behind
+  // the post, a few percent of the wall's pixels: not occluded for it,
+  // but those pixels are counted against the tolerance. Without the post
+  // the view hides nothing on frame 1: the wall's pixels next to the edge
+  // (where the floor's plane runs on behind the wall) are not counted.
+  const auto scene = [](bool post) {
+    vds::enc::Scene s = grey_scene();
+    add_quad(s, {{{300, 400, -100}, {300, -400, -100}, {300, -400, 300}, {300, 400, 300}}}, {-1, 0, 0});
+    add_quad(s, {{{-100, -400, -100}, {-100, 400, -100}, {300, 400, -100}, {300, -400, -100}}}, {0, 0, 1});
+    if (post) add_quad(s, {{{150, 3, -100}, {150, -3, -100}, {150, -3, 300}, {150, 3, 300}}}, {-1, 0, 0});
+    return s;
+  };
+  vds::enc::CameraPath path;
+  path.frames = {{0, 0, 0, 0, -10}, {200, 20, 0, 8, -12}};
+  vds::enc::RenderOptions ro;
+  ro.supersample = 1;
+  vds::enc::WalkViewOptions o;
+  o.slots = 1;
+  o.threshold = 100;
+  o.lookahead = 0;
+  o.occlusion_updates = true;
+  for (const bool post : {false, true}) {
+    SCOPED_TRACE(post ? "post" : "no post");
+    const vds::enc::Scene s = scene(post);
+    const vds::enc::SceneRenderer r(s, {}, ro);
+    Visible vis;
+    const vds::enc::WalkViewBuffers b = buffers_of(r, path, &vis);
+    // The wall's pixels on frame 1.
+    size_t wall_px = 0;
+    for (const auto& [id, px] : vis[1]) wall_px += id < 2 ? px : 0;
+    ASSERT_GT(wall_px, 10000u);
+    // Every pixel the view hides counts: the post's are some, the edge's none.
+    o.occlusion_tolerance_px = 0;
+    const auto strict = vds::enc::plan_walk_views(s, path, vis, o, nullptr, &b);
+    ASSERT_EQ(strict.updates[0].size(), 1u);
+    EXPECT_EQ(strict.updates[1].size(), post ? 1u : 0u);
+    if (!post) continue;
+    // Not occluded for the wall (the view hides under a tenth of its
+    // pixels): with the post's pixels tolerated, the view draws the wall.
+    o.occlusion_tolerance_px = wall_px / 10;
+    const auto tolerant = vds::enc::plan_walk_views(s, path, vis, o, nullptr, &b);
+    EXPECT_TRUE(tolerant.updates[1].empty());
+    for (size_t i = 0; i < vis[1].size(); ++i)
+      if (vis[1][i].first < 2) EXPECT_EQ(tolerant.choice[1][i], 0);
+  }
 }
 
 TEST(WalkViews, ATourOfOaDm4IsServedWithinTheThreshold) {

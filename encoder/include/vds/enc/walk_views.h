@@ -61,6 +61,12 @@ struct WalkViewOptions {
   double occlusion_margin = 2;
   bool occlusion_updates = false;
   size_t occlusion_tolerance_px = 0;
+  // With the visibility buffers (WalkViewBuffers): a view is occluded for a
+  // polygon when more than this share of the polygon's pixels on the
+  // screen (of those inside the view) lie behind something else there, and
+  // a frame's occluded pixels are those of each polygon's view that hides
+  // the fewest (occlusion_margin is then not used).
+  double occlusion_share = 0.1;
   // Texels around a polygon's footprint in a view counted as read (Update::
   // mcus): the bilinear filter's neighbour and the client's fixed-point
   // cameras.
@@ -97,13 +103,45 @@ struct WalkViewPlan {
   size_t pixels_unserved = 0;       // by no held view (a hole until an update arrives)
 };
 
+// The visibility buffers themselves, sampled every `step` pixels each way
+// (the pixel centres (step i + 1/2, step j + 1/2) of a frame of
+// WalkViewOptions::width x height): for each frame, the polygon its screen
+// shows at each sample, and the polygon and its depth (camera-space z,
+// scene units; +infinity for none) that a view at the frame's camera shows
+// there (the views' field of view, the frame's size). With them the
+// occlusion test is per pixel: a view is occluded for a polygon where the
+// polygon's points on the screen lie, seen from the view, behind something
+// else (a pillar, a torch, a model's limb), and the planner counts those
+// pixels instead of comparing shares of the polygon's area.
+struct WalkViewBuffers {
+  int step = 2;
+  int width = 0, height = 0;  // samples across and down
+  std::vector<std::vector<uint32_t>> screen_ids;  // per frame, width x height (kNoTriangle: none)
+  std::vector<std::vector<uint32_t>> view_ids;
+  std::vector<std::vector<float>> view_depth;
+};
+
+// A width x height buffer sampled as WalkViewBuffers keeps it: the
+// samples at (step i, step j).
+template <typename T>
+std::vector<T> walk_buffer_samples(const std::vector<T>& full, int width, int height, int step) {
+  const int w = (width + step - 1) / step, h = (height + step - 1) / step;
+  std::vector<T> out;
+  out.reserve(static_cast<size_t>(w) * static_cast<size_t>(h));
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) out.push_back(full[static_cast<size_t>(j * step) * static_cast<size_t>(width) + static_cast<size_t>(i * step)]);
+  return out;
+}
+
 // `visible[f]`: (polygon, pixels it covers) for each polygon frame f shows,
 // from the ground truth's visibility buffers; `view_visible[f]` the same
 // for a view at frame f's camera when views have a wider field of view
-// (nullptr: the same as `visible`).
+// (nullptr: the same as `visible`); `buffers`: the buffers themselves, for
+// the per-pixel occlusion test (nullptr: the test by shares of area).
 WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
                              const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>& visible,
                              const WalkViewOptions& o = WalkViewOptions{},
-                             const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>* view_visible = nullptr);
+                             const std::vector<std::vector<std::pair<uint32_t, uint32_t>>>* view_visible = nullptr,
+                             const WalkViewBuffers* buffers = nullptr);
 
 }  // namespace vds::enc
