@@ -11,6 +11,7 @@
 #include <fstream>
 #include <memory>
 #include <numeric>
+#include <stdexcept>
 #include <string>
 
 #include "board_run.h"
@@ -158,7 +159,8 @@ void run(const FlyOptions& o) {
                 "only): mean %.2f dB\n", full);
   }
   if (o.out.empty()) return;
-  std::ofstream csv(std::filesystem::path(o.out) / "frames.csv");
+  const std::string csv_path = (std::filesystem::path(o.out) / "frames.csv").string();
+  std::ofstream csv(csv_path);
   csv << "frame,down_bytes,elevation_bytes,up_bytes,grows,intra,shrinks,coefficients_added,coefficients_dropped,blocks_wanted,"
          "coefficients_held,coefficients_needed,blocks_needed,psnr,psnr_client_renderer_full_texture\n";
   for (size_t i = 0; i < r.frames.size(); ++i) {
@@ -168,6 +170,8 @@ void run(const FlyOptions& o) {
         << f.held << ',' << f.update.needed << ',' << f.update.needed_blocks << ',' << f.psnr << ','
         << f.psnr_client_renderer << '\n';
   }
+  csv.close();
+  if (!csv) throw std::runtime_error(csv_path + ": cannot be written");
   const std::string sheet_path = save_sheet(o.out, sheet);
   std::printf("  %s/frames.csv, %s (ground truth | vds)\n", o.out.c_str(), sheet_path.c_str());
 }
