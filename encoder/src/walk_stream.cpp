@@ -8,6 +8,7 @@
 #include <numeric>
 #include <queue>
 #include <stdexcept>
+#include <unordered_set>
 
 #include "vds/enc/arith_encoder.h"
 #include "vds/enc/frames.h"
@@ -175,9 +176,20 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     buffers.view_ids.resize(n);
     buffers.view_depth.resize(n);
   }
+  // The triangle the client draws at each pixel: a small triangle the
+  // frame keeps (visible_large_triangles) where it shows, else the large
+  // one behind it.
   const auto keep_screen = [&](size_t f, const SceneFrame& fr) {
-    if (o.pixel_occlusion)
-      buffers.screen_ids[f] = walk_buffer_samples(fr.large_ids.empty() ? fr.ids : fr.large_ids, o.width, o.height, buffers.step);
+    if (!o.pixel_occlusion) return;
+    if (fr.large_ids.empty()) {
+      buffers.screen_ids[f] = walk_buffer_samples(fr.ids, o.width, o.height, buffers.step);
+      return;
+    }
+    std::unordered_set<uint32_t> kept;
+    for (const auto& [id, px] : visible[f]) kept.insert(id);
+    std::vector<uint32_t> drawn_ids(fr.ids.size());
+    for (size_t i = 0; i < drawn_ids.size(); ++i) drawn_ids[i] = kept.count(fr.ids[i]) ? fr.ids[i] : fr.large_ids[i];
+    buffers.screen_ids[f] = walk_buffer_samples(drawn_ids, o.width, o.height, buffers.step);
   };
   render_path(renderer, path, o.threads, [&](size_t f, const SceneFrame& fr) {
     truth[f] = fr.rgb;
@@ -230,7 +242,9 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
   vo.view_height = view_h;
   CameraPath wide = path;
   wide.hfov_deg = view_hfov;
-  const SceneRenderer view_vis(drawn, {}, vro);
+  // (Alpha-tested surfaces cut out as the scene's are: what lies behind a
+  // grating shows through it.)
+  const SceneRenderer view_vis(drawn, images, vro);
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> view_visible(n);
   render_path(view_vis, wide, o.threads, [&](size_t f, const SceneFrame& fr) {
     view_visible[f] = visible_triangles(fr);

@@ -224,7 +224,8 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
         // Hidden where the four samples around the point all show
         // something nearer (an edge where the polygon meets a wall in
         // front of its plane's extension hides at most two of them).
-        const int iu = static_cast<int>(std::floor(u / b.step - 0.5)), iv = static_cast<int>(std::floor(v / b.step - 0.5));
+        // (Sample i lies at pixel centre step i + 1/2.)
+        const int iu = static_cast<int>(std::floor((u - 0.5) / b.step)), iv = static_cast<int>(std::floor((v - 0.5) / b.step));
         bool all = true;
         for (int q = 0; q < 4 && all; ++q) {
           const int su = std::clamp(iu + (q & 1), 0, b.width - 1), sv = std::clamp(iv + (q >> 1), 0, b.height - 1);
@@ -353,25 +354,53 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   // Whether the views `v` leave frame f unserved: more than tolerance_px
   // of its pixels with no view within the threshold, or (occlusion_updates)
   // more than occlusion_tolerance_px served only by occluded views.
-  // With the buffers, a polygon's occluded pixels are those its least
-  // hidden serving view hides.
+  // Each polygon's view among views `v`: one not occluded for it before an
+  // occluded one; of those not occluded the smallest factor; of occluded
+  // ones (with the buffers) the one hiding least, then the smallest
+  // factor. With the buffers, views within the threshold come first when
+  // one serves the polygon. -1: no view shows it.
+  struct Pick {
+    int k = -1;
+    double factor = std::numeric_limits<double>::infinity();
+    bool occluded = true;
+    double hidden = 0;  // the share of its pixels the view hides (with the buffers)
+  };
+  const auto pick_view = [&](size_t f, const std::vector<int64_t>& v, uint32_t id) {
+    Pick best;
+    bool best_within = false;
+    for (size_t k = 0; k < v.size(); ++k) {
+      if (v[k] < 0) continue;
+      const double fk = factor(f, static_cast<size_t>(v[k]), id);
+      if (fk == inf) continue;
+      const bool occ = occluded(f, static_cast<size_t>(v[k]), id);
+      const double hk = buffers != nullptr ? hidden_share(f, static_cast<size_t>(v[k]), id) : 0;
+      const bool within = buffers != nullptr && fk <= limit;
+      const bool better = best.k < 0 || (within && !best_within) ||
+                          (within == best_within && ((best.occluded && !occ) ||
+                                                     (occ == best.occluded && ((occ && hk < best.hidden) ||
+                                                                               ((!occ || hk == best.hidden) && fk < best.factor)))));
+      if (better) best = {static_cast<int>(k), fk, occ, hk}, best_within = within;
+    }
+    return best;
+  };
+  // With the buffers, a polygon's occluded pixels are those the view it
+  // would be drawn from hides.
   const auto unserved = [&](size_t f, const std::vector<int64_t>& v) {
     size_t px_out = 0;
     double px_occluded = 0;
     for (const auto& entry : visible[f]) {
       const uint32_t id = entry.first;
+      if (buffers != nullptr) {
+        const Pick p = pick_view(f, v, id);
+        if (p.k < 0 || p.factor > limit) px_out += entry.second;
+        else if (o.occlusion_updates) px_occluded += entry.second * p.hidden;
+        continue;
+      }
       bool served = false, clear = false;
-      double least = 1;
       for (const int64_t g : v) {
         if (g < 0 || factor(f, static_cast<size_t>(g), id) > limit) continue;
         served = true;
-        if (!o.occlusion_updates) {
-          clear = true;
-          break;
-        }
-        if (buffers != nullptr) {
-          least = std::min(least, hidden_share(f, static_cast<size_t>(g), id));
-        } else if (!occluded(f, static_cast<size_t>(g), id)) {
+        if (!o.occlusion_updates || !occluded(f, static_cast<size_t>(g), id)) {
           clear = true;
           break;
         }
@@ -379,7 +408,7 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
       if (!served) {
         px_out += entry.second;
       } else if (!clear) {
-        px_occluded += entry.second * (buffers != nullptr ? least : 1.0);
+        px_occluded += entry.second;
       }
     }
     return px_out > o.tolerance_px || px_occluded > static_cast<double>(o.occlusion_tolerance_px);
@@ -417,31 +446,17 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
         }
       const bool zoomed = zooms > 1 && best_run[1] >= static_cast<size_t>(std::max(1, o.zoom_min_run)) &&
                           static_cast<double>(best_run[1]) >= o.zoom_run * static_cast<double>(best_run[0]);
-      // An update for occluded pixels alone that serves too few frames is
-      // not worth its bytes: the occluded views go on drawing.
       held[victim] = static_cast<int64_t>(zoomed ? best[1] + n : best[0]);
       plan.updates[f].push_back({static_cast<uint32_t>(victim), static_cast<uint32_t>(zoomed ? best[1] : best[0]),
                                  zoomed ? static_cast<uint8_t>(o.zoom) : kWalkZoomUnit, std::vector<uint8_t>(static_cast<size_t>(mw * mh), 0)});
     }
     // (Each frame's updates are whole: pointers into them stay valid.)
     for (WalkViewPlan::Update& u : plan.updates[f]) holder[u.slot] = &u;
-    // Each polygon's view: the smallest factor, among the views that are
-    // not occluded there if any serves it.
+    // Each polygon's view (pick_view).
     for (const auto& [id, px] : visible[f]) {
-      int8_t pick = -1;
-      double q = std::numeric_limits<double>::infinity();
-      bool pick_occluded = true;
-      double pick_hidden = 0;
-      for (size_t k = 0; k < held.size(); ++k) {
-        if (held[k] < 0) continue;
-        const double fk = factor(f, static_cast<size_t>(held[k]), id);
-        if (fk == inf) continue;
-        const bool occ = occluded(f, static_cast<size_t>(held[k]), id);
-        // (Of two occluded views, with the buffers, the one hiding less.)
-        const double hk = occ && buffers != nullptr ? hidden_share(f, static_cast<size_t>(held[k]), id) : 0;
-        if (pick < 0 || (pick_occluded && !occ) || (occ == pick_occluded && (hk < pick_hidden || (hk == pick_hidden && fk < q))))
-          q = fk, pick = static_cast<int8_t>(k), pick_occluded = occ, pick_hidden = hk;
-      }
+      const Pick p = pick_view(f, held, id);
+      const int8_t pick = static_cast<int8_t>(p.k);
+      const double q = p.factor;
       plan.choice[f].push_back(pick);
       if (pick >= 0) mark(holder[static_cast<size_t>(pick)]->mcus, f, static_cast<size_t>(held[static_cast<size_t>(pick)]), id);
       plan.pixels += px;

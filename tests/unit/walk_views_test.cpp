@@ -202,6 +202,48 @@ TEST(WalkViews, PixelByPixelAThinPostCountsTheWallPixelsItHidesAndAnEdgeHidesNon
   }
 }
 
+TEST(WalkViews, PixelByPixelAPolygonIsDrawnFromAViewThatDoesNotHideItOverOneWithASmallerFactor) {
+  // A wall at x = 300 and a post at x = 250 in front of its middle. Frame
+  // 0 looks at the wall from x = 200, behind the post; frame 1 from x =
+  // 100, y = 300, at a slant past it; frame 2 from x = 270, between the
+  // post and the wall, sees only the wall's middle. Both views serve frame
+  // 2; the one from frame 0 magnifies less (nearer, head on) but sees the
+  // post in front of most of that middle: the wall is drawn from the view
+  // of frame 1, which the post does not hide.
+  vds::enc::Scene s = grey_scene();
+  add_quad(s, {{{300, 150, -150}, {300, -150, -150}, {300, -150, 150}, {300, 150, 150}}}, {-1, 0, 0});
+  add_quad(s, {{{250, 15, -150}, {250, -15, -150}, {250, -15, 150}, {250, 15, 150}}}, {-1, 0, 0});
+  vds::enc::CameraPath path;
+  path.frames = {{200, 0, 0, 0, 0}, {100, 300, 0, -56.3, 0}, {270, 0, 0, 0, 0}};
+  vds::enc::RenderOptions ro;
+  ro.supersample = 1;
+  const vds::enc::SceneRenderer r(s, {}, ro);
+  Visible vis;
+  const vds::enc::WalkViewBuffers b = buffers_of(r, path, &vis);
+  // Frame 2 shows the wall's two triangles and not the post.
+  ASSERT_EQ(vis[2].size(), 2u);
+  for (const auto& [id, px] : vis[2]) ASSERT_LT(id, 2u);
+  vds::enc::WalkViewOptions o;
+  o.slots = 2;
+  o.threshold = 100;
+  o.lookahead = 0;
+  o.occlusion_updates = true;
+  o.occlusion_tolerance_px = size_t{1} << 30;  // no updates for occlusion: the views held are frame 0's and 1's
+  const auto plan = vds::enc::plan_walk_views(s, path, vis, o, nullptr, &b);
+  ASSERT_EQ(plan.updates[0].size(), 1u);
+  ASSERT_EQ(plan.updates[1].size(), 1u);
+  ASSERT_TRUE(plan.updates[2].empty());
+  const int8_t slot_of_frame1 = static_cast<int8_t>(plan.updates[1][0].slot);
+  for (const int8_t c : plan.choice[2]) EXPECT_EQ(c, slot_of_frame1);
+  // By shares of area the view of frame 0 sees most of each wall triangle
+  // (the post hides a fifth of what it shows of them): it is not
+  // occluded, and its smaller factor wins.
+  o.occlusion_margin = 0.5;
+  const auto by_area = vds::enc::plan_walk_views(s, path, vis, o);
+  ASSERT_EQ(by_area.updates[1].size(), 1u);
+  for (const int8_t c : by_area.choice[2]) EXPECT_NE(c, static_cast<int8_t>(by_area.updates[1][0].slot));
+}
+
 TEST(WalkViews, ATourOfOaDm4IsServedWithinTheThreshold) {
   const vds::test::TourVisibility tv = vds::test::tour_visibility("oa_dm4", 200);
   const vds::enc::Scene& s = tv.scene;

@@ -56,16 +56,18 @@ struct WalkViewOptions {
   // view that is not occluded for it when one serves it; with
   // occlusion_updates, a frame with more than occlusion_tolerance_px
   // pixels that only occluded views serve gets a view update, like one
-  // with pixels no view serves. Off here; the walkthrough encoder's
-  // defaults (WalkEncodeOptions) turn it on.
+  // with pixels no view serves. Off here (unless the per-pixel test's
+  // buffers are given: then occlusion_share decides); the walkthrough
+  // encoder's defaults (WalkEncodeOptions) turn it on.
   double occlusion_margin = 2;
   bool occlusion_updates = false;
   size_t occlusion_tolerance_px = 0;
   // With the visibility buffers (WalkViewBuffers): a view is occluded for a
-  // polygon when more than this share of the polygon's pixels on the
-  // screen (of those inside the view) lie behind something else there, and
-  // a frame's occluded pixels are those of each polygon's view that hides
-  // the fewest (occlusion_margin is then not used).
+  // polygon when more than this share of the polygon's samples on the
+  // screen (of those inside the view) lie behind something else there
+  // (nearer than the polygon's plane by more than 2 %), and a frame's
+  // occluded pixels are those each polygon's view (the one it would be
+  // drawn from) hides (occlusion_margin is then not used).
   double occlusion_share = 0.1;
   // Texels around a polygon's footprint in a view counted as read (Update::
   // mcus): the bilinear filter's neighbour and the client's fixed-point
