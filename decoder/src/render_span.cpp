@@ -1199,6 +1199,11 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
   DT* const zrow = static_cast<DT*>(b.depth) + static_cast<uint32_t>(y - b.y0) * static_cast<uint32_t>(b.width);
   uint8_t* const crow = b.color + static_cast<uint32_t>(y - b.y0) * b.color_stride;
   const typename Sampler::Ctx tex = Sampler::ctx(s);  // a local copy: the stores below cannot alias it
+  // The length the general set-up last took in this span: the next piece
+  // of a projective span tries twice that first, not the whole rest
+  // (where the values need short pieces, halving from the rest cost every
+  // piece about 7 tries).
+  [[maybe_unused]] int32_t fit = 0;
   while (xa < xb) {
     int32_t len = xb - xa;
     RowState r;
@@ -1218,7 +1223,11 @@ void texture_span(const BandTarget& b, const PolySetup& s, int32_t y, int32_t xa
       fast = row_fast_call<2, kProj>(s, y, xa, len, r);
     }
     if (!fast) {
+      if constexpr (kProj) {
+        if (fit > 0 && len > 2 * fit) len = 2 * fit;
+      }
       while (!row_piece(s, y, xa, len, r)) len = (len + 1) >> 1;
+      if constexpr (kProj) fit = len;
     }
     // Both buffers are indexed from the piece end with i = -len .. -1.
     DT* const ze = zrow + xa + len;
