@@ -547,17 +547,19 @@ std::vector<std::pair<uint32_t, uint32_t>> count_ids(std::vector<uint32_t> ids) 
 }
 }  // namespace
 
-std::vector<std::pair<uint32_t, uint32_t>> visible_triangles(const SceneFrame& f) {
-  std::vector<uint32_t> ids;
-  ids.reserve(f.ids.size());
-  for (uint32_t id : f.ids)
-    if (id != kNoTriangle) ids.push_back(id);
-  return count_ids(std::move(ids));
+std::vector<std::pair<uint32_t, uint32_t>> triangle_pixels(const std::vector<uint32_t>& ids) {
+  std::vector<uint32_t> shown;
+  shown.reserve(ids.size());
+  for (uint32_t id : ids)
+    if (id != kNoTriangle) shown.push_back(id);
+  return count_ids(std::move(shown));
 }
 
-std::vector<std::pair<uint32_t, uint32_t>> visible_large_triangles(const SceneFrame& f) {
-  if (f.large_ids.empty()) return visible_triangles(f);
-  if (f.large_ids.size() != f.ids.size()) throw std::invalid_argument("visible_large_triangles: large_ids of another size");
+std::vector<std::pair<uint32_t, uint32_t>> visible_triangles(const SceneFrame& f) { return triangle_pixels(f.ids); }
+
+std::vector<uint32_t> drawn_triangle_ids(const SceneFrame& f) {
+  if (f.large_ids.empty()) return f.ids;
+  if (f.large_ids.size() != f.ids.size()) throw std::invalid_argument("drawn_triangle_ids: large_ids of another size");
   // A small triangle is one whose pixels large_ids does not show it at. It
   // stays where what lies behind it is nothing, or a triangle the frame
   // does not show elsewhere (the view through a grille of small ones).
@@ -567,14 +569,16 @@ std::vector<std::pair<uint32_t, uint32_t>> visible_large_triangles(const SceneFr
   std::unordered_set<uint32_t> stays;
   for (size_t i = 0; i < f.ids.size(); ++i)
     if (f.ids[i] != kNoTriangle && f.large_ids[i] != f.ids[i] && shown.count(f.large_ids[i]) == 0) stays.insert(f.ids[i]);
-  std::vector<uint32_t> ids;
-  ids.reserve(f.ids.size());
+  std::vector<uint32_t> out(f.ids.size());
   for (size_t i = 0; i < f.ids.size(); ++i) {
     const uint32_t id = f.ids[i];
-    if (id == kNoTriangle) continue;
-    ids.push_back(f.large_ids[i] == id || stays.count(id) != 0 ? id : f.large_ids[i]);
+    out[i] = id == kNoTriangle || f.large_ids[i] == id || stays.count(id) != 0 ? id : f.large_ids[i];
   }
-  return count_ids(std::move(ids));
+  return out;
+}
+
+std::vector<std::pair<uint32_t, uint32_t>> visible_large_triangles(const SceneFrame& f) {
+  return triangle_pixels(drawn_triangle_ids(f));
 }
 
 void render_path(const SceneRenderer& r, const CameraPath& path, int threads,

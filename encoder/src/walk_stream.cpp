@@ -8,7 +8,6 @@
 #include <numeric>
 #include <queue>
 #include <stdexcept>
-#include <unordered_set>
 
 #include "vds/enc/arith_encoder.h"
 #include "vds/enc/frames.h"
@@ -176,27 +175,17 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     buffers.view_ids.resize(n);
     buffers.view_depth.resize(n);
   }
-  // The triangle the client draws at each pixel: a small triangle the
-  // frame keeps (visible_large_triangles) where it shows, else the large
-  // one behind it.
-  const auto keep_screen = [&](size_t f, const SceneFrame& fr) {
-    if (!o.pixel_occlusion) return;
-    if (fr.large_ids.empty()) {
-      buffers.screen_ids[f] = walk_buffer_samples(fr.ids, o.width, o.height, buffers.step);
-      return;
-    }
-    std::unordered_set<uint32_t> kept;
-    for (const auto& [id, px] : visible[f]) kept.insert(id);
-    std::vector<uint32_t> drawn_ids(fr.ids.size());
-    for (size_t i = 0; i < drawn_ids.size(); ++i) drawn_ids[i] = kept.count(fr.ids[i]) ? fr.ids[i] : fr.large_ids[i];
-    buffers.screen_ids[f] = walk_buffer_samples(drawn_ids, o.width, o.height, buffers.step);
+  // What the client draws at each pixel (drawn_triangle_ids): the
+  // triangles the frame shows, and the screen's buffer for the per-pixel
+  // occlusion test.
+  const auto keep_visibility = [&](size_t f, const SceneFrame& fr) {
+    const std::vector<uint32_t> drawn_ids = drawn_triangle_ids(fr);
+    visible[f] = triangle_pixels(drawn_ids);
+    if (o.pixel_occlusion) buffers.screen_ids[f] = walk_buffer_samples(drawn_ids, o.width, o.height, buffers.step);
   };
   render_path(renderer, path, o.threads, [&](size_t f, const SceneFrame& fr) {
     truth[f] = fr.rgb;
-    if (!geometry) {
-      visible[f] = visible_large_triangles(fr);
-      keep_screen(f, fr);
-    }
+    if (!geometry) keep_visibility(f, fr);
   }, [&](size_t done) { progress("ground truth", done, n); });
   RenderOptions vro = ro;
   vro.supersample = 1;
@@ -207,10 +196,7 @@ WalkEncodeResult encode_walk(const Scene& s, const CameraPath& path, const WalkE
     RenderOptions ids_ro = vro;
     ids_ro.min_pixels = o.min_pixels;
     const SceneRenderer ids(drawn, images, ids_ro);
-    render_path(ids, path, o.threads, [&](size_t f, const SceneFrame& fr) {
-      visible[f] = visible_large_triangles(fr);
-      keep_screen(f, fr);
-    }, [&](size_t done) { progress("visibility", done, n); });
+    render_path(ids, path, o.threads, keep_visibility, [&](size_t done) { progress("visibility", done, n); });
   }
   // 2. Geometry and views.
   std::vector<std::vector<uint32_t>> ids(n);

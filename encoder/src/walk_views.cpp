@@ -8,6 +8,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 
 #include "vds/enc/scene_render.h"
@@ -200,16 +201,23 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
       return dot(m, P3{p0[0] - from[0], p0[1] - from[1], p0[2] - from[2]}) / den;
     };
     const std::vector<uint32_t>& ids = b.screen_ids[f];
+    // The plane of the sample's polygon (normal m through p0), kept while
+    // the samples of a row stay on one polygon.
+    uint32_t plane_of = kNoTriangle;
+    P3 p0{}, m{};
     for (int j = 0; j < b.height; ++j)
       for (int i = 0; i < b.width; ++i) {
         const uint32_t id = ids[static_cast<size_t>(j) * static_cast<size_t>(b.width) + static_cast<size_t>(i)];
         if (id == kNoTriangle || 3 * static_cast<size_t>(id) + 2 >= s.indices.size()) continue;
-        const auto& a = s.vertices[s.indices[3 * static_cast<size_t>(id)]].pos;
-        const auto& b1 = s.vertices[s.indices[3 * static_cast<size_t>(id) + 1]].pos;
-        const auto& c1 = s.vertices[s.indices[3 * static_cast<size_t>(id) + 2]].pos;
-        const P3 p0{a[0], a[1], a[2]};
-        const P3 e1{b1[0] - a[0], b1[1] - a[1], b1[2] - a[2]}, e2{c1[0] - a[0], c1[1] - a[1], c1[2] - a[2]};
-        const P3 m{e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        if (id != plane_of) {
+          const auto& a = s.vertices[s.indices[3 * static_cast<size_t>(id)]].pos;
+          const auto& b1 = s.vertices[s.indices[3 * static_cast<size_t>(id) + 1]].pos;
+          const auto& c1 = s.vertices[s.indices[3 * static_cast<size_t>(id) + 2]].pos;
+          const P3 e1{b1[0] - a[0], b1[1] - a[1], b1[2] - a[2]}, e2{c1[0] - a[0], c1[1] - a[1], c1[2] - a[2]};
+          p0 = P3{a[0], a[1], a[2]};
+          m = P3{e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+          plane_of = id;
+        }
         const P3 d = ray(sf, b.step * i + 0.5, b.step * j + 0.5);
         const double t = to_plane(sf.position, d, m, p0);
         if (!(t > 0)) continue;
@@ -255,7 +263,6 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   // there, which the view would draw onto it.
   const auto occluded = [&](size_t f, size_t j, uint32_t id) {
     const size_t g = j % n;  // (a zoomed view's visibility: its frame's, cut by its image's bounds)
-    if (buffers != nullptr) return hidden_share(f, j, id) > o.occlusion_share;
     if (f == g || !(o.occlusion_margin <= 1)) return false;
     const auto shown = shows[g].find(id);
     const auto sf = on_screen[f].find(id);
@@ -351,40 +358,37 @@ WalkViewPlan plan_walk_views(const Scene& s, const CameraPath& path,
   plan.choice.resize(n);
   std::vector<int64_t> held(static_cast<size_t>(o.slots), -1);  // the camera (index, above) of each slot's view
   std::vector<WalkViewPlan::Update*> holder(static_cast<size_t>(o.slots), nullptr);  // the update that put it there
-  // Whether the views `v` leave frame f unserved: more than tolerance_px
-  // of its pixels with no view within the threshold, or (occlusion_updates)
-  // more than occlusion_tolerance_px served only by occluded views.
   // Each polygon's view among views `v`: one not occluded for it before an
   // occluded one; of those not occluded the smallest factor; of occluded
   // ones (with the buffers) the one hiding least, then the smallest
   // factor. With the buffers, views within the threshold come first when
-  // one serves the polygon. -1: no view shows it.
+  // one serves the polygon, and a view is occluded when it hides more than
+  // occlusion_share of the polygon's pixels. -1: no view shows it.
   struct Pick {
     int k = -1;
     double factor = std::numeric_limits<double>::infinity();
-    bool occluded = true;
     double hidden = 0;  // the share of its pixels the view hides (with the buffers)
   };
   const auto pick_view = [&](size_t f, const std::vector<int64_t>& v, uint32_t id) {
     Pick best;
-    bool best_within = false;
+    // The order of the rules above, smallest first.
+    std::tuple<bool, bool, double, double> best_rank;
     for (size_t k = 0; k < v.size(); ++k) {
       if (v[k] < 0) continue;
       const double fk = factor(f, static_cast<size_t>(v[k]), id);
       if (fk == inf) continue;
-      const bool occ = occluded(f, static_cast<size_t>(v[k]), id);
       const double hk = buffers != nullptr ? hidden_share(f, static_cast<size_t>(v[k]), id) : 0;
-      const bool within = buffers != nullptr && fk <= limit;
-      const bool better = best.k < 0 || (within && !best_within) ||
-                          (within == best_within && ((best.occluded && !occ) ||
-                                                     (occ == best.occluded && ((occ && hk < best.hidden) ||
-                                                                               ((!occ || hk == best.hidden) && fk < best.factor)))));
-      if (better) best = {static_cast<int>(k), fk, occ, hk}, best_within = within;
+      const bool occ = buffers != nullptr ? hk > o.occlusion_share : occluded(f, static_cast<size_t>(v[k]), id);
+      const std::tuple<bool, bool, double, double> rank{buffers != nullptr && fk > limit, occ, occ ? hk : 0, fk};
+      if (best.k < 0 || rank < best_rank) best = {static_cast<int>(k), fk, hk}, best_rank = rank;
     }
     return best;
   };
-  // With the buffers, a polygon's occluded pixels are those the view it
-  // would be drawn from hides.
+  // Whether the views `v` leave frame f unserved: more than tolerance_px
+  // of its pixels with no view within the threshold, or (occlusion_updates)
+  // more than occlusion_tolerance_px served only by occluded views. With
+  // the buffers, a polygon's occluded pixels are those the view it would
+  // be drawn from hides.
   const auto unserved = [&](size_t f, const std::vector<int64_t>& v) {
     size_t px_out = 0;
     double px_occluded = 0;

@@ -70,6 +70,15 @@ std::vector<std::pair<uint32_t, uint32_t>> visible_triangles(const SceneFrame& f
 // rendered without min_pixels: visible_triangles(f).
 std::vector<std::pair<uint32_t, uint32_t>> visible_large_triangles(const SceneFrame& f);
 
+// The triangle that client draws at each pixel (kNoTriangle: none): a
+// small triangle where it stays, else the large one behind it; what
+// visible_large_triangles counts. Frames rendered without min_pixels: f.ids.
+std::vector<uint32_t> drawn_triangle_ids(const SceneFrame& f);
+
+// The triangles of a per-pixel buffer, each with the pixels it covers, by
+// triangle (kNoTriangle left out).
+std::vector<std::pair<uint32_t, uint32_t>> triangle_pixels(const std::vector<uint32_t>& ids);
+
 class SceneRenderer {
  public:
   // `images[t]` is texture t's image (RGBA; empty: drawn mid grey).
