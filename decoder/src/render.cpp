@@ -95,6 +95,7 @@ Status check_list(const DrawList& list) {
     if (m.shading == Shading::mesh_colors &&
         (!m.surface || !m.surface->face || !m.surface->y || !m.surface->cb || !m.surface->cr))
       return Status::malformed;
+    if (m.shading == Shading::view_mapped && m.views && !m.views->map) return Status::malformed;
     if (m.shading == Shading::texture || m.shading == Shading::view_mapped) {
       const Status st = check_texture(m.texture);
       if (st != Status::ok) return st;
@@ -250,9 +251,20 @@ struct RenderFrame {
     return oc;
   }
 
+  // Projects every vertex below the cache's size that a triangle names
+  // (a draw list may hold positions no mesh draws this frame).
   void fill_cache() {
     const uint32_t n = list.num_positions < r.cfg_.vertex_cache ? list.num_positions : r.cfg_.vertex_cache;
-    for (uint32_t i = 0; i < n; ++i) r.cache_outcode_[i] = project(i, &r.cache_[i]);
+    uint8_t* const oc = r.cache_outcode_;
+    for (uint32_t i = 0; i < n; ++i) oc[i] = kUnprojected;
+    for (uint32_t mi = 0; mi < list.num_meshes; ++mi) {
+      const Mesh& m = list.meshes[mi];
+      const uint32_t count = 3 * m.num_triangles;
+      for (uint32_t k = 0; k < count; ++k) {
+        const uint32_t i = m.indices[k];
+        if (i < n && oc[i] == kUnprojected) oc[i] = project(i, &r.cache_[i]);
+      }
+    }
     cached = n;
   }
 
@@ -269,13 +281,25 @@ struct RenderFrame {
       for (uint32_t t = 0; t < m.num_triangles && g < cap; ++t, ++g) {
         const uint16_t* idx = m.indices + 3 * t;
         uint16_t first = 0, last = last_band;
-        if (idx[0] < cached && idx[1] < cached && idx[2] < cached) {
-          const uint8_t o0 = r.cache_outcode_[idx[0]], o1 = r.cache_outcode_[idx[1]], o2 = r.cache_outcode_[idx[2]];
+        // A vertex past the vertex cache is projected here for its triangle
+        // alone (and again in the bands that draw it).
+        CachedVertex cv[3];
+        uint8_t oc[3];
+        for (int k = 0; k < 3; ++k) {
+          if (idx[k] < cached) {
+            cv[k] = r.cache_[idx[k]];
+            oc[k] = r.cache_outcode_[idx[k]];
+          } else {
+            oc[k] = project(idx[k], &cv[k]);
+          }
+        }
+        {
+          const uint8_t o0 = oc[0], o1 = oc[1], o2 = oc[2];
           if (o0 & o1 & o2 & kOutAll) {
             first = 1;
             last = 0;
           } else if (!((o0 | o1 | o2) & kNoProjection)) {
-            const int32_t y0 = r.cache_[idx[0]].y, y1 = r.cache_[idx[1]].y, y2 = r.cache_[idx[2]].y;
+            const int32_t y0 = cv[0].y, y1 = cv[1].y, y2 = cv[2].y;
             const int32_t margin = (o0 | o1 | o2) ? 256 : 0;
             const int32_t lo = (y0 < y1 ? (y0 < y2 ? y0 : y2) : (y1 < y2 ? y1 : y2)) - margin;
             const int32_t hi = (y0 > y1 ? (y0 > y2 ? y0 : y2) : (y1 > y2 ? y1 : y2)) + margin;
@@ -289,11 +313,11 @@ struct RenderFrame {
             } else {
               first = static_cast<uint16_t>(r0 / bh);
               last = static_cast<uint16_t>((r1 - 1) / bh);
-              if ((o0 | o1 | o2) == 0 && !drawable(m, r.cache_[idx[0]], r.cache_[idx[1]], r.cache_[idx[2]])) {
+              if ((o0 | o1 | o2) == 0 && !drawable(m, cv[0], cv[1], cv[2])) {
                 // Unclipped and off screen sideways, facing away or of zero
                 // area: no band draws it (draw_mesh would reject it in each
                 // of its bands, counting it culled there when on screen).
-                if (on_screen_x(r.cache_[idx[0]], r.cache_[idx[1]], r.cache_[idx[2]])) {
+                if (on_screen_x(cv[0], cv[1], cv[2])) {
                   r.stats_.culled += static_cast<uint32_t>(last - first) + 1;
                 }
                 first = 1;

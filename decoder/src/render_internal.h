@@ -48,6 +48,9 @@ enum : uint8_t {
   // Not a plane: the cached screen position is not valid (the vertex is in
   // front of the near plane only when this bit is clear).
   kNoProjection = 64,
+  // Not an outcode: a cached vertex not projected this frame (no triangle
+  // drawn names it).
+  kUnprojected = 128,
 };
 
 // Camera constants of a frame.
@@ -70,7 +73,7 @@ int clip_polygon(const FrameCamera& fc, uint8_t planes, const ClipVertex* in, in
 struct MaterialCtx {
   const Mesh* mesh;
   int num_attribs;  // 0 flat, 2 texture, 3 gouraud, 0 view_mapped, 2 mesh_colors
-  uint32_t tri;     // the triangle's index in the mesh (mesh_colors)
+  uint32_t tri;     // the triangle's index in the mesh (mesh_colors, Mesh::views)
 };
 
 // The band being drawn.

@@ -235,9 +235,9 @@ void lattice_values(int res_log2, int f, const ScreenVertex* v, int n, VertexVal
 // View-mapped: the rows of the homography (vds/homography.h), which works on
 // coordinates / 256: per pixel, 256 W = h20 x + h21 y + 256 h22 and 65536 S =
 // 256 (h00 x + h01 y) + 65536 h02, so that texel u = 65536 S / (256 W).
-void view_mapped_values(const Mesh& m, bool repeat, int f, const ScreenVertex* v, int n, VertexValues& vv) {
-  const Texture& t = *m.texture;
-  const int32_t(&h)[3][3] = m.view_map.m;
+void view_mapped_values(const Texture& t, const Homography& map, bool repeat, int f, const ScreenVertex* v, int n,
+                        VertexValues& vv) {
+  const int32_t(&h)[3][3] = map.m;
   const ScreenVertex& a = v[0];
   int64_t* wrow = vv.wrow;
   wrow[0] = h[2][0];
@@ -414,6 +414,14 @@ bool fast_safe(const PolygonTarget& t, const PolySetup& s, int32_t xmin, int32_t
   return true;
 }
 
+// Whether a view a ViewMapSource gives has the form of the mesh's texture,
+// which render() validated and the span function was chosen for.
+bool same_form(const Texture& a, const Texture& b) {
+  return a.format == b.format && a.address == b.address && a.apron == b.apron && a.width == b.width &&
+         a.height == b.height && a.stride == b.stride && a.chroma_stride == b.chroma_stride &&
+         a.texels != nullptr && (a.format != TexFormat::ycbcr420 || (a.cb != nullptr && a.cr != nullptr));
+}
+
 }  // namespace
 
 void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const ScreenVertex* v, int n, PreparedPolygon* pp) {
@@ -472,15 +480,22 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
     s.nn = 2;
     lattice_values(s.lat.face.res_log2, m.filter == Filter::nearest ? 0 : kLatticeFracBits, v, n, vv);
   } else {
-    repeat = texture_repeats(*m.texture);
-    s.tex = make_tex_ctx(*m.texture, repeat);
+    const Texture* tex = m.texture;
+    const Homography* map = &m.view_map;
+    Homography asked;
+    if (m.shading == Shading::view_mapped && m.views != nullptr) {
+      map = &asked;
+      if (!m.views->map(m.views->ctx, mat.tri, &tex, &asked) || !same_form(*tex, *m.texture)) return;
+    }
+    repeat = texture_repeats(*tex);
+    s.tex = make_tex_ctx(*tex, repeat);
     s.nn = 2;
     const int f = fraction_bits(m, target.format);
     if (m.shading == Shading::texture) {
-      texture_values(*m.texture, repeat, f, v, n, vv);
+      texture_values(*tex, repeat, f, v, n, vv);
     } else {  // view_mapped
       s.proj = true;
-      view_mapped_values(m, repeat, f, v, n, vv);
+      view_mapped_values(*tex, *map, repeat, f, v, n, vv);
     }
   }
   if (s.nn)

@@ -60,6 +60,8 @@ Status WalkGeometry::init(Arena& arena, uint32_t slots, int32_t quantum_raw) {
   int32_t(*ring)[3] = static_cast<int32_t(*)[3]>(arena.alloc(kWalkVertexRing * 3 * sizeof(int32_t), alignof(int32_t)));
   if (!positions_ || !filled_ || !mark_ || !hot_ || !next_hot_ || !ring) return Status::workspace_too_small;
   for (uint32_t s = 0; s < slots; ++s) filled_[s] = 0, mark_[s] = 0;
+  // Drawn from directly (positions()), empty slots included.
+  for (size_t i = 0; i < 3 * static_cast<size_t>(slots); ++i) positions_[i] = Vec3<Q16_16>{};
   slots_ = slots;
   quantum_ = quantum_raw;
   fraction_bits_ = walk_fraction_bits(quantum_raw);

@@ -667,6 +667,108 @@ TEST(RenderApi, ApronAndPlainTexturesGiveTheSameFrame) {
   }
 }
 
+// A mesh whose triangles ask a ViewMapSource for their view and
+// homography draws what one mesh per triangle with its own texture and
+// view_map draws, whatever the caches; a triangle the source refuses, or
+// given a view of another form than the mesh's texture, is not drawn.
+TEST(RenderApi, AViewPerTriangleFromASourceDrawsWhatAMeshPerTriangleDraws) {
+  const ClientScene cs(view_mapped_cube(), TexFormat::rgb565);
+  const DrawList& base = cs.list();
+  // Every view-mapped triangle, one mesh each, and their indices as one mesh.
+  struct Tri {
+    const Mesh* from;
+    uint32_t t;
+  };
+  std::vector<Tri> tris;
+  std::vector<uint16_t> idx;
+  for (uint32_t mi = 0; mi < base.num_meshes; ++mi) {
+    const Mesh& m = base.meshes[mi];
+    if (m.shading != Shading::view_mapped) continue;
+    for (uint32_t t = 0; t < m.num_triangles; ++t) {
+      tris.push_back({&m, t});
+      idx.insert(idx.end(), m.indices + 3 * t, m.indices + 3 * t + 3);
+    }
+  }
+  ASSERT_GE(tris.size(), 8u);
+  const Texture* form = tris[0].from->texture;
+  Texture other_form = *form;
+  other_form.stride += 2;  // the same texels, another stride: not the mesh's form
+  struct Source {
+    const std::vector<Tri>* tris;
+    const Texture* other_form;
+    int refuse = 0;  // 1: odd triangles refused; 2: odd triangles given a view of another form
+    static bool map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
+      const Source& s = *static_cast<const Source*>(ctx);
+      if (s.refuse == 1 && t % 2 == 1) return false;
+      const Mesh& m = *(*s.tris)[t].from;
+      *tex = s.refuse == 2 && t % 2 == 1 ? s.other_form : m.texture;
+      *out = m.view_map;
+      return true;
+    }
+  };
+  Status status = Status::ok;  // of the last render
+  const auto render = [&](const std::vector<Mesh>& meshes, uint32_t vertex_cache, uint32_t triangle_cache) {
+    RenderConfig cfg;
+    cfg.width = 240;
+    cfg.height = 180;
+    cfg.band_height = 16;
+    cfg.format = PixelFormat::rgb565;
+    cfg.vertex_cache = vertex_cache;
+    cfg.triangle_cache = triangle_cache;
+    cfg.setup_cache = 4;
+    std::vector<uint8_t> ws(render_workspace_size(cfg));
+    Arena arena(ws.data(), ws.size());
+    Renderer r;
+    EXPECT_EQ(r.init(cfg, arena), Status::ok);
+    std::vector<uint8_t> out;
+    const DrawList list{base.positions, base.num_positions, meshes.data(), static_cast<uint32_t>(meshes.size())};
+    const auto put = [](void* ctx, const Band& b) {
+      auto* o = static_cast<std::vector<uint8_t>*>(ctx);
+      for (int y = 0; y < b.height; ++y) o->insert(o->end(), b.pixels + y * b.stride, b.pixels + y * b.stride + b.width * 2);
+      return true;
+    };
+    status = r.render(cs.camera(), list, 0x203040, put, &out);
+    return out;
+  };
+  // One mesh per triangle, the odd ones drawn or left empty.
+  const auto per_triangle = [&](bool odd_too) {
+    std::vector<Mesh> meshes;
+    for (size_t i = 0; i < tris.size(); ++i) {
+      Mesh m = *tris[i].from;
+      m.indices = &idx[3 * i];
+      m.num_triangles = odd_too || i % 2 == 0 ? 1 : 0;
+      meshes.push_back(m);
+    }
+    return meshes;
+  };
+  Source src{&tris, &other_form};
+  const ViewMapSource source{&Source::map, &src};
+  Mesh one = *tris[0].from;
+  one.indices = idx.data();
+  one.num_triangles = static_cast<uint32_t>(tris.size());
+  one.views = &source;
+  // Vertex caches of every position, of a few (the rest projected where
+  // needed) and of none; triangle caches of all, some and none.
+  const std::vector<uint8_t> all = render(per_triangle(true), 65536, 65536);
+  const std::vector<uint8_t> even = render(per_triangle(false), 65536, 65536);
+  ASSERT_EQ(status, Status::ok);
+  ASSERT_NE(all, even) << "the odd triangles show";
+  for (const auto& [vc, tc] : {std::pair{65536u, 65536u}, std::pair{5u, 65536u}, std::pair{5u, 3u}, std::pair{0u, 0u}}) {
+    src.refuse = 0;
+    EXPECT_EQ(render({one}, vc, tc), all) << "vertex cache " << vc << ", triangle cache " << tc;
+    EXPECT_EQ(status, Status::ok);
+    src.refuse = 1;
+    EXPECT_EQ(render({one}, vc, tc), even) << "vertex cache " << vc << ", triangle cache " << tc;
+    src.refuse = 2;
+    EXPECT_EQ(render({one}, vc, tc), even) << "vertex cache " << vc << ", triangle cache " << tc;
+  }
+  // A source without its function is refused.
+  const ViewMapSource none{};
+  one.views = &none;
+  render({one}, 0, 0);
+  EXPECT_EQ(status, Status::malformed);
+}
+
 // Grid positions ((g << grid_shift) + grid_origin) draw exactly what the
 // same positions as Q16.16 vectors draw, with and without the vertex cache.
 TEST(RenderApi, GridPositionsDrawWhatTheirWorldPositionsDraw) {

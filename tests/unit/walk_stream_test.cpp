@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <functional>
 #include <numeric>
+#include <stdexcept>
 #include <vector>
 
 #include "vds/enc/frames.h"
@@ -55,6 +56,47 @@ TEST(WalkStream, ARoomPlaysEndToEndWithinItsRate) {
   EXPECT_EQ(vds::enc::client_frame_crcs(r.stream), r.frame_crc);
   std::printf("room, 60 frames: %.2f kbit/s, pre-roll %u ms, %zu view updates (%zu zoomed) at quality %d, PSNR %.2f dB\n", r.kbps,
               r.preroll_ms, r.view_updates, r.view_zoomed, r.quality, r.psnr_rgb);
+}
+
+// The client draws the same frames in the least workspace that plays the
+// stream (its triangles projected and their homographies computed again
+// in each band that needs them) as in any larger one, where a cache of
+// projected vertices, then of homographies, takes what is spare.
+TEST(WalkStream, TheClientShowsTheSameFramesInTheLeastWorkspaceAsInAnyLarger) {
+  const vds::enc::Scene room = vds::test::walk_room();
+  const vds::enc::CameraPath path = vds::test::walk_room_path(40);
+  vds::enc::WalkEncodeOptions o;
+  o.rate_kbps = 24;
+  const auto r = vds::enc::encode_walk(room, path, o);
+  ASSERT_GT(r.slots, 20u);
+  const auto crcs = [&](size_t budget) {
+    const vds::enc::ClientArena a{budget, 0};
+    return vds::enc::client_frame_crcs(r.stream, nullptr, &a);
+  };
+  const auto plays = [&](size_t budget) {
+    try {
+      crcs(budget);
+      return true;
+    } catch (const std::runtime_error&) {
+      return false;
+    }
+  };
+  // The least workspace that plays it (the chunk buffer and HEAD's
+  // declaration: what the client needs, no cache).
+  size_t lo = 1, hi = size_t{1} << 22;
+  ASSERT_FALSE(plays(lo));
+  ASSERT_TRUE(plays(hi));
+  while (hi - lo > 1) {
+    const size_t mid = lo + (hi - lo) / 2;
+    (plays(mid) ? hi : lo) = mid;
+  }
+  EXPECT_EQ(hi, vds::kClientPlayerConfig.max_chunk_bytes + r.workspace_bytes);
+  // Some vertices cached; all and some homographies; all of both.
+  const size_t vertex = 13, map = sizeof(vds::Homography) + 1;
+  for (size_t more : {size_t{0}, 100 * vertex, 3 * r.slots * vertex + r.slots / 2 * map,
+                      3 * r.slots * vertex + r.slots * map + 4096, size_t{1} << 22}) {
+    EXPECT_EQ(crcs(hi + more), r.frame_crc) << "workspace " << hi << " + " << more;
+  }
 }
 
 TEST(WalkStream, RefinementsAddToTheViewsTheClientHolds) {

@@ -106,7 +106,7 @@ enum class Shading : uint8_t {
   flat = 0,         // Mesh::color
   gouraud = 1,      // Mesh::colors per vertex
   texture = 2,      // Mesh::texture at Mesh::uvs per vertex
-  view_mapped = 3,  // Mesh::texture (a stored view) at Mesh::view_map(pixel)
+  view_mapped = 3,  // Mesh::texture (a stored view) at Mesh::view_map(pixel), or Mesh::views per triangle
   mesh_colors = 4,  // Mesh::surface: samples on each face's lattice (nearest or linear)
 };
 
@@ -162,6 +162,18 @@ struct LatticeFace {
   uint8_t res_log2;  // 0..10
 };
 
+// Shading::view_mapped with a view per triangle: triangle t of the mesh
+// (its index in Mesh::indices / 3) is drawn from *tex at homography *out,
+// asked once per polygon set-up, so a caller holding many triangles keeps
+// no homography per triangle (it may keep some: the answer must be the
+// same each time it is asked in a frame). false leaves the triangle
+// undrawn. Every texture it gives has Mesh::texture's format, address
+// mode, apron, size and strides (a texture that differs is not drawn).
+struct ViewMapSource {
+  bool (*map)(void* ctx, uint32_t t, const Texture** tex, Homography* out) = nullptr;
+  void* ctx = nullptr;
+};
+
 struct MeshColorsSurface {
   const uint8_t* y = nullptr;  // Y', Cb, Cr planes (JFIF full range), `samples` each
   const uint8_t* cb = nullptr;
@@ -186,6 +198,7 @@ struct Mesh {
   const TexCoord* uvs = nullptr;       // texture: per vertex
   const Texture* texture = nullptr;    // texture, view_mapped
   Homography view_map{};               // view_mapped: screen pixel -> texel (plane_homography(screen, view))
+  const ViewMapSource* views = nullptr;  // view_mapped: instead of texture and view_map per triangle (texture: their form)
   const MeshColorsSurface* surface = nullptr;  // mesh_colors
 };
 

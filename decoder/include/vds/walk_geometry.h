@@ -161,6 +161,9 @@ class WalkGeometry {
   const Vec3<Q16_16>* triangle(uint32_t slot) const {
     return slot < slots_ && filled_[slot] ? &positions_[3 * static_cast<size_t>(slot)] : nullptr;
   }
+  // Every slot's three positions (3 slots() entries; an empty slot's are
+  // stale): a draw list's positions, a triangle's vertices 3 slot + k.
+  const Vec3<Q16_16>* positions() const { return positions_; }
   uint32_t frames() const { return frames_; }
 
  private:

@@ -23,6 +23,7 @@ namespace vds {
 struct WalkPlay {
   WalkParams params;
   Renderer renderer;
+  const WalkGeometry* geometry = nullptr;
   Camera view_cam[kWalkMaxViews];
   bool view_ready[kWalkMaxViews];
   Texture view_tex[kWalkMaxViews];
@@ -32,12 +33,22 @@ struct WalkPlay {
   bool pending_refines = false;  // the WVUP names the slot's own camera: its image may be a residual
   bool pending_predicted = false;  // the slot holds the view's prediction: its image may be a residual
   bool image_open = false;
-  Mesh* meshes = nullptr;
-  Vec3<Q16_16>* positions = nullptr;
-  uint16_t* indices = nullptr;
+  // The frame's draw list: one mesh of the triangles drawn, each from the
+  // view and homography frame_map() gives it at its set-up.
+  uint16_t* indices = nullptr;  // 3 a triangle drawn: slot s's vertices are 3 s + k
   uint8_t* view_of = nullptr;
   uint16_t* hot_stamp = nullptr;     // per slot: walk_frame_stamp of the frame it was last hot in
   bool fresh[kWalkMaxViews] = {};    // a view update since the last frame
+  // What the screen's and each view's cameras alone give (vds/homography.h),
+  // computed once a frame when a triangle first asks for that view.
+  HomographyCameras pair[kWalkMaxViews];
+  uint8_t pair_state[kWalkMaxViews] = {};  // kUnknown, kMade or kFailed this frame
+  // The homographies of slots [0, kept) as the frame first asks for them
+  // (the spare workspace's: a triangle set up in several bands then costs
+  // one); map_state as pair_state.
+  Homography* maps = nullptr;
+  uint8_t* map_state = nullptr;
+  uint32_t kept = 0;
 };
 
 namespace {
@@ -69,10 +80,35 @@ Texture with_border(const Texture& t) {
 // (docs/walkthrough.md); the frames are the same with any cache.
 constexpr uint32_t kWalkSetupCache = 32;
 
-RenderConfig render_config(const StreamHeader& h, const WalkParams& w, const PlayerConfig& c) {
-  RenderConfig rc = detail::band_render_config(h, c, 3u * w.slots, w.slots);
+RenderConfig render_config(const StreamHeader& h, const WalkParams& w, const PlayerConfig& c, uint32_t vertex_cache) {
+  RenderConfig rc = detail::band_render_config(h, c, vertex_cache, w.slots);
   rc.setup_cache = kWalkSetupCache;
   return rc;
+}
+
+constexpr uint8_t kUnknown = 0, kMade = 1, kFailed = 2;
+
+// What a workspace larger than the walkthrough needs buys, in this order
+// (each makes the frames cheaper, never different): the renderer's cache of
+// projected vertices, then the homographies kept a frame
+// (docs/walkthrough.md, "The client on the Cortex-M4 board").
+struct WalkSpare {
+  uint32_t vertices = 0;  // the renderer's vertex cache
+  uint32_t maps = 0;      // slots whose homographies are kept
+};
+constexpr size_t kVertexBytes = sizeof(detail::CachedVertex) + 1;
+constexpr size_t kMapBytes = sizeof(Homography) + 1;
+constexpr size_t kSpareSlack = 32;  // the alignment of the arrays these add
+
+WalkSpare spare_caches(const WalkParams& w, size_t spare) {
+  WalkSpare out;
+  spare = spare > kSpareSlack ? spare - kSpareSlack : 0;
+  const size_t verts = spare / kVertexBytes;
+  out.vertices = static_cast<uint32_t>(verts < 3u * w.slots ? verts : 3u * w.slots);
+  spare -= out.vertices * kVertexBytes;
+  const size_t maps = spare / kMapBytes;
+  out.maps = static_cast<uint32_t>(maps < w.slots ? maps : w.slots);
+  return out;
 }
 
 bool cameras_equal(const Camera& a, const Camera& b) {
@@ -107,21 +143,20 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
     p.fail(Status::workspace_too_small, "the walkthrough's slots and views do not fit the workspace");
     return false;
   }
+  const WalkSpare spare = spare_caches(w, p.arena().remaining() - need);
   WalkPlay* wp = static_cast<WalkPlay*>(p.arena().alloc(sizeof(WalkPlay), alignof(WalkPlay)));
   if (wp == nullptr) return false;
   *wp = WalkPlay{};
   wp->params = w;
+  wp->geometry = &p.walk_geometry;
   if (w.rate_bytes != 0 && h.frame_period_us != 0) p.set_schedule(w.preroll_ms);
   Status s = p.walk_geometry.init(p.arena(), w.slots, w.quantum_raw);
   if (s == Status::ok) s = p.image.init(p.arena());
-  if (s == Status::ok) s = wp->renderer.init(render_config(h, w, p.config()), p.arena());
-  wp->meshes = p.arena().alloc_array<Mesh>(w.slots);
-  wp->positions = p.arena().alloc_array<Vec3<Q16_16>>(3u * w.slots);
+  if (s == Status::ok) s = wp->renderer.init(render_config(h, w, p.config(), spare.vertices), p.arena());
   wp->indices = p.arena().alloc_array<uint16_t>(3u * w.slots);
   wp->view_of = p.arena().alloc_array<uint8_t>(w.slots);
   wp->hot_stamp = p.arena().alloc_array<uint16_t>(w.slots);
-  if (s == Status::ok && (!wp->meshes || !wp->positions || !wp->indices || !wp->view_of || !wp->hot_stamp))
-    s = Status::workspace_too_small;
+  if (s == Status::ok && (!wp->indices || !wp->view_of || !wp->hot_stamp)) s = Status::workspace_too_small;
   for (uint8_t v = 0; v < w.views && s == Status::ok; ++v) {
     uint8_t* planes = static_cast<uint8_t*>(p.arena().alloc(plane_bytes(w), 4));
     if (planes == nullptr) {
@@ -145,36 +180,72 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
     wp->view_ready[v] = false;
     wp->bordered[v] = with_border(t);
   }
+  if (s == Status::ok && spare.maps != 0) {
+    wp->maps = p.arena().alloc_array<Homography>(spare.maps);
+    wp->map_state = p.arena().alloc_array<uint8_t>(spare.maps);
+    wp->kept = wp->maps != nullptr && wp->map_state != nullptr ? spare.maps : 0;  // else none kept: the same frames
+  }
   if (s != Status::ok) {
     p.fail(s, "the walkthrough could not be set up");
     return false;
   }
-  for (uint32_t i = 0; i < 3u * w.slots; ++i) wp->indices[i] = static_cast<uint16_t>(i);
   for (uint32_t i = 0; i < w.slots; ++i) wp->view_of[i] = 0, wp->hot_stamp[i] = 0;
   p.walk_frames.reset();
   p.walk = wp;
   return true;
 }
 
-// Triangle i of a draw list: its positions, and a mesh mapping it from a view.
-Mesh& put_triangle(WalkPlay& w, uint32_t i, const Vec3<Q16_16>* tri) {
-  for (int k = 0; k < 3; ++k) w.positions[3 * i + static_cast<uint32_t>(k)] = tri[k];
-  Mesh& m = w.meshes[i];
-  m = Mesh{};
-  m.indices = &w.indices[3 * i];
+// The draw list of `n` triangles whose indices are in w.indices, drawn
+// from the slots' own positions, each from the view `map` gives it.
+Mesh one_mesh(const WalkPlay& w, uint32_t n, const Texture* form, const ViewMapSource* map) {
+  Mesh m;
+  m.indices = w.indices;
+  m.num_triangles = n;
   m.shading = Shading::view_mapped;
   m.filter = Filter::bilinear_luma;  // chroma nearest: a fifth fewer instructions a pixel, 0.03 dB (docs/walkthrough.md)
   m.cull = Cull::none;
+  m.texture = form;  // every view's planes have the same form
+  m.views = map;
   return m;
 }
 
-DrawList draw_list(const WalkPlay& w, uint32_t n) {
+DrawList draw_list(const WalkPlay& w, const Mesh* mesh) {
   DrawList list;
-  list.positions = w.positions;
-  list.num_positions = 3 * n;
-  list.meshes = w.meshes;
-  list.num_meshes = n;
+  list.positions = w.geometry->positions();
+  list.num_positions = 3 * w.params.slots;
+  list.meshes = mesh;
+  list.num_meshes = 1;
   return list;
+}
+
+void put_indices(WalkPlay& w, uint32_t i, uint32_t slot) {
+  for (uint32_t k = 0; k < 3; ++k) w.indices[3 * i + k] = static_cast<uint16_t>(3 * slot + k);
+}
+
+struct FrameCtx {
+  WalkPlay* w;
+  const Camera* cam;
+};
+
+// Triangle t of the frame: from the view the stream chose for its slot,
+// at the homography of its plane between the screen and that view.
+bool frame_map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
+  const FrameCtx& f = *static_cast<const FrameCtx*>(ctx);
+  WalkPlay& w = *f.w;
+  const uint32_t slot = w.indices[3 * t] / 3u;
+  const uint8_t v = w.view_of[slot];
+  if (v >= kWalkMaxViews || !w.view_ready[v]) return false;
+  if (w.pair_state[v] == kUnknown)
+    w.pair_state[v] = homography_cameras(*f.cam, w.view_cam[v], &w.pair[v]) == Status::ok ? kMade : kFailed;
+  if (w.pair_state[v] == kFailed) return false;
+  *tex = &w.view_tex[v];
+  if (slot < w.kept) {
+    if (w.map_state[slot] == kUnknown)
+      w.map_state[slot] = plane_homography(w.pair[v], w.geometry->triangle(slot), &w.maps[slot]) == Status::ok ? kMade : kFailed;
+    *out = w.maps[slot];
+    return w.map_state[slot] == kMade;
+  }
+  return plane_homography(w.pair[v], w.geometry->triangle(slot), out) == Status::ok;
 }
 
 Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
@@ -182,30 +253,13 @@ Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
   if (walk_camera(p.header(), pose, &cam) != Status::ok) return Status::malformed;
   const uint16_t* hot = p.walk_geometry.hot();
   const uint32_t n = p.walk_geometry.hot_count();
-  for (uint32_t i = 0; i < n; ++i) {
-    Mesh& m = put_triangle(w, i, p.walk_geometry.triangle(hot[i]));
-    m.texture = &w.view_tex[w.view_of[hot[i]]];
-    m.num_triangles = 0;
-  }
-  // Each view's triangles, with what the screen's and the view's cameras
-  // alone give computed once (the same homographies; a triangle then
-  // costs a rank-one update of a matrix, vds/homography.h).
-  for (uint8_t v = 0; v < kWalkMaxViews; ++v) {
-    if (!w.view_ready[v]) continue;
-    HomographyCameras pair;
-    Status ps = Status::invalid_argument;
-    bool pair_made = false;
-    for (uint32_t i = 0; i < n; ++i) {
-      if (w.view_of[hot[i]] != v) continue;
-      if (!pair_made) {
-        ps = homography_cameras(cam, w.view_cam[v], &pair);
-        pair_made = true;
-      }
-      Mesh& m = w.meshes[i];
-      m.num_triangles = ps == Status::ok && plane_homography(pair, p.walk_geometry.triangle(hot[i]), &m.view_map) == Status::ok ? 1 : 0;
-    }
-  }
-  return w.renderer.render(cam, draw_list(w, n), 0, detail::render_band_to_player, &p);
+  for (uint32_t i = 0; i < n; ++i) put_indices(w, i, hot[i]);
+  for (uint8_t& st : w.pair_state) st = kUnknown;
+  for (uint32_t i = 0; i < w.kept; ++i) w.map_state[i] = kUnknown;
+  FrameCtx ctx{&w, &cam};
+  const ViewMapSource source{frame_map, &ctx};
+  const Mesh mesh = one_mesh(w, n, &w.view_tex[0], &source);
+  return w.renderer.render(cam, draw_list(w, &mesh), 0, detail::render_band_to_player, &p);
 }
 
 // A view's prediction: the band's RGB565 rows into the slot's Y'CbCr
@@ -265,6 +319,31 @@ bool in_front(const Camera& v, const Vec3<Q16_16>* tri) {
   return true;
 }
 
+struct PredictCtx {
+  WalkPlay* w;
+  int slot;  // the view slot being predicted
+};
+
+// Triangle t of a prediction: from its own view when it lies in front of
+// it, else from the first other view it lies in front of (never the slot
+// being predicted), through the view's border.
+bool predict_map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
+  const PredictCtx& c = *static_cast<const PredictCtx*>(ctx);
+  const WalkPlay& w = *c.w;
+  const uint32_t slot_i = w.indices[3 * t] / 3u;
+  const Vec3<Q16_16>* tri = w.geometry->triangle(slot_i);
+  const uint8_t own = w.view_of[slot_i];
+  int v = own != c.slot && own < w.params.views && w.view_ready[own] && in_front(w.view_cam[own], tri) ? own : -1;
+  for (int u = 0; u < w.params.views && v < 0; ++u)
+    if (u != c.slot && w.view_ready[u] && in_front(w.view_cam[u], tri)) v = u;
+  if (v < 0) return false;
+  *tex = &w.bordered[v];
+  Camera from = w.view_cam[v];
+  from.cx = Q16_16::from_raw(from.cx.raw() + static_cast<int32_t>(kBorder << 16));
+  from.cy = Q16_16::from_raw(from.cy.raw() + static_cast<int32_t>(kBorder << 16));
+  return plane_homography(w.pending_cam, from, tri, out) == Status::ok;
+}
+
 // Before a view update's image: every triangle the client holds drawn at
 // the new view's camera from a view it lies in front of — its own view
 // first, then the others in order, never the slot being replaced — into
@@ -278,23 +357,14 @@ Status predict_view(Player& p, WalkPlay& w, int slot, bool* predicted) {
     if (v != slot && w.view_ready[v]) other = v;
   if (other < 0) return Status::ok;
   uint32_t n = 0;
-  for (uint32_t slot_i = 0; slot_i < w.params.slots; ++slot_i) {
-    const Vec3<Q16_16>* tri = p.walk_geometry.triangle(slot_i);
-    if (tri == nullptr) continue;
-    Mesh& m = put_triangle(w, n++, tri);
-    const uint8_t own = w.view_of[slot_i];
-    int v = own != slot && own < w.params.views && w.view_ready[own] && in_front(w.view_cam[own], tri) ? own : -1;
-    for (int u = 0; u < w.params.views && v < 0; ++u)
-      if (u != slot && w.view_ready[u] && in_front(w.view_cam[u], tri)) v = u;
-    m.texture = &w.bordered[v >= 0 ? v : other];
-    Camera from = w.view_cam[v >= 0 ? v : other];
-    from.cx = Q16_16::from_raw(from.cx.raw() + static_cast<int32_t>(kBorder << 16));
-    from.cy = Q16_16::from_raw(from.cy.raw() + static_cast<int32_t>(kBorder << 16));
-    m.num_triangles = v >= 0 && plane_homography(w.pending_cam, from, tri, &m.view_map) == Status::ok ? 1 : 0;
-  }
+  for (uint32_t slot_i = 0; slot_i < w.params.slots; ++slot_i)
+    if (p.walk_geometry.triangle(slot_i) != nullptr) put_indices(w, n++, slot_i);
+  PredictCtx ctx{&w, slot};
+  const ViewMapSource source{predict_map, &ctx};
+  const Mesh mesh = one_mesh(w, n, &w.bordered[other], &source);
   PredictTarget target{&w.view_tex[slot]};
   constexpr uint32_t kGrey = 0x808080;
-  const Status s = w.renderer.render(w.pending_cam, draw_list(w, n), kGrey, predict_band, &target);
+  const Status s = w.renderer.render(w.pending_cam, draw_list(w, &mesh), kGrey, predict_band, &target);
   *predicted = s == Status::ok;
   return s;
 }
@@ -429,12 +499,12 @@ const Texture* Player::walk_view(uint8_t slot) const {
 bool Player::walk_view_predicted() const { return walk != nullptr && walk->pending >= 0 && walk->pending_predicted; }
 
 size_t Player::walk_workspace_bytes(const StreamHeader& h, const WalkParams& w, const PlayerConfig& c) {
-  const RenderConfig rc = render_config(h, w, c);
-  // Each allocation of setup() with its worst alignment slack.
+  const RenderConfig rc = render_config(h, w, c, 0);
+  // Each allocation of setup() with its worst alignment slack; the caches
+  // a larger workspace adds (spare_caches) are not needed.
   return sizeof(WalkPlay) + alignof(WalkPlay) + WalkGeometry::workspace_bytes(w.slots) + ImageDecoder::kWorkspaceBytes +
-         render_workspace_size(rc) + w.slots * sizeof(Mesh) + alignof(Mesh) + 3u * w.slots * sizeof(Vec3<Q16_16>) +
-         alignof(Vec3<Q16_16>) + 3u * w.slots * sizeof(uint16_t) + alignof(uint16_t) + w.slots + w.slots * sizeof(uint16_t) +
-         alignof(uint16_t) + w.views * (plane_bytes(w) + 4);
+         render_workspace_size(rc) + 3u * w.slots * sizeof(uint16_t) + alignof(uint16_t) + w.slots +
+         w.slots * sizeof(uint16_t) + alignof(uint16_t) + w.views * (plane_bytes(w) + 4);
 }
 
 namespace detail {
