@@ -251,11 +251,20 @@ struct RenderFrame {
     return oc;
   }
 
-  // Projects every vertex below the cache's size that a triangle names
-  // (a draw list may hold positions no mesh draws this frame).
+  // Projects the vertices below the cache's size: every one when the
+  // meshes name at least as many vertices as that (a mesh's vertices are
+  // shared by its triangles), else only those a triangle names (a draw list
+  // may hold many positions no mesh draws this frame).
   void fill_cache() {
     const uint32_t n = list.num_positions < r.cfg_.vertex_cache ? list.num_positions : r.cfg_.vertex_cache;
     uint8_t* const oc = r.cache_outcode_;
+    cached = n;
+    uint64_t named = 0;
+    for (uint32_t mi = 0; mi < list.num_meshes; ++mi) named += 3 * uint64_t{list.meshes[mi].num_triangles};
+    if (named >= n) {
+      for (uint32_t i = 0; i < n; ++i) oc[i] = project(i, &r.cache_[i]);
+      return;
+    }
     for (uint32_t i = 0; i < n; ++i) oc[i] = kUnprojected;
     for (uint32_t mi = 0; mi < list.num_meshes; ++mi) {
       const Mesh& m = list.meshes[mi];
@@ -265,7 +274,6 @@ struct RenderFrame {
         if (i < n && oc[i] == kUnprojected) oc[i] = project(i, &r.cache_[i]);
       }
     }
-    cached = n;
   }
 
   // The band range of every triangle the triangle cache holds, from the same

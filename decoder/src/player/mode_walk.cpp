@@ -35,7 +35,9 @@ struct WalkPlay {
   bool image_open = false;
   // The frame's draw list: one mesh of the triangles drawn, each from the
   // view and homography frame_map() gives it at its set-up.
-  uint16_t* indices = nullptr;  // 3 a triangle drawn: slot s's vertices are 3 s + k
+  // 3 a triangle drawn: slot s's vertices are 3 s + k. Before that, the
+  // frame's sort keys (put_key: 4 bytes a hot triangle, 4-byte aligned).
+  uint16_t* indices = nullptr;
   uint8_t* view_of = nullptr;
   uint16_t* hot_stamp = nullptr;     // per slot: walk_frame_stamp of the frame it was last hot in
   bool fresh[kWalkMaxViews] = {};    // a view update since the last frame
@@ -153,7 +155,7 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   Status s = p.walk_geometry.init(p.arena(), w.slots, w.quantum_raw);
   if (s == Status::ok) s = p.image.init(p.arena());
   if (s == Status::ok) s = wp->renderer.init(render_config(h, w, p.config(), spare.vertices), p.arena());
-  wp->indices = p.arena().alloc_array<uint16_t>(3u * w.slots);
+  wp->indices = static_cast<uint16_t*>(p.arena().alloc(3u * w.slots * sizeof(uint16_t), 4));
   wp->view_of = p.arena().alloc_array<uint8_t>(w.slots);
   wp->hot_stamp = p.arena().alloc_array<uint16_t>(w.slots);
   if (s == Status::ok && (!wp->indices || !wp->view_of || !wp->hot_stamp)) s = Status::workspace_too_small;
@@ -222,6 +224,65 @@ void put_indices(WalkPlay& w, uint32_t i, uint32_t slot) {
   for (uint32_t k = 0; k < 3; ++k) w.indices[3 * i + k] = static_cast<uint16_t>(3 * slot + k);
 }
 
+// Sort key i of a frame, in the front of w.indices (whose 6 bytes a
+// triangle hold 4 bytes of key).
+uint32_t key_at(const WalkPlay& w, uint32_t i) {
+  uint32_t k;
+  __builtin_memcpy(&k, reinterpret_cast<const uint8_t*>(w.indices) + 4 * size_t{i}, 4);
+  return k;
+}
+void put_key(WalkPlay& w, uint32_t i, uint32_t k) { __builtin_memcpy(reinterpret_cast<uint8_t*>(w.indices) + 4 * size_t{i}, &k, 4); }
+
+// A triangle's key: its centroid's squared distance from `c` as a number
+// with 6 bits of exponent and 12 of mantissa (ordered as the distance),
+// then its slot (14 bits: kWalkMaxSlots).
+static_assert(kWalkMaxSlots <= (1u << 14), "a slot fits a key's low 14 bits");
+uint32_t distance_key(const Vec3<Q16_16>* t, const Vec3<Q16_16>& c, uint32_t slot) {
+  // Quarter units: a map of +-2^13 units keeps every sum below 2^40.
+  const auto d = [](Q16_16 a, Q16_16 b, Q16_16 e, Q16_16 o) {
+    return ((int64_t{a.raw()} + b.raw() + e.raw()) >> 14) - 3 * int64_t{o.raw() >> 14};
+  };
+  const int64_t dx = d(t[0].x, t[1].x, t[2].x, c.x), dy = d(t[0].y, t[1].y, t[2].y, c.y), dz = d(t[0].z, t[1].z, t[2].z, c.z);
+  uint64_t d2 = static_cast<uint64_t>(dx * dx) + static_cast<uint64_t>(dy * dy) + static_cast<uint64_t>(dz * dz);
+  uint32_t e = 0;
+  if (d2 >= (uint64_t{1} << 18)) {
+    e = static_cast<uint32_t>(64 - clz64(d2) - 18);
+    d2 >>= e;
+  }
+  return (e << 26) | (static_cast<uint32_t>(d2 >> 6) << 14) | slot;
+}
+
+// The frame's hot triangles into w.indices, nearest first: the depth test
+// then turns away most of what lies behind, which costs a fraction of a
+// drawn pixel (docs/walkthrough.md). A heap sort of their keys in place.
+void put_nearest_first(WalkPlay& w, const WalkGeometry& g, const Vec3<Q16_16>& camera) {
+  const uint16_t* hot = g.hot();
+  const uint32_t n = g.hot_count();
+  for (uint32_t i = 0; i < n; ++i) put_key(w, i, distance_key(g.triangle(hot[i]), camera, hot[i]));
+  const auto sift = [&w](uint32_t root, uint32_t end) {
+    const uint32_t v = key_at(w, root);
+    while (2 * root + 1 < end) {
+      uint32_t c = 2 * root + 1;
+      if (c + 1 < end && key_at(w, c + 1) > key_at(w, c)) ++c;
+      const uint32_t kc = key_at(w, c);
+      if (kc <= v) break;
+      put_key(w, root, kc);
+      root = c;
+    }
+    put_key(w, root, v);
+  };
+  for (uint32_t i = n / 2; i-- > 0;) sift(i, n);
+  for (uint32_t end = n; end > 1; --end) {
+    const uint32_t top = key_at(w, 0);
+    put_key(w, 0, key_at(w, end - 1));
+    put_key(w, end - 1, top);
+    sift(0, end - 1);
+  }
+  // Keys to indices from the last: triangle i's indices (bytes 6i..6i+5)
+  // never reach a key not yet read (bytes below 4i + 4).
+  for (uint32_t i = n; i-- > 0;) put_indices(w, i, key_at(w, i) & 0x3FFFu);
+}
+
 struct FrameCtx {
   WalkPlay* w;
   const Camera* cam;
@@ -251,9 +312,8 @@ bool frame_map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
 Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
   Camera cam;
   if (walk_camera(p.header(), pose, &cam) != Status::ok) return Status::malformed;
-  const uint16_t* hot = p.walk_geometry.hot();
   const uint32_t n = p.walk_geometry.hot_count();
-  for (uint32_t i = 0; i < n; ++i) put_indices(w, i, hot[i]);
+  put_nearest_first(w, p.walk_geometry, cam.position);
   for (uint8_t& st : w.pair_state) st = kUnknown;
   for (uint32_t i = 0; i < w.kept; ++i) w.map_state[i] = kUnknown;
   FrameCtx ctx{&w, &cam};
@@ -503,7 +563,7 @@ size_t Player::walk_workspace_bytes(const StreamHeader& h, const WalkParams& w, 
   // Each allocation of setup() with its worst alignment slack; the caches
   // a larger workspace adds (spare_caches) are not needed.
   return sizeof(WalkPlay) + alignof(WalkPlay) + WalkGeometry::workspace_bytes(w.slots) + ImageDecoder::kWorkspaceBytes +
-         render_workspace_size(rc) + 3u * w.slots * sizeof(uint16_t) + alignof(uint16_t) + w.slots +
+         render_workspace_size(rc) + 3u * w.slots * sizeof(uint16_t) + 4 + w.slots +
          w.slots * sizeof(uint16_t) + alignof(uint16_t) + w.views * (plane_bytes(w) + 4);
 }
 
