@@ -64,7 +64,16 @@ void normalise(BVec& a) {
   }
   if (mx == 0) return;
   const int s = bitlen64(mx) - kNormBits + 1;  // below 2^29: room for rounding
-  for (int64_t& x : a.v) x = shift_round(x, s);
+  if (mx < (uint64_t{1} << 31)) {
+    // Entries of 32 bits (a difference of two Q16.16 points): the same
+    // shifts in 32-bit arithmetic (s <= 2; every result below 2^29).
+    for (int64_t& x : a.v) {
+      const int32_t v = static_cast<int32_t>(x);
+      x = s <= 0 ? static_cast<int32_t>(static_cast<uint32_t>(v) << -s) : shr_round(v, s);
+    }
+  } else {
+    for (int64_t& x : a.v) x = shift_round(x, s);
+  }
   a.e += s;
 }
 
@@ -193,8 +202,10 @@ Status plane_homography(const HomographyCameras& cams, const Vec3<Q16_16> plane[
   // homography, so each edge is normalised on its own.
   const BVec e1 = vec_diff(plane[1], plane[0]);
   const BVec e2 = vec_diff(plane[2], plane[0]);
-  BVec n{{e1.v[1] * e2.v[2] - e1.v[2] * e2.v[1], e1.v[2] * e2.v[0] - e1.v[0] * e2.v[2],
-          e1.v[0] * e2.v[1] - e1.v[1] * e2.v[0]},
+  // Entries below 2^30 after normalise: 32 x 32-bit products.
+  const auto m = [](int64_t a, int64_t b) { return mul32x32_64(static_cast<int32_t>(a), static_cast<int32_t>(b)); };
+  BVec n{{m(e1.v[1], e2.v[2]) - m(e1.v[2], e2.v[1]), m(e1.v[2], e2.v[0]) - m(e1.v[0], e2.v[2]),
+          m(e1.v[0], e2.v[1]) - m(e1.v[1], e2.v[0])},
          0};
   normalise(n);
   if (n.v[0] == 0 && n.v[1] == 0 && n.v[2] == 0) return Status::invalid_argument;
@@ -203,7 +214,7 @@ Status plane_homography(const HomographyCameras& cams, const Vec3<Q16_16> plane[
   // (times |n|). Zero means the plane contains that centre. Kept below
   // 2^30 with its exponent.
   const BVec p = vec_diff(plane[0], cams.from_position);
-  int64_t delta = n.v[0] * p.v[0] + n.v[1] * p.v[1] + n.v[2] * p.v[2];  // < 3 * 2^58
+  int64_t delta = m(n.v[0], p.v[0]) + m(n.v[1], p.v[1]) + m(n.v[2], p.v[2]);  // < 3 * 2^58
   if (delta == 0) return Status::invalid_argument;
   int delta_e = n.e + p.e;
   const int ds = bitlen64(abs64(delta)) - kNormBits;

@@ -169,6 +169,30 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (s1 != s2) __builtin_trap();
   if (s1 == vds::Status::ok && a != b) __builtin_trap();
 
+  // View-mapped meshes asking a ViewMapSource for each triangle's view and
+  // homography (their own, as Mesh::views says) draw what they draw alone.
+  struct Own {
+    const vds::Mesh* mesh;
+    static bool map(void* ctx, uint32_t, const vds::Texture** t, vds::Homography* h) {
+      const vds::Mesh& m = *static_cast<const Own*>(ctx)->mesh;
+      *t = m.texture;
+      *h = m.view_map;
+      return true;
+    }
+  };
+  std::vector<Own> own(nm);
+  std::vector<vds::ViewMapSource> sources(nm);
+  std::vector<vds::Mesh> asking = meshes;
+  for (uint32_t m = 0; m < nm; ++m) {
+    own[m].mesh = &meshes[m];
+    sources[m] = {&Own::map, &own[m]};
+    if (asking[m].shading == vds::Shading::view_mapped) asking[m].views = &sources[m];
+  }
+  vds::Status s3;
+  const std::vector<uint8_t> c = render(banded, 1, cam, vds::DrawList{pos.data(), np, asking.data(), nm}, &s3);
+  if (s3 != s2) __builtin_trap();
+  if (s3 == vds::Status::ok && c != b) __builtin_trap();
+
   // Grid positions ((g << shift) + origin) against the Q16.16 positions
   // they stand for, saturated as the renderer saturates them: the same
   // status and frame; a shift above 15 is refused.
