@@ -79,22 +79,29 @@ Texture with_border(const Texture& t) {
 // A triangle crossing several bands is set up once while it stays in the
 // set-up cache instead of once a band: 32 entries (about 14 KB on the
 // Cortex-M4) take about 6 % off a frame of oa_dm4 and oa_dm5
-// (docs/walkthrough.md); the frames are the same with any cache.
+// (docs/walkthrough.md); the frames are the same with any cache. A
+// workspace with room to spare holds up to kWalkSetupCacheMost: on the
+// client firmware's, 48 took oa_dm5 furthest (64 and 128 leave fewer
+// projected vertices there; in 4 MiB they save 1 and 2 % more).
 constexpr uint32_t kWalkSetupCache = 32;
+constexpr uint32_t kWalkSetupCacheMost = 48;
 
-RenderConfig render_config(const StreamHeader& h, const WalkParams& w, const PlayerConfig& c, uint32_t vertex_cache) {
+RenderConfig render_config(const StreamHeader& h, const WalkParams& w, const PlayerConfig& c, uint32_t vertex_cache,
+                           uint32_t setup_cache = kWalkSetupCache) {
   RenderConfig rc = detail::band_render_config(h, c, vertex_cache, w.slots);
-  rc.setup_cache = kWalkSetupCache;
+  rc.setup_cache = setup_cache;
   return rc;
 }
 
 constexpr uint8_t kUnknown = 0, kMade = 1, kFailed = 2;
 
 // What a workspace larger than the walkthrough needs buys, in this order
-// (each makes the frames cheaper, never different): the renderer's cache of
-// projected vertices, then the homographies kept a frame
-// (docs/walkthrough.md, "The client on the Cortex-M4 board").
+// (each makes the frames cheaper, never different): set-up cache entries
+// up to kWalkSetupCacheMost, the renderer's cache of projected vertices,
+// then the homographies kept a frame (docs/walkthrough.md, "The client on
+// the Cortex-M4 board").
 struct WalkSpare {
+  uint32_t setups = kWalkSetupCache;  // the renderer's set-up cache
   uint32_t vertices = 0;  // the renderer's vertex cache
   uint32_t maps = 0;      // slots whose homographies are kept
 };
@@ -102,9 +109,18 @@ constexpr size_t kVertexBytes = sizeof(detail::CachedVertex) + 1;
 constexpr size_t kMapBytes = sizeof(Homography) + 1;
 constexpr size_t kSpareSlack = 32;  // the alignment of the arrays these add
 
-WalkSpare spare_caches(const WalkParams& w, size_t spare) {
+WalkSpare spare_caches(const StreamHeader& h, const WalkParams& w, const PlayerConfig& c, size_t spare) {
   WalkSpare out;
   spare = spare > kSpareSlack ? spare - kSpareSlack : 0;
+  const size_t base = render_workspace_size(render_config(h, w, c, 0));
+  for (uint32_t k = kWalkSetupCacheMost; k > kWalkSetupCache; --k) {
+    const size_t more = render_workspace_size(render_config(h, w, c, 0, k)) - base;
+    if (more <= spare) {
+      out.setups = k;
+      spare -= more;
+      break;
+    }
+  }
   const size_t verts = spare / kVertexBytes;
   out.vertices = static_cast<uint32_t>(verts < 3u * w.slots ? verts : 3u * w.slots);
   spare -= out.vertices * kVertexBytes;
@@ -145,7 +161,7 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
     p.fail(Status::workspace_too_small, "the walkthrough's slots and views do not fit the workspace");
     return false;
   }
-  const WalkSpare spare = spare_caches(w, p.arena().remaining() - need);
+  const WalkSpare spare = spare_caches(h, w, p.config(), p.arena().remaining() - need);
   WalkPlay* wp = static_cast<WalkPlay*>(p.arena().alloc(sizeof(WalkPlay), alignof(WalkPlay)));
   if (wp == nullptr) return false;
   *wp = WalkPlay{};
@@ -154,7 +170,7 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   if (w.rate_bytes != 0 && h.frame_period_us != 0) p.set_schedule(w.preroll_ms);
   Status s = p.walk_geometry.init(p.arena(), w.slots, w.quantum_raw);
   if (s == Status::ok) s = p.image.init(p.arena());
-  if (s == Status::ok) s = wp->renderer.init(render_config(h, w, p.config(), spare.vertices), p.arena());
+  if (s == Status::ok) s = wp->renderer.init(render_config(h, w, p.config(), spare.vertices, spare.setups), p.arena());
   wp->indices = static_cast<uint16_t*>(p.arena().alloc(3u * w.slots * sizeof(uint16_t), 4));
   wp->view_of = p.arena().alloc_array<uint8_t>(w.slots);
   wp->hot_stamp = p.arena().alloc_array<uint16_t>(w.slots);
