@@ -293,44 +293,35 @@ struct RenderFrame {
         // alone (and again in the bands that draw it).
         CachedVertex cv[3];
         uint8_t oc[3];
-        for (int k = 0; k < 3; ++k) {
-          if (idx[k] < cached) {
-            cv[k] = r.cache_[idx[k]];
-            oc[k] = r.cache_outcode_[idx[k]];
-          } else {
-            oc[k] = project(idx[k], &cv[k]);
-          }
-        }
-        {
-          const uint8_t o0 = oc[0], o1 = oc[1], o2 = oc[2];
-          if (o0 & o1 & o2 & kOutAll) {
+        for (int k = 0; k < 3; ++k) oc[k] = fetch(idx[k], &cv[k]);
+        const uint8_t o0 = oc[0], o1 = oc[1], o2 = oc[2];
+        if (o0 & o1 & o2 & kOutAll) {
+          first = 1;
+          last = 0;
+        } else if (!((o0 | o1 | o2) & kNoProjection)) {
+          const int32_t y0 = cv[0].y, y1 = cv[1].y, y2 = cv[2].y;
+          const int32_t margin = (o0 | o1 | o2) ? 256 : 0;
+          const int32_t lo = (y0 < y1 ? (y0 < y2 ? y0 : y2) : (y1 < y2 ? y1 : y2)) - margin;
+          const int32_t hi = (y0 > y1 ? (y0 > y2 ? y0 : y2) : (y1 > y2 ? y1 : y2)) + margin;
+          // Rows [raster_row(lo), raster_row(hi)), clamped to the screen.
+          int32_t r0 = raster_row(lo), r1 = raster_row(hi);
+          r0 = r0 < 0 ? 0 : r0;
+          r1 = r1 > r.cfg_.height ? r.cfg_.height : r1;
+          if (r0 >= r1) {
             first = 1;
             last = 0;
-          } else if (!((o0 | o1 | o2) & kNoProjection)) {
-            const int32_t y0 = cv[0].y, y1 = cv[1].y, y2 = cv[2].y;
-            const int32_t margin = (o0 | o1 | o2) ? 256 : 0;
-            const int32_t lo = (y0 < y1 ? (y0 < y2 ? y0 : y2) : (y1 < y2 ? y1 : y2)) - margin;
-            const int32_t hi = (y0 > y1 ? (y0 > y2 ? y0 : y2) : (y1 > y2 ? y1 : y2)) + margin;
-            // Rows [raster_row(lo), raster_row(hi)), clamped to the screen.
-            int32_t r0 = raster_row(lo), r1 = raster_row(hi);
-            r0 = r0 < 0 ? 0 : r0;
-            r1 = r1 > r.cfg_.height ? r.cfg_.height : r1;
-            if (r0 >= r1) {
+          } else {
+            first = static_cast<uint16_t>(r0 / bh);
+            last = static_cast<uint16_t>((r1 - 1) / bh);
+            if ((o0 | o1 | o2) == 0 && !drawable(m, cv[0], cv[1], cv[2])) {
+              // Unclipped and off screen sideways, facing away or of zero
+              // area: no band draws it (draw_mesh would reject it in each
+              // of its bands, counting it culled there when on screen).
+              if (on_screen_x(cv[0], cv[1], cv[2])) {
+                r.stats_.culled += static_cast<uint32_t>(last - first) + 1;
+              }
               first = 1;
               last = 0;
-            } else {
-              first = static_cast<uint16_t>(r0 / bh);
-              last = static_cast<uint16_t>((r1 - 1) / bh);
-              if ((o0 | o1 | o2) == 0 && !drawable(m, cv[0], cv[1], cv[2])) {
-                // Unclipped and off screen sideways, facing away or of zero
-                // area: no band draws it (draw_mesh would reject it in each
-                // of its bands, counting it culled there when on screen).
-                if (on_screen_x(cv[0], cv[1], cv[2])) {
-                  r.stats_.culled += static_cast<uint32_t>(last - first) + 1;
-                }
-                first = 1;
-                last = 0;
-              }
             }
           }
         }

@@ -239,6 +239,8 @@ DrawList draw_list(const WalkPlay& w, const Mesh* mesh) {
 void put_indices(WalkPlay& w, uint32_t i, uint32_t slot) {
   for (uint32_t k = 0; k < 3; ++k) w.indices[3 * i + k] = static_cast<uint16_t>(3 * slot + k);
 }
+// The slot of the draw list's triangle t (put_indices).
+uint32_t slot_of(const WalkPlay& w, uint32_t t) { return w.indices[3 * t] / 3u; }
 
 // Sort key i of a frame, in the front of w.indices (whose 6 bytes a
 // triangle hold 4 bytes of key).
@@ -309,7 +311,7 @@ struct FrameCtx {
 bool frame_map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
   const FrameCtx& f = *static_cast<const FrameCtx*>(ctx);
   WalkPlay& w = *f.w;
-  const uint32_t slot = w.indices[3 * t] / 3u;
+  const uint32_t slot = slot_of(w, t);
   const uint8_t v = w.view_of[slot];
   if (v >= kWalkMaxViews || !w.view_ready[v]) return false;
   if (w.pair_state[v] == kUnknown)
@@ -406,7 +408,7 @@ struct PredictCtx {
 bool predict_map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
   const PredictCtx& c = *static_cast<const PredictCtx*>(ctx);
   const WalkPlay& w = *c.w;
-  const uint32_t slot_i = w.indices[3 * t] / 3u;
+  const uint32_t slot_i = slot_of(w, t);
   const Vec3<Q16_16>* tri = w.geometry->triangle(slot_i);
   const uint8_t own = w.view_of[slot_i];
   int v = own != c.slot && own < w.params.views && w.view_ready[own] && in_front(w.view_cam[own], tri) ? own : -1;
