@@ -85,8 +85,16 @@ Status check_list(const DrawList& list) {
       return Status::invalid_argument;
     }
     if (m.num_triangles == 0) continue;
-    if (!m.indices || m.num_triangles > 0x7FFFFFFFu / 3) return Status::malformed;
-    const uint32_t count = m.num_triangles * 3;
+    if (!m.indices || m.num_triangles > 0x7FFFFFFFu / kMaxFaceCorners) return Status::malformed;
+    if (m.corners && m.shading == Shading::mesh_colors) return Status::invalid_argument;
+    uint32_t count = m.num_triangles * 3;
+    if (m.corners) {
+      count = 0;
+      for (uint32_t t = 0; t < m.num_triangles; ++t) {
+        if (m.corners[t] < 3 || m.corners[t] > kMaxFaceCorners) return Status::malformed;
+        count += m.corners[t];
+      }
+    }
     for (uint32_t k = 0; k < count; ++k) {
       if (m.indices[k] >= list.num_positions) return Status::malformed;
     }
@@ -102,6 +110,15 @@ Status check_list(const DrawList& list) {
     }
   }
   return Status::ok;
+}
+
+// The corners of face t of m, and of all its faces.
+int face_corners(const Mesh& m, uint32_t t) { return m.corners ? m.corners[t] : 3; }
+uint64_t mesh_corners(const Mesh& m) {
+  if (!m.corners) return 3 * uint64_t{m.num_triangles};
+  uint64_t n = 0;
+  for (uint32_t t = 0; t < m.num_triangles; ++t) n += m.corners[t];
+  return n;
 }
 
 int num_attribs(Shading s) {
@@ -260,7 +277,7 @@ struct RenderFrame {
     uint8_t* const oc = r.cache_outcode_;
     cached = n;
     uint64_t named = 0;
-    for (uint32_t mi = 0; mi < list.num_meshes; ++mi) named += 3 * uint64_t{list.meshes[mi].num_triangles};
+    for (uint32_t mi = 0; mi < list.num_meshes; ++mi) named += mesh_corners(list.meshes[mi]);
     if (named >= n) {
       for (uint32_t i = 0; i < n; ++i) oc[i] = project(i, &r.cache_[i]);
       return;
@@ -268,16 +285,16 @@ struct RenderFrame {
     for (uint32_t i = 0; i < n; ++i) oc[i] = kUnprojected;
     for (uint32_t mi = 0; mi < list.num_meshes; ++mi) {
       const Mesh& m = list.meshes[mi];
-      const uint32_t count = 3 * m.num_triangles;
-      for (uint32_t k = 0; k < count; ++k) {
+      const uint64_t count = mesh_corners(m);
+      for (uint64_t k = 0; k < count; ++k) {
         const uint32_t i = m.indices[k];
         if (i < n && oc[i] == kUnprojected) oc[i] = project(i, &r.cache_[i]);
       }
     }
   }
 
-  // The band range of every triangle the triangle cache holds, from the same
-  // test draw_mesh applies per band: [1, 0] (empty) for a triangle outside a
+  // The band range of every face the triangle cache holds, from the same
+  // test draw_mesh applies per band: [1, 0] (empty) for a face outside a
   // clip plane, [0, last band] when its vertices are not all projected.
   void fill_triangle_bands() {
     const uint32_t cap = r.cfg_.triangle_cache;
@@ -286,23 +303,32 @@ struct RenderFrame {
     uint32_t g = 0;
     for (uint32_t mi = 0; mi < list.num_meshes && g < cap; ++mi) {
       const Mesh& m = list.meshes[mi];
+      const uint16_t* idx = m.indices;
       for (uint32_t t = 0; t < m.num_triangles && g < cap; ++t, ++g) {
-        const uint16_t* idx = m.indices + 3 * t;
+        const int n = face_corners(m, t);
         uint16_t first = 0, last = last_band;
-        // A vertex past the vertex cache is projected here for its triangle
+        // A vertex past the vertex cache is projected here for its face
         // alone (and again in the bands that draw it).
-        CachedVertex cv[3];
-        uint8_t oc[3];
-        for (int k = 0; k < 3; ++k) oc[k] = fetch(idx[k], &cv[k]);
-        const uint8_t o0 = oc[0], o1 = oc[1], o2 = oc[2];
-        if (o0 & o1 & o2 & kOutAll) {
+        CachedVertex cv[kMaxFaceCorners];
+        uint8_t all = kOutAll, any = 0;
+        for (int k = 0; k < n; ++k) {
+          const uint8_t oc = fetch(idx[k], &cv[k]);
+          all &= oc;
+          any |= oc;
+        }
+        idx += n;
+        if (all & kOutAll) {
           first = 1;
           last = 0;
-        } else if (!((o0 | o1 | o2) & kNoProjection)) {
-          const int32_t y0 = cv[0].y, y1 = cv[1].y, y2 = cv[2].y;
-          const int32_t margin = (o0 | o1 | o2) ? 256 : 0;
-          const int32_t lo = (y0 < y1 ? (y0 < y2 ? y0 : y2) : (y1 < y2 ? y1 : y2)) - margin;
-          const int32_t hi = (y0 > y1 ? (y0 > y2 ? y0 : y2) : (y1 > y2 ? y1 : y2)) + margin;
+        } else if (!(any & kNoProjection)) {
+          int32_t lo = cv[0].y, hi = cv[0].y;
+          for (int k = 1; k < n; ++k) {
+            lo = cv[k].y < lo ? cv[k].y : lo;
+            hi = cv[k].y > hi ? cv[k].y : hi;
+          }
+          const int32_t margin = any ? 256 : 0;
+          lo -= margin;
+          hi += margin;
           // Rows [raster_row(lo), raster_row(hi)), clamped to the screen.
           int32_t r0 = raster_row(lo), r1 = raster_row(hi);
           r0 = r0 < 0 ? 0 : r0;
@@ -313,11 +339,11 @@ struct RenderFrame {
           } else {
             first = static_cast<uint16_t>(r0 / bh);
             last = static_cast<uint16_t>((r1 - 1) / bh);
-            if ((o0 | o1 | o2) == 0 && !drawable(m, cv[0], cv[1], cv[2])) {
+            if (any == 0 && !drawable(m, cv, n)) {
               // Unclipped and off screen sideways, facing away or of zero
               // area: no band draws it (draw_mesh would reject it in each
               // of its bands, counting it culled there when on screen).
-              if (on_screen_x(cv[0], cv[1], cv[2])) {
+              if (on_screen_x(cv, n)) {
                 r.stats_.culled += static_cast<uint32_t>(last - first) + 1;
               }
               first = 1;
@@ -331,21 +357,30 @@ struct RenderFrame {
     }
   }
 
-  // Whether an unclipped triangle's columns reach the screen, as
+  // Whether an unclipped face's columns reach the screen, as
   // prepare_polygon tests them (pixel centres inside its box).
-  bool on_screen_x(const CachedVertex& a, const CachedVertex& b, const CachedVertex& c) const {
-    const int32_t xlo = a.x < b.x ? (a.x < c.x ? a.x : c.x) : (b.x < c.x ? b.x : c.x);
-    const int32_t xhi = a.x > b.x ? (a.x > c.x ? a.x : c.x) : (b.x > c.x ? b.x : c.x);
+  bool on_screen_x(const CachedVertex* v, int n) const {
+    int32_t xlo = v[0].x, xhi = v[0].x;
+    for (int k = 1; k < n; ++k) {
+      xlo = v[k].x < xlo ? v[k].x : xlo;
+      xhi = v[k].x > xhi ? v[k].x : xhi;
+    }
     return raster_row(xhi) > 0 && raster_row(xlo) < r.cfg_.width;
   }
 
-  // Whether an unclipped triangle can draw anything: on screen sideways,
+  // Whether an unclipped face can draw anything: on screen sideways,
   // facing the way the mesh draws and of non-zero area (the same products
-  // as prepare_polygon's).
-  bool drawable(const Mesh& m, const CachedVertex& a, const CachedVertex& b, const CachedVertex& c) const {
-    const int64_t area = int64_t{b.x - a.x} * (c.y - a.y) - int64_t{c.x - a.x} * (b.y - a.y);
-    if (area == 0 || (m.cull == Cull::back && area > 0) || (m.cull == Cull::front && area < 0)) return false;
-    return on_screen_x(a, b, c);
+  // as prepare_polygon's fan: its signed area, and some fan triangle's).
+  bool drawable(const Mesh& m, const CachedVertex* v, int n) const {
+    int64_t area = 0;
+    bool some = false;
+    for (int i = 1; i + 1 < n; ++i) {
+      const int64_t a = int64_t{v[i].x - v[0].x} * (v[i + 1].y - v[0].y) - int64_t{v[i + 1].x - v[0].x} * (v[i].y - v[0].y);
+      area += a;
+      some = some || a != 0;
+    }
+    if (area == 0 || !some || (m.cull == Cull::back && area > 0) || (m.cull == Cull::front && area < 0)) return false;
+    return on_screen_x(v, n);
   }
 
   uint8_t fetch(uint32_t i, CachedVertex* out) {
@@ -471,12 +506,12 @@ struct RenderFrame {
   }
 
   // Draws mesh m into the band; `first_tri` is the running index of its first
-  // triangle (for the triangle cache), `band_index` the band's number.
+  // face (for the triangle cache), `band_index` the band's number.
   void draw_mesh(const BandTarget& band, const Mesh& m, uint32_t first_tri, uint16_t band_index) {
-    MaterialCtx mat{&m, num_attribs(m.shading), 0};
+    MaterialCtx mat{&m, num_attribs(m.shading), 0, 0, 3};
     const uint32_t tcap = r.cfg_.triangle_cache;
     const uint16_t* const tb = r.tri_bands_;
-    // A triangle misses the band when raster_row(ymax) <= y0 or
+    // A face misses the band when raster_row(ymax) <= y0 or
     // raster_row(ymin) >= y1, i.e. ymax <= 256 y0 + 128 or ymin >= 256 y1 - 127.
     const int32_t miss_below = band.y0 * 256 + 128;
     const int32_t miss_above = band.y1 * 256 - 127;
@@ -484,15 +519,21 @@ struct RenderFrame {
     const uint8_t* const cache_oc = r.cache_outcode_;
     const uint32_t n_cached = cached;
     const uint32_t nt = m.num_triangles;
-    // Triangles [0, tc_end) of the mesh are in the triangle cache.
+    const uint8_t* const corners = m.corners;
+    // Faces [0, tc_end) of the mesh are in the triangle cache.
     const uint32_t tc_end = first_tri >= tcap ? 0 : (tcap - first_tri < nt ? tcap - first_tri : nt);
-    for (uint32_t t = 0; t < nt; ++t) {
+    const uint16_t* idx = m.indices;  // face t's corners
+    int n = 3;
+    for (uint32_t t = 0; t < nt; ++t, idx += n) {
+      n = corners ? corners[t] : 3;
       if (t < tc_end) {
-        // Most triangles miss a band: skip them in a loop of their own.
+        // Most faces miss a band: skip them in a loop of their own.
         const uint16_t* p = tb + 2 * size_t{first_tri + t};
         if (band_index < p[0] || band_index > p[1]) {
           do {
             ++t;
+            idx += n;
+            n = t < nt && corners ? corners[t] : 3;
             p += 2;
           } while (t < tc_end && (band_index < p[0] || band_index > p[1]));
           if (t == nt) break;
@@ -500,8 +541,10 @@ struct RenderFrame {
       }
       const uint32_t g = first_tri + t;
       mat.tri = t;
+      mat.first = idx[0];
+      mat.corners = n;
       if (cursor < live) {
-        // Live tags ascend and so do the triangles of a band's walk.
+        // Live tags ascend and so do the faces of a band's walk.
         const uint32_t* const tags = r.setup_tags_;
         while (cursor < live && tags[cursor] <= g) ++cursor;
         if (cursor < live && tags[cursor] == g + 1) {
@@ -511,42 +554,40 @@ struct RenderFrame {
           continue;
         }
       }
-      const uint16_t* idx = m.indices + 3 * t;
-      CachedVertex cv[3];
-      uint8_t oc[3];
-      if (idx[0] < n_cached && idx[1] < n_cached && idx[2] < n_cached) {
-        // The common case, kept short: every triangle is visited once per band.
-        oc[0] = cache_oc[idx[0]];
-        oc[1] = cache_oc[idx[1]];
-        oc[2] = cache_oc[idx[2]];
-        if (oc[0] & oc[1] & oc[2] & kOutAll) continue;
-        if (!((oc[0] | oc[1] | oc[2]) & kNoProjection)) {
-          const int32_t y0 = cache[idx[0]].y, y1 = cache[idx[1]].y, y2 = cache[idx[2]].y;
-          const int32_t lo = y0 < y1 ? (y0 < y2 ? y0 : y2) : (y1 < y2 ? y1 : y2);
-          const int32_t hi = y0 > y1 ? (y0 > y2 ? y0 : y2) : (y1 > y2 ? y1 : y2);
-          // Clipped vertices are rounded on their own, so a clipped
-          // triangle's bound is widened by a pixel (the picture must not
-          // depend on which band a triangle is tested against).
-          const int32_t margin = (oc[0] | oc[1] | oc[2]) ? 256 : 0;
-          if (hi + margin <= miss_below || lo - margin >= miss_above) continue;
+      CachedVertex cv[kMaxFaceCorners];
+      uint8_t all = kOutAll, any = 0;
+      bool in_cache = true;
+      for (int k = 0; k < n; ++k) in_cache = in_cache && idx[k] < n_cached;
+      if (in_cache) {
+        // The common case, kept short: every face is visited once per band.
+        for (int k = 0; k < n; ++k) {
+          const uint8_t oc = cache_oc[idx[k]];
+          all &= oc;
+          any |= oc;
         }
-        cv[0] = cache[idx[0]];
-        cv[1] = cache[idx[1]];
-        cv[2] = cache[idx[2]];
       } else {
-        for (int k = 0; k < 3; ++k) oc[k] = fetch(idx[k], &cv[k]);
-        if (oc[0] & oc[1] & oc[2] & kOutAll) continue;
-        if (!((oc[0] | oc[1] | oc[2]) & kNoProjection)) {
-          int32_t lo = cv[0].y, hi = cv[0].y;
-          for (int k = 1; k < 3; ++k) {
-            lo = cv[k].y < lo ? cv[k].y : lo;
-            hi = cv[k].y > hi ? cv[k].y : hi;
-          }
-          const int32_t margin = (oc[0] | oc[1] | oc[2]) ? 256 : 0;
-          if (hi + margin <= miss_below || lo - margin >= miss_above) continue;
+        for (int k = 0; k < n; ++k) {
+          const uint8_t oc = fetch(idx[k], &cv[k]);
+          all &= oc;
+          any |= oc;
         }
       }
-      const uint8_t any = static_cast<uint8_t>(oc[0] | oc[1] | oc[2]);
+      if (all & kOutAll) continue;
+      if (!(any & kNoProjection)) {
+        int32_t lo = INT32_MAX, hi = INT32_MIN;
+        for (int k = 0; k < n; ++k) {
+          const int32_t y = in_cache ? cache[idx[k]].y : cv[k].y;
+          lo = y < lo ? y : lo;
+          hi = y > hi ? y : hi;
+        }
+        // Clipped vertices are rounded on their own, so a clipped
+        // face's bound is widened by a pixel (the picture must not
+        // depend on which band a face is tested against).
+        const int32_t margin = any ? 256 : 0;
+        if (hi + margin <= miss_below || lo - margin >= miss_above) continue;
+      }
+      if (in_cache)
+        for (int k = 0; k < n; ++k) cv[k] = cache[idx[k]];
       // The clipper's scratch array is free once it has run, and the direct
       // path needs no clipping: one store serves both (a small stack).
       union Scratch {
@@ -556,44 +597,44 @@ struct RenderFrame {
       if (any == 0) {
         // Off screen sideways, facing and zero area first, as
         // prepare_polygon decides them (the same products): a rejected
-        // triangle costs no vertex copies, no set-up and no set-up cache
+        // face costs no vertex copies, no set-up and no set-up cache
         // slot. It counts as culled where prepare_polygon would count it.
-        // (Triangles in the triangle cache were tested once per frame.)
-        if (!drawable(m, cv[0], cv[1], cv[2])) {
-          if (on_screen_x(cv[0], cv[1], cv[2])) ++r.stats_.culled;  // then it faces away or has no area
+        // (Faces in the triangle cache were tested once per frame.)
+        if (!drawable(m, cv, n)) {
+          if (on_screen_x(cv, n)) ++r.stats_.culled;  // then it faces away or has no area
           continue;
         }
         ScreenVertex* sv = scratch.screen;
-        for (int k = 0; k < 3; ++k) {
+        for (int k = 0; k < n; ++k) {
           sv[k].x = cv[k].x;
           sv[k].y = cv[k].y;
           sv[k].q = cv[k].q;
           attributes(m, idx[k], k, sv[k].a);
         }
-        draw(band, mat, sv, 3, g, false);
+        draw(band, mat, sv, n, g, false);
         continue;
       }
       ++r.stats_.clipped;
-      ClipVertex in[3], out[kMaxPolyVerts];
-      for (int k = 0; k < 3; ++k) {
+      ClipVertex in[kMaxFaceCorners], out[kMaxPolyVerts];
+      for (int k = 0; k < n; ++k) {
         in[k] = camera_vertex(idx[k]);
         attributes(m, idx[k], k, in[k].a);
       }
-      const int n = clip_polygon(fc, static_cast<uint8_t>(any & kOutAll), in, 3, out, scratch.clip, mat.num_attribs);
-      if (n < 3) {
+      const int nc = clip_polygon(fc, static_cast<uint8_t>(any & kOutAll), in, n, out, scratch.clip, mat.num_attribs);
+      if (nc < 3) {
         if (g < r.cfg_.triangle_cache) set_triangle_rows(g, 0, 0);  // nothing left in any band
         continue;
       }
       ScreenVertex* sv = scratch.screen;
       bool ok = true;
-      for (int k = 0; k < n && ok; ++k) {
+      for (int k = 0; k < nc && ok; ++k) {
         const Vec3<Q16_16> p{Q16_16::from_raw(out[k].x), Q16_16::from_raw(out[k].y), Q16_16::from_raw(out[k].z)};
         ok = camera_project(*fc.cam, p, &sv[k].x, &sv[k].y);
         sv[k].q = depth_q(fc, out[k].z);
         for (int j = 0; j < kMaxAttribs; ++j) sv[k].a[j] = out[k].a[j];
       }
       if (ok) {
-        draw(band, mat, sv, n, g, true);
+        draw(band, mat, sv, nc, g, true);
       } else if (g < r.cfg_.triangle_cache) {
         set_triangle_rows(g, 0, 0);
       }

@@ -33,8 +33,8 @@ struct ScreenVertex {
   int32_t a[kMaxAttribs];
 };
 
-// 3 vertices, plus one per clip plane (near, far, 4 guard planes).
-constexpr int kMaxPolyVerts = 9;
+// A face's corners, plus one per clip plane (near, far, 4 guard planes).
+constexpr int kMaxPolyVerts = kMaxFaceCorners + 6;
 
 // Outcode bits of a camera-space vertex.
 enum : uint8_t {
@@ -73,7 +73,9 @@ int clip_polygon(const FrameCamera& fc, uint8_t planes, const ClipVertex* in, in
 struct MaterialCtx {
   const Mesh* mesh;
   int num_attribs;  // 0 flat, 2 texture, 3 gouraud, 0 view_mapped, 2 mesh_colors
-  uint32_t tri;     // the triangle's index in the mesh (mesh_colors, Mesh::views)
+  uint32_t tri;     // the face's number in the mesh (mesh_colors, Mesh::views)
+  uint32_t first;   // its first corner's vertex (Mesh::views)
+  int corners;      // its corners (Mesh::corners): more than 3, rasterised as one polygon
 };
 
 // The band being drawn.

@@ -107,6 +107,7 @@ struct PreparedPolygon {
   int32_t n;                        // outline vertices
   bool culled;                      // facing or zero area (counted per band it touches)
   bool set_up;                      // planes computed (counted per band it touches)
+  bool whole;                       // rasterised as one convex polygon (a face of more than 3 corners), else as a fan
   RasterVertex outline[kMaxPolyVerts];
 };
 
@@ -428,6 +429,7 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   pp->fn = nullptr;
   pp->culled = false;
   pp->set_up = false;
+  pp->whole = mat.corners > 3;
   pp->n = n;
   int32_t xmin, xmax;
   if (!place(target, v, n, pp, &xmin, &xmax)) return;
@@ -485,7 +487,7 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
     Homography asked;
     if (m.shading == Shading::view_mapped && m.views != nullptr) {
       map = &asked;
-      if (!m.views->map(m.views->ctx, mat.tri, &tex, &asked) || !same_form(*tex, *m.texture)) return;
+      if (!m.views->map(m.views->ctx, mat.tri, mat.first, &tex, &asked) || !same_form(*tex, *m.texture)) return;
     }
     repeat = texture_repeats(*tex);
     s.tex = make_tex_ctx(*tex, repeat);
@@ -523,6 +525,14 @@ void draw_prepared(const BandTarget& band, const PreparedPolygon& pp, RenderStat
   if (!fn) return;
   const PolySetup& s = pp.s;
   const RasterVertex* o = pp.outline;
+  if (pp.whole) {
+    raster_convex(o, pp.n, band.y0, band.y1, band.width, [&](int32_t y, int32_t xa, int32_t xb) {
+      fn(band, s, y, xa, xb);
+      ++stats.spans;
+      stats.pixels += static_cast<uint32_t>(xb - xa);
+    });
+    return;
+  }
   for (int i = 1; i + 1 < pp.n; ++i) {
     const RasterVertex rv[3] = {o[0], o[i], o[i + 1]};
     raster_triangle(rv, band.y0, band.y1, band.width, [&](int32_t y, int32_t xa, int32_t xb) {

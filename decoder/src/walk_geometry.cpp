@@ -44,6 +44,80 @@ uint32_t walk_get_ring_index(ArithDecoder& d, ArithContext* ring_bucket) {
   return walk_get_place(d, ring_bucket, kWalkRingBits);
 }
 
+namespace {
+int bitlen(uint64_t v) { return v == 0 ? 0 : 64 - clz64(v); }
+uint64_t mag(int64_t v) { return v < 0 ? 0 - static_cast<uint64_t>(v) : static_cast<uint64_t>(v); }
+bool same_point(const Vec3<Q16_16>& p, const Vec3<Q16_16>& q) {
+  return p.x.raw() == q.x.raw() && p.y.raw() == q.y.raw() && p.z.raw() == q.z.raw();
+}
+}  // namespace
+
+uint8_t walk_quad(const Vec3<Q16_16>* a, const Vec3<Q16_16>* b, int32_t tolerance) {
+  // The shared edge: a's corners i, i + 1 are b's corners other than j.
+  int qi = -1, qj = -1;
+  for (int i = 0; i < 3 && qi < 0; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const Vec3<Q16_16>& e0 = a[i];
+      const Vec3<Q16_16>& e1 = a[(i + 1) % 3];
+      const Vec3<Q16_16>& b1 = b[(j + 1) % 3];
+      const Vec3<Q16_16>& b2 = b[(j + 2) % 3];
+      if (((same_point(b1, e0) && same_point(b2, e1)) || (same_point(b1, e1) && same_point(b2, e0))) &&
+          !same_point(b[j], a[0]) && !same_point(b[j], a[1]) && !same_point(b[j], a[2])) {
+        qi = i;
+        qj = j;
+        break;
+      }
+    }
+  if (qi < 0) return 0;
+  // The outline p0..p3 as differences from p0, brought below 2^20 by one
+  // shift (arithmetic, the same on every board).
+  const Vec3<Q16_16>* p[4] = {&a[qi], &b[qj], &a[(qi + 1) % 3], &a[(qi + 2) % 3]};
+  int64_t d[4][3] = {};
+  uint64_t most = 0;
+  for (int k = 1; k < 4; ++k)
+    for (int c = 0; c < 3; ++c) {
+      d[k][c] = int64_t{(&p[k]->x)[c].raw()} - (&p[0]->x)[c].raw();
+      most = mag(d[k][c]) > most ? mag(d[k][c]) : most;
+    }
+  const int s = bitlen(most) > 20 ? bitlen(most) - 20 : 0;
+  for (int k = 1; k < 4; ++k)
+    for (int c = 0; c < 3; ++c) d[k][c] >>= s;
+  // a's normal from p0: (p2 - p0) x (p3 - p0), each entry below 2^41.
+  const int64_t n[3] = {d[2][1] * d[3][2] - d[2][2] * d[3][1], d[2][2] * d[3][0] - d[2][0] * d[3][2],
+                        d[2][0] * d[3][1] - d[2][1] * d[3][0]};
+  int axis = 0;
+  for (int c = 1; c < 3; ++c) axis = mag(n[c]) > mag(n[axis]) ? c : axis;
+  const uint64_t nmax = mag(n[axis]);
+  if (nmax == 0) return 0;
+  // b's third corner within the tolerance of the plane: |n . d1| / |n| <=
+  // tol, tested as |n . d1| <= tol max|n_c| (|n| >= max|n_c|).
+  int64_t tol = tolerance >> s;
+  tol = tol < 2 ? 2 : (tol > (int64_t{1} << 20) ? (int64_t{1} << 20) : tol);
+  const int64_t off = n[0] * d[1][0] + n[1] * d[1][1] + n[2] * d[1][2];  // < 3 * 2^61
+  if (mag(off) > static_cast<uint64_t>(tol) * nmax) return 0;
+  // Convex: the turns at the four corners all one way, in the plane of the
+  // two axes other than the normal's largest.
+  const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
+  int sign = 0;
+  for (int k = 0; k < 4; ++k) {
+    const int64_t* q0 = d[k];
+    const int64_t* q1 = d[(k + 1) % 4];
+    const int64_t* q2 = d[(k + 2) % 4];
+    const int64_t turn = (q1[u] - q0[u]) * (q2[v] - q1[v]) - (q1[v] - q0[v]) * (q2[u] - q1[u]);  // < 2^43
+    const int t = turn > 0 ? 1 : (turn < 0 ? -1 : 0);
+    if (t == 0 || (sign != 0 && t != sign)) return 0;
+    sign = t;
+  }
+  return static_cast<uint8_t>(1 + 3 * qi + qj);
+}
+
+void WalkGeometry::join(uint32_t slot) {
+  uint8_t code = 0;
+  if (slot + 1 < slots_ && (filled_[slot] & 1) && (filled_[slot + 1] & 1))
+    code = walk_quad(&positions_[3 * static_cast<size_t>(slot)], &positions_[3 * static_cast<size_t>(slot) + 3], quantum_);
+  filled_[slot] = static_cast<uint8_t>((filled_[slot] & 1) | (code << 4));
+}
+
 size_t WalkGeometry::workspace_bytes(uint32_t slots) {
   return 3 * static_cast<size_t>(slots) * sizeof(Vec3<Q16_16>) + alignof(Vec3<Q16_16>) + 2 * slots + 2 * 2 * slots + 8 +
          kWalkVertexRing * 3 * sizeof(int32_t) + alignof(int32_t);
@@ -140,7 +214,9 @@ Status WalkGeometry::decode(ArithDecoder& d) {
     if (!d.ok()) return d.status();
     for (int c = 0; c < 3; ++c)
       for (int a = 0; a < 3; ++a) prev_[c][a] = cur_[c][a];
-    filled_[slot] = 1;
+    filled_[slot] |= 1;
+    if (slot > 0) join(slot - 1);
+    join(slot);
     if (hot_now) mark_[slot] = 1;
   }
   // Slots hot before that stay hot.
@@ -157,7 +233,7 @@ Status WalkGeometry::decode(ArithDecoder& d) {
     const uint32_t gap = d.decode_ueg(ctx_.again_gap, 4, 8, 4);
     if (!d.ok()) return d.status();
     const uint64_t slot = static_cast<uint64_t>(k == 0 ? 0 : at + 1) + gap;
-    if (slot >= slots_ || !filled_[slot]) return Status::malformed;
+    if (slot >= slots_ || !(filled_[slot] & 1)) return Status::malformed;
     at = static_cast<uint32_t>(slot);
     mark_[at] = 1;
   }
@@ -166,7 +242,7 @@ Status WalkGeometry::decode(ArithDecoder& d) {
   uint32_t n = 0;
   for (uint32_t slot = 0; slot < slots_; ++slot)
     if (mark_[slot]) {
-      if (!filled_[slot]) return Status::malformed;
+      if (!(filled_[slot] & 1)) return Status::malformed;
       next_hot_[n++] = static_cast<uint16_t>(slot);
     }
   uint16_t* t = hot_;

@@ -136,6 +136,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // Meshes: indices drawn from the input (occasionally out of range).
   const uint32_t nm = 1 + in.u8() % 4;
   std::vector<std::vector<uint16_t>> idx(nm);
+  std::vector<std::vector<uint8_t>> corners(nm);
   std::vector<vds::Mesh> meshes(nm);
   for (uint32_t m = 0; m < nm; ++m) {
     const uint8_t kind = in.u8();
@@ -150,7 +151,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (auto& row : mesh.view_map.m)
       for (int32_t& v : row) v = in.i32();
     const uint32_t nt = in.u8() % 12;
-    for (uint32_t t = 0; t < 3 * nt; ++t) {
+    // Faces of 3 or 4 corners (Mesh::corners) when the kind's top bit is
+    // set, now and then a count out of range; room for 4 indices a face.
+    if (kind & 0x80) {
+      for (uint32_t t = 0; t < nt; ++t) {
+        const uint8_t c = in.u8();
+        corners[m].push_back(static_cast<uint8_t>(c == 255 ? 5 : (c == 254 ? 2 : 3 + (c & 1))));
+      }
+      mesh.corners = corners[m].data();
+    }
+    for (uint32_t t = 0; t < (mesh.corners ? 4 : 3) * nt; ++t) {
       const uint8_t b = in.u8();
       idx[m].push_back(static_cast<uint16_t>(b == 255 ? 1000 : b % np));
     }
@@ -173,7 +183,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   // homography (their own, as Mesh::views says) draw what they draw alone.
   struct Own {
     const vds::Mesh* mesh;
-    static bool map(void* ctx, uint32_t, const vds::Texture** t, vds::Homography* h) {
+    static bool map(void* ctx, uint32_t, uint32_t, const vds::Texture** t, vds::Homography* h) {
       const vds::Mesh& m = *static_cast<const Own*>(ctx)->mesh;
       *t = m.texture;
       *h = m.view_map;

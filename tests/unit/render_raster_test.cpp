@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -129,6 +130,74 @@ TEST(RenderRaster, TopLeftRuleIsPixelExact) {
   int total = 0;
   for (int v : c2) total += v;
   EXPECT_EQ(total, 2);  // (1.5, 2.5) and (3.5, 2.5) lie just outside the slanted edges
+}
+
+// A convex polygon's one span a row covers exactly the pixels its fan
+// triangles cover (from every corner), each once, in either orientation
+// and in any band of rows; a polygon of zero height draws nothing.
+TEST(RenderRaster, ConvexPolygonsCoverWhatTheirFansCover) {
+  std::mt19937 rng(2026);
+  int tested = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const int n = 4 + static_cast<int>(rng() % 5);
+    // Corners on an ellipse at increasing angles, snapped to 1/256 pixel.
+    const double cx = std::uniform_real_distribution<double>(-10, kW + 10)(rng);
+    const double cy = std::uniform_real_distribution<double>(-10, kH + 10)(rng);
+    const double rx = std::uniform_real_distribution<double>(0.3, 60)(rng);
+    const double ry = std::uniform_real_distribution<double>(0.3, 60)(rng);
+    std::vector<double> angle(n);
+    for (double& a : angle) a = std::uniform_real_distribution<double>(0, 6.2831853)(rng);
+    std::sort(angle.begin(), angle.end());
+    std::vector<RasterVertex> v;
+    for (double a : angle) v.push_back({static_cast<int32_t>(std::lround((cx + rx * std::cos(a)) * 256)),
+                                        static_cast<int32_t>(std::lround((cy + ry * std::sin(a)) * 256))});
+    if (trial % 2) std::reverse(v.begin(), v.end());
+    // Strictly convex after snapping (every turn one way), else skipped.
+    int sign = 0;
+    bool convex = true;
+    for (int k = 0; k < n && convex; ++k) {
+      const RasterVertex& a = v[k];
+      const RasterVertex& b = v[(k + 1) % n];
+      const RasterVertex& c = v[(k + 2) % n];
+      const int64_t turn = int64_t{b.x - a.x} * (c.y - b.y) - int64_t{b.y - a.y} * (c.x - b.x);
+      const int t = turn > 0 ? 1 : (turn < 0 ? -1 : 0);
+      convex = t != 0 && (sign == 0 || t == sign);
+      sign = t;
+    }
+    if (!convex) continue;
+    ++tested;
+    const int32_t y0 = static_cast<int32_t>(rng() % kH), y1 = y0 + 1 + static_cast<int32_t>(rng() % (kH - y0));
+    std::vector<int> whole(static_cast<size_t>(kW) * kH, 0);
+    int32_t rows_seen = -1;
+    const int32_t spans = raster_convex(v.data(), n, y0, y1, kW, [&](int32_t y, int32_t xa, int32_t xb) {
+      EXPECT_GE(y, y0);
+      EXPECT_LT(y, y1);
+      EXPECT_GT(y, rows_seen) << "one span a row, rows in order";
+      rows_seen = y;
+      EXPECT_GE(xa, 0);
+      EXPECT_LE(xb, kW);
+      for (int32_t x = xa; x < xb; ++x) ++whole[static_cast<size_t>(y) * kW + x];
+    });
+    int32_t covered_rows = 0;
+    for (int y = 0; y < kH; ++y) {
+      bool any = false;
+      for (int x = 0; x < kW; ++x) any = any || whole[static_cast<size_t>(y) * kW + x] != 0;
+      covered_rows += any;
+    }
+    EXPECT_EQ(spans, covered_rows);
+    for (int from = 0; from < n; ++from) {
+      std::vector<int> tris;
+      for (int k = 1; k + 1 < n; ++k) tris.insert(tris.end(), {from, (from + k) % n, (from + k + 1) % n});
+      std::vector<int> fan = coverage(v, tris, kW, kH);
+      for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x)
+          if (y < y0 || y >= y1) fan[static_cast<size_t>(y) * kW + x] = 0;
+      ASSERT_EQ(whole, fan) << "trial " << trial << ", fan from corner " << from;
+    }
+  }
+  EXPECT_GT(tested, 300);
+  const RasterVertex flat[4] = {{256, 1000}, {2000, 1000}, {3000, 1000}, {500, 1000}};
+  EXPECT_EQ(raster_convex(flat, 4, 0, kH, kW, [](int32_t, int32_t, int32_t) { ADD_FAILURE(); }), 0);
 }
 
 TEST(RenderRaster, DegenerateTrianglesDrawNothing) {

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <random>
 #include <utility>
+#include <tuple>
 #include <vector>
 
 #include "../../decoder/src/render_internal.h"
@@ -697,7 +698,7 @@ TEST(RenderApi, AViewPerTriangleFromASourceDrawsWhatAMeshPerTriangleDraws) {
     const std::vector<Tri>* tris;
     const Texture* other_form;
     int refuse = 0;  // 1: odd triangles refused; 2: odd triangles given a view of another form
-    static bool map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
+    static bool map(void* ctx, uint32_t t, uint32_t, const Texture** tex, Homography* out) {
       const Source& s = *static_cast<const Source*>(ctx);
       if (s.refuse == 1 && t % 2 == 1) return false;
       const Mesh& m = *(*s.tris)[t].from;
@@ -769,6 +770,16 @@ TEST(RenderApi, AViewPerTriangleFromASourceDrawsWhatAMeshPerTriangleDraws) {
   EXPECT_EQ(status, Status::malformed);
 }
 
+// A band sink appending an RGB565 band's rows to a std::vector<uint16_t>.
+bool append_rgb565_band(void* ctx, const Band& b) {
+  auto* f = static_cast<std::vector<uint16_t>*>(ctx);
+  for (int y = 0; y < b.height; ++y) {
+    const auto* row = reinterpret_cast<const uint16_t*>(b.pixels + y * b.stride);
+    f->insert(f->end(), row, row + b.width);
+  }
+  return true;
+}
+
 // Grid positions ((g << grid_shift) + grid_origin) draw exactly what the
 // same positions as Q16.16 vectors draw, with and without the vertex cache.
 TEST(RenderApi, GridPositionsDrawWhatTheirWorldPositionsDraw) {
@@ -825,14 +836,7 @@ TEST(RenderApi, GridPositionsDrawWhatTheirWorldPositionsDraw) {
         std::vector<uint16_t> frame;
         EXPECT_EQ(r.render(
                       cam, list, 0,
-                      [](void* ctx, const Band& b) {
-                        auto* f = static_cast<std::vector<uint16_t>*>(ctx);
-                        for (int y = 0; y < b.height; ++y) {
-                          const auto* row = reinterpret_cast<const uint16_t*>(b.pixels + y * b.stride);
-                          f->insert(f->end(), row, row + b.width);
-                        }
-                        return true;
-                      },
+                      append_rgb565_band,
                       &frame),
                   Status::ok);
         return frame;
@@ -844,6 +848,103 @@ TEST(RenderApi, GridPositionsDrawWhatTheirWorldPositionsDraw) {
           << "the surface should cover much of the frame";
     }
   }
+}
+
+// A mesh of convex planar quads (Mesh::corners) covers exactly the pixels
+// the same quads split into triangle pairs cover, in any cache
+// configuration and either winding, also where the near plane cuts them
+// (clipped apart, a pair gains a corner on the cut: a pixel there may
+// fall the other way; none did here, a few are allowed). A face count
+// out of range is refused, and so are quads with mesh colors.
+TEST(RenderApi, QuadFacesCoverWhatTheirTrianglePairsCover) {
+  constexpr int kSide = 13;
+  std::vector<Vec3<Q16_16>> pos;
+  for (int j = 0; j < kSide; ++j)
+    for (int i = 0; i < kSide; ++i) {
+      const auto q = [](double x) { return Q16_16::from_raw(static_cast<int32_t>(std::lround(x * 65536))); };
+      pos.push_back({q(i * 0.37 - 2.2), q(0.0), q(j * 0.41 - 2.4)});
+    }
+  // A checkerboard: two flat meshes, quads and the same as triangle pairs.
+  std::vector<uint16_t> quads[2], pairs[2];
+  for (int j = 0; j + 1 < kSide; ++j)
+    for (int i = 0; i + 1 < kSide; ++i) {
+      const uint16_t a = static_cast<uint16_t>(j * kSide + i), b = static_cast<uint16_t>(a + 1),
+                     c = static_cast<uint16_t>(a + kSide), d = static_cast<uint16_t>(c + 1);
+      const int k = (i + j) % 2;
+      if ((i * 7 + j * 3) % 4 == 0) {
+        quads[k].insert(quads[k].end(), {b, a, c, d});  // the other winding, from another corner
+      } else {
+        quads[k].insert(quads[k].end(), {a, b, d, c});
+      }
+      pairs[k].insert(pairs[k].end(), {a, b, d, a, d, c});
+    }
+  std::vector<uint8_t> fours(quads[0].size() / 4 + quads[1].size() / 4, 4);
+  const auto mesh = [&](const std::vector<uint16_t>& idx, bool as_quads, uint32_t color) {
+    Mesh m;
+    m.indices = idx.data();
+    m.num_triangles = static_cast<uint32_t>(idx.size() / (as_quads ? 4 : 3));
+    m.corners = as_quads ? fours.data() : nullptr;
+    m.shading = Shading::flat;
+    m.cull = Cull::none;
+    m.color = color;
+    return m;
+  };
+  const Mesh q[2] = {mesh(quads[0], true, 0xE0A020), mesh(quads[1], true, 0x2040C0)};
+  const Mesh t[2] = {mesh(pairs[0], false, 0xE0A020), mesh(pairs[1], false, 0x2040C0)};
+  const DrawList by_quads{pos.data(), static_cast<uint32_t>(pos.size()), q, 2};
+  const DrawList by_pairs{pos.data(), static_cast<uint32_t>(pos.size()), t, 2};
+  uint32_t clipped = 0;  // of the last frame drawn
+  const auto draw = [&](const Camera& cam, const DrawList& list, uint32_t vc, uint32_t tc, uint32_t sc, Status* st) {
+    RenderConfig cfg;
+    cfg.width = 96;
+    cfg.height = 72;
+    cfg.band_height = 8;
+    cfg.vertex_cache = vc;
+    cfg.triangle_cache = tc;
+    cfg.setup_cache = sc;
+    std::vector<uint8_t> ws(render_workspace_size(cfg));
+    Arena arena(ws.data(), ws.size());
+    Renderer r;
+    EXPECT_EQ(r.init(cfg, arena), Status::ok);
+    std::vector<uint16_t> frame;
+    *st = r.render(
+        cam, list, 0,
+        append_rgb565_band,
+        &frame);
+    clipped = r.stats().clipped;
+    return frame;
+  };
+  Status st = Status::ok;
+  const Camera above = ref::to_client(ref::CameraD::look_at({0.3, 3.2, -2.9}, {0, 0, 0.2}, {0, 1, 0}, 96, 72, 60, 0.1, 20));
+  const Camera inside = ref::to_client(ref::CameraD::look_at({0.1, 0.5, -1.0}, {0.4, 0, 1.5}, {0, 1, 0}, 96, 72, 70, 0.3, 20));
+  for (const Camera* cam : {&above, &inside}) {
+    const std::vector<uint16_t> want = draw(*cam, by_pairs, 1000, 1000, 8, &st);
+    ASSERT_EQ(st, Status::ok);
+    if (cam == &inside) EXPECT_GT(clipped, 4u) << "the near plane cuts quads";
+    EXPECT_GT(std::count_if(want.begin(), want.end(), [](uint16_t p) { return p != 0; }), 96 * 72 / 3);
+    for (const auto& [vc, tc, sc] : {std::tuple{1000u, 1000u, 8u}, std::tuple{40u, 1000u, 2u}, std::tuple{40u, 30u, 0u},
+                                     std::tuple{0u, 0u, 0u}, std::tuple{1000u, 1000u, 200u}}) {
+      const std::vector<uint16_t> got = draw(*cam, by_quads, vc, tc, sc, &st);
+      ASSERT_EQ(st, Status::ok);
+      ASSERT_EQ(got.size(), want.size());
+      size_t differ = 0;
+      for (size_t i = 0; i < got.size(); ++i) differ += got[i] != want[i];
+      if (cam == &above) {
+        EXPECT_EQ(differ, 0u) << "caches " << vc << " " << tc << " " << sc;
+      } else {
+        EXPECT_LE(differ, 12u) << "caches " << vc << " " << tc << " " << sc;
+      }
+    }
+  }
+  fours[3] = 5;
+  draw(above, by_quads, 0, 0, 0, &st);
+  EXPECT_EQ(st, Status::malformed);
+  fours[3] = 4;
+  Mesh colours = q[0];
+  colours.shading = Shading::mesh_colors;
+  const DrawList mc{pos.data(), static_cast<uint32_t>(pos.size()), &colours, 1};
+  draw(above, mc, 0, 0, 0, &st);
+  EXPECT_NE(st, Status::ok) << "mesh colors take triangles only";
 }
 
 TEST(RenderApi, BandRenderingOf240x180In16LineBandsFitsIn16KiB) {

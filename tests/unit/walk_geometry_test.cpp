@@ -231,10 +231,94 @@ TEST(WalkGeometryRecord, TheClientHoldsWhatThePlanSaysOnATourOfOaDm4) {
       EXPECT_GE(turns, 1) << "frame " << f << " slot " << slot;
     }
   }
+  // Each slot's quad with the next (joins_next) is walk_quad of what both
+  // hold now, kept as sends replace either; most of a map's triangles
+  // pair up (rectangles sent as two triangles).
+  uint32_t joined = 0, filled = 0;
+  for (uint32_t slot = 0; slot < plan.slots; ++slot) {
+    const auto* a = client.triangle(slot);
+    const auto* b = slot + 1 < plan.slots ? client.triangle(slot + 1) : nullptr;
+    filled += a != nullptr;
+    const uint8_t want = a && b ? vds::walk_quad(a, b, kQuantum) : 0;
+    ASSERT_EQ(client.joins_next(slot), want) << "slot " << slot;
+    joined += want != 0;
+  }
+  EXPECT_GT(joined * 5, filled) << joined << " of " << filled << " slots join the next";
   const double kbps = bytes * 8.0 / (coded.chunks.size() / tv.path.fps) / 1000;
   std::printf("oa_dm4, 300 frames: %zu triangles in %u slots, %zu bytes of geometry (%.2f kbit/s, %.1f bits a triangle sent)\n",
               plan.first_sends + plan.resends, plan.slots, bytes, kbps, bytes * 8.0 / (plan.first_sends + plan.resends));
   EXPECT_LT(kbps, 3.0);  // measured 2.24 kbit/s (docs/walkthrough.md)
+}
+
+// Two triangles make one quad when they share an edge, lie in one plane
+// (within the tolerance) and turn one way at all four corners; the code
+// names the outline. Large coordinates do not overflow.
+TEST(WalkQuad, RectanglesInAnyPlaneJoinDartsAndFoldsDoNot) {
+  using P = vds::Vec3<vds::Q16_16>;
+  const auto at = [](double x, double y, double z) {
+    return P{vds::Q16_16::from_raw(static_cast<int32_t>(std::lround(x * 65536))),
+             vds::Q16_16::from_raw(static_cast<int32_t>(std::lround(y * 65536))),
+             vds::Q16_16::from_raw(static_cast<int32_t>(std::lround(z * 65536)))};
+  };
+  const auto same = [](const P& p, const P& q) { return p.x.raw() == q.x.raw() && p.y.raw() == q.y.raw() && p.z.raw() == q.z.raw(); };
+  // The outline a code names: a[i], b[j], a[i + 1], a[i + 2].
+  const auto outline = [](const P* a, const P* b, uint8_t code) {
+    const int i = (code - 1) / 3, j = (code - 1) % 3;
+    return std::array<P, 4>{a[i], b[j], a[(i + 1) % 3], a[(i + 2) % 3]};
+  };
+  // A rectangle in z = 5 split along its diagonal, either way round.
+  const P a[3] = {at(0, 0, 5), at(4, 0, 5), at(4, 3, 5)};
+  const P b[3] = {at(0, 0, 5), at(4, 3, 5), at(0, 3, 5)};
+  const uint8_t q = vds::walk_quad(a, b, 4096);
+  ASSERT_EQ(q, 1 + 3 * 2 + 2);
+  const auto o = outline(a, b, q);
+  EXPECT_TRUE(same(o[0], a[2]) && same(o[1], b[2]) && same(o[2], a[0]) && same(o[3], a[1]));
+  EXPECT_NE(vds::walk_quad(b, a, 4096), 0);
+  // The third corner off the plane: by less than the tolerance, by more.
+  const P near_b[3] = {b[0], b[1], at(0, 3, 5 + 1.0 / 32)};
+  const P off_b[3] = {b[0], b[1], at(0, 3, 5.25)};
+  EXPECT_NE(vds::walk_quad(a, near_b, 4096), 0);
+  EXPECT_EQ(vds::walk_quad(a, off_b, 4096), 0);
+  // A dart (concave at b's third corner), a fold over the shared edge,
+  // one shared corner only, and the same triangle twice.
+  const P dart[3] = {at(4, 3, 5), at(0, 0, 5), at(3, 1, 5)};
+  EXPECT_EQ(vds::walk_quad(a, dart, 4096), 0);
+  const P fold[3] = {at(0, 0, 5), at(4, 3, 5), at(4, -3, 5)};
+  EXPECT_EQ(vds::walk_quad(a, fold, 4096), 0);
+  const P corner[3] = {at(0, 0, 5), at(-4, 0, 5), at(-4, -3, 5)};
+  EXPECT_EQ(vds::walk_quad(a, corner, 4096), 0);
+  EXPECT_EQ(vds::walk_quad(a, a, 4096), 0);
+  // Rectangles in random planes far from the origin, on a 1/16 grid:
+  // their halves join (within the grid's rounding), and not once a
+  // corner leaves the plane by 40 grid steps.
+  vds::test::Xorshift32 rng{99};
+  const auto uni = [&](double lo, double hi) { return lo + (hi - lo) * (rng.next() % 1000001) / 1e6; };
+  int joined = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    double u[3] = {uni(-1, 1), uni(-1, 1), uni(-1, 1)}, w[3] = {uni(-1, 1), uni(-1, 1), uni(-1, 1)};
+    const double nu = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (double& c : u) c /= nu;
+    const double d = w[0] * u[0] + w[1] * u[1] + w[2] * u[2];
+    for (int c = 0; c < 3; ++c) w[c] -= d * u[c];
+    const double nw = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    if (nw < 0.1) continue;
+    for (double& c : w) c /= nw;
+    const double o3[3] = {uni(-20000, 20000), uni(-20000, 20000), uni(-20000, 20000)};
+    const double su = uni(8, 400), sw = uni(8, 400);
+    const auto corner_at = [&](double s, double t, double lift) {
+      const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+      double p[3];
+      for (int c = 0; c < 3; ++c) p[c] = std::round((o3[c] + s * u[c] + t * w[c] + lift * n[c]) * 16) / 16;
+      return at(p[0], p[1], p[2]);
+    };
+    const P ta[3] = {corner_at(0, 0, 0), corner_at(su, 0, 0), corner_at(su, sw, 0)};
+    const P tb[3] = {corner_at(0, 0, 0), corner_at(su, sw, 0), corner_at(0, sw, 0)};
+    const P lifted[3] = {tb[0], tb[1], corner_at(0, sw, 40.0 / 16)};
+    const uint8_t code = vds::walk_quad(ta, tb, 4096);
+    joined += code != 0;
+    EXPECT_EQ(vds::walk_quad(ta, lifted, 4096), 0) << "trial " << trial;
+  }
+  EXPECT_GE(joined, 150);
 }
 
 TEST(WalkGeometryRecord, PrefixesAndGarbageAreRefused) {

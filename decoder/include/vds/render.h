@@ -162,15 +162,16 @@ struct LatticeFace {
   uint8_t res_log2;  // 0..10
 };
 
-// Shading::view_mapped with a view per triangle: triangle t of the mesh
-// (its index in Mesh::indices / 3) is drawn from *tex at homography *out,
-// asked once per polygon set-up, so a caller holding many triangles keeps
-// no homography per triangle (it may keep some: the answer must be the
-// same each time it is asked in a frame). false leaves the triangle
-// undrawn. Every texture it gives has Mesh::texture's format, address
-// mode, apron, size and strides (a texture that differs is not drawn).
+// Shading::view_mapped with a view per face: face t of the mesh (its
+// number in the mesh's order), whose first corner is vertex `first`, is
+// drawn from *tex at homography *out, asked once per polygon set-up, so a
+// caller holding many faces keeps no homography per face (it may keep
+// some: the answer must be the same each time it is asked in a frame).
+// false leaves the face undrawn. Every texture it gives has
+// Mesh::texture's format, address mode, apron, size and strides (a
+// texture that differs is not drawn).
 struct ViewMapSource {
-  bool (*map)(void* ctx, uint32_t t, const Texture** tex, Homography* out) = nullptr;
+  bool (*map)(void* ctx, uint32_t t, uint32_t first, const Texture** tex, Homography* out) = nullptr;
   void* ctx = nullptr;
 };
 
@@ -185,11 +186,19 @@ struct MeshColorsSurface {
   const void* ctx = nullptr;
 };
 
-// Triangles that share one material. Vertex attributes (colors, uvs) are
+// The most corners a face of a mesh may have (Mesh::corners).
+constexpr int kMaxFaceCorners = 4;
+
+// Faces that share one material: triangles, or with `corners` convex
+// planar polygons of 3 to kMaxFaceCorners corners (drawn as one polygon:
+// one set-up, one view homography). Vertex attributes (colors, uvs) are
 // indexed by the same vertex index as DrawList::positions.
+// (The fields are ordered so that a 64-bit host packs them in 104 bytes.)
 struct Mesh {
-  const uint16_t* indices = nullptr;  // 3 per triangle, each < DrawList::num_positions
-  uint32_t num_triangles = 0;
+  const uint16_t* indices = nullptr;  // each face's corners in turn, each < DrawList::num_positions
+  // Per face its number of corners, 3..kMaxFaceCorners; nullptr: 3 each.
+  // Not with Shading::mesh_colors (its faces are triangles).
+  const uint8_t* corners = nullptr;
   Shading shading = Shading::flat;
   Filter filter = Filter::bilinear;
   Cull cull = Cull::back;
@@ -198,7 +207,8 @@ struct Mesh {
   const TexCoord* uvs = nullptr;       // texture: per vertex
   const Texture* texture = nullptr;    // texture, view_mapped
   Homography view_map{};               // view_mapped: screen pixel -> texel (plane_homography(screen, view))
-  const ViewMapSource* views = nullptr;  // view_mapped: instead of texture and view_map per triangle (texture: their form)
+  uint32_t num_triangles = 0;          // faces (triangles unless `corners` says otherwise)
+  const ViewMapSource* views = nullptr;  // view_mapped: instead of texture and view_map per face (texture: their form)
   const MeshColorsSurface* surface = nullptr;  // mesh_colors
 };
 

@@ -138,6 +138,15 @@ uint32_t walk_get_ring_index(ArithDecoder& d, ArithContext* ring_bucket);
 // with the encoder.
 bool walk_predict(const WalkVertexRing& ring, const int32_t prev[3][3], const int32_t cur[3][3], int c, int32_t out[3]);
 
+// Whether triangles a and b (world positions) form one convex planar
+// quad: b shares an edge with a, its third corner lies within `tolerance`
+// (raw Q16.16 world units) of a's plane, and the quad's four corners turn
+// the same way. 0 if not; else 1 + 3 i + j: b's corner j lies between a's
+// corners i and i + 1 (mod 3), so the quad's outline is a[i], b[j],
+// a[i + 1], a[i + 2]. Integer arithmetic only (the same answer on every
+// board).
+uint8_t walk_quad(const Vec3<Q16_16>* a, const Vec3<Q16_16>* b, int32_t tolerance);
+
 class WalkGeometry {
  public:
   static size_t workspace_bytes(uint32_t slots);
@@ -159,8 +168,12 @@ class WalkGeometry {
   const uint16_t* hot() const { return hot_; }  // ascending
   // The slot's triangle (world positions), or nullptr if it holds none.
   const Vec3<Q16_16>* triangle(uint32_t slot) const {
-    return slot < slots_ && filled_[slot] ? &positions_[3 * static_cast<size_t>(slot)] : nullptr;
+    return slot < slots_ && (filled_[slot] & 1) ? &positions_[3 * static_cast<size_t>(slot)] : nullptr;
   }
+  // Whether the slot's triangle and the next slot's form one quad
+  // (walk_quad, within the vertex grid's quantum of one plane): 0 if not
+  // (or either slot is empty), else walk_quad's outline code.
+  uint8_t joins_next(uint32_t slot) const { return slot < slots_ ? static_cast<uint8_t>(filled_[slot] >> 4) : 0; }
   // Every slot's three positions (3 slots() entries; an empty slot's are
   // stale): a draw list's positions, a triangle's vertices 3 slot + k.
   const Vec3<Q16_16>* positions() const { return positions_; }
@@ -171,7 +184,8 @@ class WalkGeometry {
   int32_t quantum_ = 0;
   int fraction_bits_ = 0;
   Vec3<Q16_16>* positions_ = nullptr;  // 3 per slot
-  uint8_t* filled_ = nullptr;
+  uint8_t* filled_ = nullptr;  // per slot: bit 0 holds a triangle, bits 4-7 joins_next
+  void join(uint32_t slot);    // joins_next(slot) anew
   uint16_t* hot_ = nullptr;
   uint16_t* next_hot_ = nullptr;
   uint8_t* mark_ = nullptr;  // per slot, while a frame is decoded

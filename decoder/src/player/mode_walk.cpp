@@ -33,11 +33,14 @@ struct WalkPlay {
   bool pending_refines = false;  // the WVUP names the slot's own camera: its image may be a residual
   bool pending_predicted = false;  // the slot holds the view's prediction: its image may be a residual
   bool image_open = false;
-  // The frame's draw list: one mesh of the triangles drawn, each from the
-  // view and homography frame_map() gives it at its set-up.
-  // 3 a triangle drawn: slot s's vertices are 3 s + k. Before that, the
-  // frame's sort keys (put_key: 4 bytes a hot triangle, 4-byte aligned).
+  // The frame's draw list: one mesh of the faces drawn, each from the
+  // view and homography frame_map() gives it at its set-up: a hot slot's
+  // triangle, or two hot slots' quad (WalkGeometry::joins_next) seen
+  // from one view. Slot s's vertices are 3 s + k; 3 indices a triangle,
+  // 4 a quad (at most 3 a hot slot). Before that, the frame's sort keys
+  // (put_key: 4 bytes a face, 4-byte aligned).
   uint16_t* indices = nullptr;
+  uint8_t* corners = nullptr;  // per face of the draw list: 3 or 4
   uint8_t* view_of = nullptr;
   uint16_t* hot_stamp = nullptr;     // per slot: walk_frame_stamp of the frame it was last hot in
   bool fresh[kWalkMaxViews] = {};    // a view update since the last frame
@@ -172,9 +175,10 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   if (s == Status::ok) s = p.image.init(p.arena());
   if (s == Status::ok) s = wp->renderer.init(render_config(h, w, p.config(), spare.vertices, spare.setups), p.arena());
   wp->indices = static_cast<uint16_t*>(p.arena().alloc(3u * w.slots * sizeof(uint16_t), 4));
+  wp->corners = p.arena().alloc_array<uint8_t>(w.slots);
   wp->view_of = p.arena().alloc_array<uint8_t>(w.slots);
   wp->hot_stamp = p.arena().alloc_array<uint16_t>(w.slots);
-  if (s == Status::ok && (!wp->indices || !wp->view_of || !wp->hot_stamp)) s = Status::workspace_too_small;
+  if (s == Status::ok && (!wp->indices || !wp->corners || !wp->view_of || !wp->hot_stamp)) s = Status::workspace_too_small;
   for (uint8_t v = 0; v < w.views && s == Status::ok; ++v) {
     uint8_t* planes = static_cast<uint8_t*>(p.arena().alloc(plane_bytes(w), 4));
     if (planes == nullptr) {
@@ -213,12 +217,14 @@ bool setup(Player& p, const uint8_t* payload, uint32_t size) {
   return true;
 }
 
-// The draw list of `n` triangles whose indices are in w.indices, drawn
-// from the slots' own positions, each from the view `map` gives it.
-Mesh one_mesh(const WalkPlay& w, uint32_t n, const Texture* form, const ViewMapSource* map) {
+// The draw list of `n` faces whose indices are in w.indices (their
+// corners in `corners`, nullptr: triangles), drawn from the slots' own
+// positions, each from the view `map` gives it.
+Mesh one_mesh(const WalkPlay& w, uint32_t n, const uint8_t* corners, const Texture* form, const ViewMapSource* map) {
   Mesh m;
   m.indices = w.indices;
   m.num_triangles = n;
+  m.corners = corners;
   m.shading = Shading::view_mapped;
   m.filter = Filter::bilinear_luma;  // chroma nearest: a fifth fewer instructions a pixel, 0.03 dB (docs/walkthrough.md)
   m.cull = Cull::none;
@@ -239,8 +245,15 @@ DrawList draw_list(const WalkPlay& w, const Mesh* mesh) {
 void put_indices(WalkPlay& w, uint32_t i, uint32_t slot) {
   for (uint32_t k = 0; k < 3; ++k) w.indices[3 * i + k] = static_cast<uint16_t>(3 * slot + k);
 }
-// The slot of the draw list's triangle t (put_indices).
-uint32_t slot_of(const WalkPlay& w, uint32_t t) { return w.indices[3 * t] / 3u; }
+// The quad of slot and slot + 1 (outline code q of joins_next: the next
+// slot's corner j between the slot's corners i and i + 1) at w.indices[at].
+void put_quad(WalkPlay& w, uint32_t at, uint32_t slot, uint8_t q) {
+  const uint32_t i = (q - 1u) / 3u, j = (q - 1u) % 3u;
+  w.indices[at] = static_cast<uint16_t>(3 * slot + i);
+  w.indices[at + 1] = static_cast<uint16_t>(3 * (slot + 1) + j);
+  w.indices[at + 2] = static_cast<uint16_t>(3 * slot + (i + 1) % 3);
+  w.indices[at + 3] = static_cast<uint16_t>(3 * slot + (i + 2) % 3);
+}
 
 // Sort key i of a frame, in the front of w.indices (whose 6 bytes a
 // triangle hold 4 bytes of key).
@@ -251,11 +264,13 @@ uint32_t key_at(const WalkPlay& w, uint32_t i) {
 }
 void put_key(WalkPlay& w, uint32_t i, uint32_t k) { __builtin_memcpy(reinterpret_cast<uint8_t*>(w.indices) + 4 * size_t{i}, &k, 4); }
 
-// A triangle's key: its centroid's squared distance from `c` as a number
-// with 6 bits of exponent and 12 of mantissa (ordered as the distance),
-// then its slot (14 bits: kWalkMaxSlots).
+// A face's key: its (first) triangle's centroid's squared distance from
+// `c` as a number with 6 bits of exponent and 11 of mantissa (ordered as
+// the distance), whether it is a quad (1 bit), then its slot (14 bits:
+// kWalkMaxSlots).
 static_assert(kWalkMaxSlots <= (1u << 14), "a slot fits a key's low 14 bits");
-uint32_t distance_key(const Vec3<Q16_16>* t, const Vec3<Q16_16>& c, uint32_t slot) {
+constexpr uint32_t kKeyQuad = 1u << 14;
+uint32_t distance_key(const Vec3<Q16_16>* t, const Vec3<Q16_16>& c, uint32_t slot, bool quad) {
   // Quarter units: a map of +-2^13 units keeps every sum below 2^40.
   const auto d = [](Q16_16 a, Q16_16 b, Q16_16 e, Q16_16 o) {
     return ((int64_t{a.raw()} + b.raw() + e.raw()) >> 14) - 3 * int64_t{o.raw() >> 14};
@@ -267,16 +282,26 @@ uint32_t distance_key(const Vec3<Q16_16>* t, const Vec3<Q16_16>& c, uint32_t slo
     e = static_cast<uint32_t>(64 - clz64(d2) - 18);
     d2 >>= e;
   }
-  return (e << 26) | (static_cast<uint32_t>(d2 >> 6) << 14) | slot;
+  return (e << 26) | (static_cast<uint32_t>(d2 >> 7) << 15) | (quad ? kKeyQuad : 0) | slot;
 }
 
-// The frame's hot triangles into w.indices, nearest first: the depth test
-// then turns away most of what lies behind, which costs a fraction of a
-// drawn pixel (docs/walkthrough.md). A heap sort of their keys in place.
-void put_nearest_first(WalkPlay& w, const WalkGeometry& g, const Vec3<Q16_16>& camera) {
+// The frame's faces into w.indices and w.corners, nearest first: the
+// depth test then turns away most of what lies behind, which costs a
+// fraction of a drawn pixel (docs/walkthrough.md). A hot slot whose
+// triangle makes a quad with the next slot's (joins_next), that slot hot
+// too and both from one view, is drawn with it as one face: one set-up
+// and one homography instead of two. A heap sort of the faces' keys in
+// place. Returns the number of faces.
+uint32_t put_nearest_first(WalkPlay& w, const WalkGeometry& g, const Vec3<Q16_16>& camera) {
   const uint16_t* hot = g.hot();
-  const uint32_t n = g.hot_count();
-  for (uint32_t i = 0; i < n; ++i) put_key(w, i, distance_key(g.triangle(hot[i]), camera, hot[i]));
+  const uint32_t hn = g.hot_count();
+  uint32_t n = 0;
+  for (uint32_t i = 0; i < hn; ++i) {
+    const uint32_t s = hot[i];
+    const bool quad = i + 1 < hn && hot[i + 1] == s + 1 && g.joins_next(s) != 0 && w.view_of[s] == w.view_of[s + 1];
+    put_key(w, n++, distance_key(g.triangle(s), camera, s, quad));
+    if (quad) ++i;
+  }
   const auto sift = [&w](uint32_t root, uint32_t end) {
     const uint32_t v = key_at(w, root);
     while (2 * root + 1 < end) {
@@ -296,9 +321,24 @@ void put_nearest_first(WalkPlay& w, const WalkGeometry& g, const Vec3<Q16_16>& c
     put_key(w, end - 1, top);
     sift(0, end - 1);
   }
-  // Keys to indices from the last: triangle i's indices (bytes 6i..6i+5)
-  // never reach a key not yet read (bytes below 4i + 4).
-  for (uint32_t i = n; i-- > 0;) put_indices(w, i, key_at(w, i) & 0x3FFFu);
+  // Keys to indices from the last: face i's indices (from byte 6i: the
+  // faces before it have at least 3 each) never reach a key not yet read
+  // (bytes below 4i).
+  uint32_t at = 0;
+  for (uint32_t i = 0; i < n; ++i) at += (key_at(w, i) & kKeyQuad) ? 4 : 3;
+  for (uint32_t i = n; i-- > 0;) {
+    const uint32_t key = key_at(w, i), slot = key & 0x3FFFu;
+    if (key & kKeyQuad) {
+      at -= 4;
+      put_quad(w, at, slot, g.joins_next(slot));
+      w.corners[i] = 4;
+    } else {
+      at -= 3;
+      for (uint32_t k = 0; k < 3; ++k) w.indices[at + k] = static_cast<uint16_t>(3 * slot + k);
+      w.corners[i] = 3;
+    }
+  }
+  return n;
 }
 
 struct FrameCtx {
@@ -306,12 +346,13 @@ struct FrameCtx {
   const Camera* cam;
 };
 
-// Triangle t of the frame: from the view the stream chose for its slot,
-// at the homography of its plane between the screen and that view.
-bool frame_map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
+// A face of the frame: from the view the stream chose for its (first)
+// slot, at the homography of that slot's plane between the screen and
+// that view (a quad's two triangles share it).
+bool frame_map(void* ctx, uint32_t, uint32_t first, const Texture** tex, Homography* out) {
   const FrameCtx& f = *static_cast<const FrameCtx*>(ctx);
   WalkPlay& w = *f.w;
-  const uint32_t slot = slot_of(w, t);
+  const uint32_t slot = first / 3u;
   const uint8_t v = w.view_of[slot];
   if (v >= kWalkMaxViews || !w.view_ready[v]) return false;
   if (w.pair_state[v] == kUnknown)
@@ -330,13 +371,12 @@ bool frame_map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
 Status draw(Player& p, WalkPlay& w, const WalkPose& pose) {
   Camera cam;
   if (walk_camera(p.header(), pose, &cam) != Status::ok) return Status::malformed;
-  const uint32_t n = p.walk_geometry.hot_count();
-  put_nearest_first(w, p.walk_geometry, cam.position);
+  const uint32_t n = put_nearest_first(w, p.walk_geometry, cam.position);
   for (uint8_t& st : w.pair_state) st = kUnknown;
   for (uint32_t i = 0; i < w.kept; ++i) w.map_state[i] = kUnknown;
   FrameCtx ctx{&w, &cam};
   const ViewMapSource source{frame_map, &ctx};
-  const Mesh mesh = one_mesh(w, n, &w.view_tex[0], &source);
+  const Mesh mesh = one_mesh(w, n, w.corners, &w.view_tex[0], &source);
   return w.renderer.render(cam, draw_list(w, &mesh), 0, detail::render_band_to_player, &p);
 }
 
@@ -405,10 +445,10 @@ struct PredictCtx {
 // Triangle t of a prediction: from its own view when it lies in front of
 // it, else from the first other view it lies in front of (never the slot
 // being predicted), through the view's border.
-bool predict_map(void* ctx, uint32_t t, const Texture** tex, Homography* out) {
+bool predict_map(void* ctx, uint32_t, uint32_t first, const Texture** tex, Homography* out) {
   const PredictCtx& c = *static_cast<const PredictCtx*>(ctx);
   const WalkPlay& w = *c.w;
-  const uint32_t slot_i = slot_of(w, t);
+  const uint32_t slot_i = first / 3u;
   const Vec3<Q16_16>* tri = w.geometry->triangle(slot_i);
   const uint8_t own = w.view_of[slot_i];
   int v = own != c.slot && own < w.params.views && w.view_ready[own] && in_front(w.view_cam[own], tri) ? own : -1;
@@ -439,7 +479,7 @@ Status predict_view(Player& p, WalkPlay& w, int slot, bool* predicted) {
     if (p.walk_geometry.triangle(slot_i) != nullptr) put_indices(w, n++, slot_i);
   PredictCtx ctx{&w, slot};
   const ViewMapSource source{predict_map, &ctx};
-  const Mesh mesh = one_mesh(w, n, &w.bordered[other], &source);
+  const Mesh mesh = one_mesh(w, n, nullptr, &w.bordered[other], &source);
   PredictTarget target{&w.view_tex[slot]};
   constexpr uint32_t kGrey = 0x808080;
   const Status s = w.renderer.render(w.pending_cam, draw_list(w, &mesh), kGrey, predict_band, &target);
@@ -581,7 +621,7 @@ size_t Player::walk_workspace_bytes(const StreamHeader& h, const WalkParams& w, 
   // Each allocation of setup() with its worst alignment slack; the caches
   // a larger workspace adds (spare_caches) are not needed.
   return sizeof(WalkPlay) + alignof(WalkPlay) + WalkGeometry::workspace_bytes(w.slots) + ImageDecoder::kWorkspaceBytes +
-         render_workspace_size(rc) + 3u * w.slots * sizeof(uint16_t) + 4 + w.slots +
+         render_workspace_size(rc) + 3u * w.slots * sizeof(uint16_t) + 4 + 2u * w.slots +
          w.slots * sizeof(uint16_t) + alignof(uint16_t) + w.views * (plane_bytes(w) + 4);
 }
 
