@@ -204,14 +204,17 @@ def frame_of(pattern):
     return max((n for k, n in stack.items() if pattern in k), default=0)
 
 
-# The deepest path of a frame: render -> draw_mesh -> draw_polygon -> a span
-# loop -> row_piece (the largest frame of each step).
+# The deepest path of a frame: render -> draw_mesh -> draw_faces -> draw_face
+# -> draw_polygon -> a span loop -> row_piece (the largest frame of each
+# step; a step the compiler inlined has none).
 # draw_polygon calls prepare_polygon, then draw_prepared (which calls the
 # span loops): the deeper of the two branches counts.
 spans = frame_of("draw_prepared") + max(frame_of("texture_span"), frame_of("gouraud_span"), frame_of("flat_span")) \
     + frame_of("row_piece")
-chain = [("Renderer::render", frame_of("Renderer::render")), ("RenderFrame::draw_mesh", frame_of("draw_mesh")),
+chain = [("Renderer::render", frame_of("Renderer::render")), ("RenderFrame::draw_mesh", frame_of("draw_mesh(")),
+         ("RenderFrame::draw_faces", frame_of("draw_faces(")), ("RenderFrame::draw_face", frame_of("draw_face(")),
          ("draw_polygon", frame_of("draw_polygon"))]
+chain = [(name, n) for name, n in chain if n > 0 or name == "Renderer::render"]
 if frame_of("prepare_polygon") >= spans:
     chain.append(("prepare_polygon", frame_of("prepare_polygon")))
 else:

@@ -112,8 +112,7 @@ Status check_list(const DrawList& list) {
   return Status::ok;
 }
 
-// The corners of face t of m, and of all its faces.
-int face_corners(const Mesh& m, uint32_t t) { return m.corners ? m.corners[t] : 3; }
+// The corners of all of m's faces.
 uint64_t mesh_corners(const Mesh& m) {
   if (!m.corners) return 3 * uint64_t{m.num_triangles};
   uint64_t n = 0;
@@ -298,89 +297,106 @@ struct RenderFrame {
   // clip plane, [0, last band] when its vertices are not all projected.
   void fill_triangle_bands() {
     const uint32_t cap = r.cfg_.triangle_cache;
-    const int32_t bh = r.cfg_.band_height;
-    const uint16_t last_band = static_cast<uint16_t>((r.cfg_.height - 1) / bh);
     uint32_t g = 0;
     for (uint32_t mi = 0; mi < list.num_meshes && g < cap; ++mi) {
       const Mesh& m = list.meshes[mi];
       const uint16_t* idx = m.indices;
       for (uint32_t t = 0; t < m.num_triangles && g < cap; ++t, ++g) {
-        const int n = face_corners(m, t);
-        uint16_t first = 0, last = last_band;
-        // A vertex past the vertex cache is projected here for its face
-        // alone (and again in the bands that draw it).
-        CachedVertex cv[kMaxFaceCorners];
-        uint8_t all = kOutAll, any = 0;
-        for (int k = 0; k < n; ++k) {
-          const uint8_t oc = fetch(idx[k], &cv[k]);
-          all &= oc;
-          any |= oc;
+        const int n = m.corners ? m.corners[t] : 3;
+        if (n == 3) {
+          face_bands<3>(m, idx, g);
+        } else {
+          face_bands<4>(m, idx, g);
         }
         idx += n;
-        if (all & kOutAll) {
-          first = 1;
-          last = 0;
-        } else if (!(any & kNoProjection)) {
-          int32_t lo = cv[0].y, hi = cv[0].y;
-          for (int k = 1; k < n; ++k) {
-            lo = cv[k].y < lo ? cv[k].y : lo;
-            hi = cv[k].y > hi ? cv[k].y : hi;
-          }
-          const int32_t margin = any ? 256 : 0;
-          lo -= margin;
-          hi += margin;
-          // Rows [raster_row(lo), raster_row(hi)), clamped to the screen.
-          int32_t r0 = raster_row(lo), r1 = raster_row(hi);
-          r0 = r0 < 0 ? 0 : r0;
-          r1 = r1 > r.cfg_.height ? r.cfg_.height : r1;
-          if (r0 >= r1) {
-            first = 1;
-            last = 0;
-          } else {
-            first = static_cast<uint16_t>(r0 / bh);
-            last = static_cast<uint16_t>((r1 - 1) / bh);
-            if (any == 0 && !drawable(m, cv, n)) {
-              // Unclipped and off screen sideways, facing away or of zero
-              // area: no band draws it (draw_mesh would reject it in each
-              // of its bands, counting it culled there when on screen).
-              if (on_screen_x(cv, n)) {
-                r.stats_.culled += static_cast<uint32_t>(last - first) + 1;
-              }
-              first = 1;
-              last = 0;
-            }
-          }
-        }
-        r.tri_bands_[2 * g] = first;
-        r.tri_bands_[2 * g + 1] = last;
       }
     }
   }
+  // Triangle cache entry g: the bands of the face of N corners idx[0..N).
+  // (Each per-corner loop below has a constant count, unrolled: set-up
+  // bound scenes visit many faces.)
+  template <int N>
+  void face_bands(const Mesh& m, const uint16_t* idx, uint32_t g) {
+    const int32_t bh = r.cfg_.band_height;
+    uint16_t first = 0, last = static_cast<uint16_t>((r.cfg_.height - 1) / bh);
+    // A vertex past the vertex cache is projected here for its face
+    // alone (and again in the bands that draw it).
+    CachedVertex cv[N];
+    uint8_t all = kOutAll, any = 0;
+#pragma GCC unroll 4
+    for (int k = 0; k < N; ++k) {
+      const uint8_t oc = fetch(idx[k], &cv[k]);
+      all &= oc;
+      any |= oc;
+    }
+    if (all & kOutAll) {
+      first = 1;
+      last = 0;
+    } else if (!(any & kNoProjection)) {
+      int32_t lo = cv[0].y, hi = cv[0].y;
+#pragma GCC unroll 4
+      for (int k = 1; k < N; ++k) {
+        lo = cv[k].y < lo ? cv[k].y : lo;
+        hi = cv[k].y > hi ? cv[k].y : hi;
+      }
+      const int32_t margin = any ? 256 : 0;
+      lo -= margin;
+      hi += margin;
+      // Rows [raster_row(lo), raster_row(hi)), clamped to the screen.
+      int32_t r0 = raster_row(lo), r1 = raster_row(hi);
+      r0 = r0 < 0 ? 0 : r0;
+      r1 = r1 > r.cfg_.height ? r.cfg_.height : r1;
+      if (r0 >= r1) {
+        first = 1;
+        last = 0;
+      } else {
+        first = static_cast<uint16_t>(r0 / bh);
+        last = static_cast<uint16_t>((r1 - 1) / bh);
+        if (any == 0 && !drawable<N>(m, cv)) {
+          // Unclipped and off screen sideways, facing away or of zero
+          // area: no band draws it (draw_mesh would reject it in each
+          // of its bands, counting it culled there when on screen).
+          if (on_screen_x<N>(cv)) {
+            r.stats_.culled += static_cast<uint32_t>(last - first) + 1;
+          }
+          first = 1;
+          last = 0;
+        }
+      }
+    }
+    r.tri_bands_[2 * g] = first;
+    r.tri_bands_[2 * g + 1] = last;
+  }
 
-  // Whether an unclipped face's columns reach the screen, as
-  // prepare_polygon tests them (pixel centres inside its box).
-  bool on_screen_x(const CachedVertex* v, int n) const {
+  // Whether an unclipped face of N corners reaches the screen's columns,
+  // as prepare_polygon tests them (pixel centres inside its box).
+  template <int N>
+  bool on_screen_x(const CachedVertex* v) const {
     int32_t xlo = v[0].x, xhi = v[0].x;
-    for (int k = 1; k < n; ++k) {
+#pragma GCC unroll 4
+    for (int k = 1; k < N; ++k) {
       xlo = v[k].x < xlo ? v[k].x : xlo;
       xhi = v[k].x > xhi ? v[k].x : xhi;
     }
     return raster_row(xhi) > 0 && raster_row(xlo) < r.cfg_.width;
   }
 
-  // Whether an unclipped face can draw anything: on screen sideways,
-  // facing the way the mesh draws and of non-zero area (the same products
-  // as prepare_polygon's fan: its signed area, and some fan triangle's).
-  bool drawable(const Mesh& m, const CachedVertex* v, int n) const {
+  // Whether an unclipped face of N corners can draw anything: on screen
+  // sideways, facing the way the mesh draws and of non-zero area (the same
+  // products as prepare_polygon's fan: its signed area, and some fan
+  // triangle's).
+  template <int N>
+  bool drawable(const Mesh& m, const CachedVertex* v) const {
     int64_t area = 0;
     bool some = false;
-    for (int i = 1; i + 1 < n; ++i) {
+#pragma GCC unroll 4
+    for (int i = 1; i + 1 < N; ++i) {
       const int64_t a = int64_t{v[i].x - v[0].x} * (v[i + 1].y - v[0].y) - int64_t{v[i + 1].x - v[0].x} * (v[i].y - v[0].y);
       area += a;
       some = some || a != 0;
     }
     if (area == 0 || !some || (m.cull == Cull::back && area > 0) || (m.cull == Cull::front && area < 0)) return false;
-    return on_screen_x(v, n);
+    return on_screen_x<N>(v);
   }
 
   uint8_t fetch(uint32_t i, CachedVertex* out) {
@@ -506,38 +522,47 @@ struct RenderFrame {
   }
 
   // Draws mesh m into the band; `first_tri` is the running index of its first
-  // face (for the triangle cache), `band_index` the band's number.
+  // face (for the triangle cache), `band_index` the band's number. Meshes
+  // of triangles take a loop of their own (three corners known: the
+  // per-face loops unrolled, as set-up bound scenes need).
   void draw_mesh(const BandTarget& band, const Mesh& m, uint32_t first_tri, uint16_t band_index) {
+    if (m.corners) {
+      draw_faces<true>(band, m, first_tri, band_index);
+    } else {
+      draw_faces<false>(band, m, first_tri, band_index);
+    }
+  }
+
+  template <bool kFaces>
+  void draw_faces(const BandTarget& band, const Mesh& m, uint32_t first_tri, uint16_t band_index) {
     MaterialCtx mat{&m, num_attribs(m.shading), 0, 0, 3};
     const uint32_t tcap = r.cfg_.triangle_cache;
     const uint16_t* const tb = r.tri_bands_;
-    // A face misses the band when raster_row(ymax) <= y0 or
-    // raster_row(ymin) >= y1, i.e. ymax <= 256 y0 + 128 or ymin >= 256 y1 - 127.
-    const int32_t miss_below = band.y0 * 256 + 128;
-    const int32_t miss_above = band.y1 * 256 - 127;
-    const CachedVertex* const cache = r.cache_;
-    const uint8_t* const cache_oc = r.cache_outcode_;
-    const uint32_t n_cached = cached;
     const uint32_t nt = m.num_triangles;
-    const uint8_t* const corners = m.corners;
+    const uint8_t* const corners = kFaces ? m.corners : nullptr;
     // Faces [0, tc_end) of the mesh are in the triangle cache.
     const uint32_t tc_end = first_tri >= tcap ? 0 : (tcap - first_tri < nt ? tcap - first_tri : nt);
-    const uint16_t* idx = m.indices;  // face t's corners
-    int n = 3;
-    for (uint32_t t = 0; t < nt; ++t, idx += n) {
-      n = corners ? corners[t] : 3;
+    const uint16_t* next = m.indices;  // faces: the corners of the face after the last one drawn or skipped
+    for (uint32_t t = 0; t < nt; ++t) {
       if (t < tc_end) {
         // Most faces miss a band: skip them in a loop of their own.
         const uint16_t* p = tb + 2 * size_t{first_tri + t};
         if (band_index < p[0] || band_index > p[1]) {
           do {
+            if constexpr (kFaces) next += corners[t];
             ++t;
-            idx += n;
-            n = t < nt && corners ? corners[t] : 3;
             p += 2;
           } while (t < tc_end && (band_index < p[0] || band_index > p[1]));
           if (t == nt) break;
         }
+      }
+      // Face t's corners.
+      const uint16_t* idx = m.indices + 3 * size_t{t};
+      int n = 3;
+      if constexpr (kFaces) {
+        n = corners[t];
+        idx = next;
+        next += n;
       }
       const uint32_t g = first_tri + t;
       mat.tri = t;
@@ -554,90 +579,129 @@ struct RenderFrame {
           continue;
         }
       }
-      CachedVertex cv[kMaxFaceCorners];
-      uint8_t all = kOutAll, any = 0;
-      bool in_cache = true;
-      for (int k = 0; k < n; ++k) in_cache = in_cache && idx[k] < n_cached;
-      if (in_cache) {
-        // The common case, kept short: every face is visited once per band.
-        for (int k = 0; k < n; ++k) {
-          const uint8_t oc = cache_oc[idx[k]];
-          all &= oc;
-          any |= oc;
-        }
+      if (n == 3) {
+        draw_face<3>(band, mat, idx, g);
       } else {
-        for (int k = 0; k < n; ++k) {
-          const uint8_t oc = fetch(idx[k], &cv[k]);
-          all &= oc;
-          any |= oc;
-        }
+        draw_face<4>(band, mat, idx, g);
       }
-      if (all & kOutAll) continue;
+    }
+  }
+
+  // Draws face g of N corners idx[0..N) into the band (unless it misses
+  // it, lies outside a clip plane or cannot draw anything). Each
+  // per-corner loop has a constant count, unrolled: set-up bound scenes
+  // visit many faces.
+  template <int N>
+  void draw_face(const BandTarget& band, const MaterialCtx& mat, const uint16_t* idx, uint32_t g) {
+    const Mesh& m = *mat.mesh;
+    // A face misses the band when raster_row(ymax) <= y0 or
+    // raster_row(ymin) >= y1, i.e. ymax <= 256 y0 + 128 or ymin >= 256 y1 - 127.
+    const int32_t miss_below = band.y0 * 256 + 128;
+    const int32_t miss_above = band.y1 * 256 - 127;
+    const CachedVertex* const cache = r.cache_;
+    CachedVertex cv[N];
+    uint8_t all = kOutAll, any = 0;
+    // Whether rows [lo, hi] (Q24.8) miss the band. Clipped vertices are
+    // rounded on their own, so a clipped face's bound is widened by a
+    // pixel (the picture must not depend on which band a face is tested
+    // against).
+    const auto misses = [&](int32_t lo, int32_t hi) {
+      const int32_t margin = any ? 256 : 0;
+      return hi + margin <= miss_below || lo - margin >= miss_above;
+    };
+    bool in_cache = true;
+#pragma GCC unroll 4
+    for (int k = 0; k < N; ++k) in_cache = in_cache && idx[k] < cached;
+    if (in_cache) {
+      // The common case, kept short: every face is visited once per
+      // band, and most that get here miss it.
+#pragma GCC unroll 4
+      for (int k = 0; k < N; ++k) {
+        const uint8_t oc = r.cache_outcode_[idx[k]];
+        all &= oc;
+        any |= oc;
+      }
+      if (all & kOutAll) return;
       if (!(any & kNoProjection)) {
-        int32_t lo = INT32_MAX, hi = INT32_MIN;
-        for (int k = 0; k < n; ++k) {
-          const int32_t y = in_cache ? cache[idx[k]].y : cv[k].y;
+        int32_t lo = cache[idx[0]].y, hi = lo;
+#pragma GCC unroll 4
+        for (int k = 1; k < N; ++k) {
+          const int32_t y = cache[idx[k]].y;
           lo = y < lo ? y : lo;
           hi = y > hi ? y : hi;
         }
-        // Clipped vertices are rounded on their own, so a clipped
-        // face's bound is widened by a pixel (the picture must not
-        // depend on which band a face is tested against).
-        const int32_t margin = any ? 256 : 0;
-        if (hi + margin <= miss_below || lo - margin >= miss_above) continue;
+        if (misses(lo, hi)) return;
       }
-      if (in_cache)
-        for (int k = 0; k < n; ++k) cv[k] = cache[idx[k]];
-      // The clipper's scratch array is free once it has run, and the direct
-      // path needs no clipping: one store serves both (a small stack).
-      union Scratch {
-        ClipVertex clip[kMaxPolyVerts];
-        ScreenVertex screen[kMaxPolyVerts];
-      } scratch;
-      if (any == 0) {
-        // Off screen sideways, facing and zero area first, as
-        // prepare_polygon decides them (the same products): a rejected
-        // face costs no vertex copies, no set-up and no set-up cache
-        // slot. It counts as culled where prepare_polygon would count it.
-        // (Faces in the triangle cache were tested once per frame.)
-        if (!drawable(m, cv, n)) {
-          if (on_screen_x(cv, n)) ++r.stats_.culled;  // then it faces away or has no area
-          continue;
+#pragma GCC unroll 4
+      for (int k = 0; k < N; ++k) cv[k] = cache[idx[k]];
+    } else {
+#pragma GCC unroll 4
+      for (int k = 0; k < N; ++k) {
+        const uint8_t oc = fetch(idx[k], &cv[k]);
+        all &= oc;
+        any |= oc;
+      }
+      if (all & kOutAll) return;
+      if (!(any & kNoProjection)) {
+        int32_t lo = cv[0].y, hi = lo;
+#pragma GCC unroll 4
+        for (int k = 1; k < N; ++k) {
+          lo = cv[k].y < lo ? cv[k].y : lo;
+          hi = cv[k].y > hi ? cv[k].y : hi;
         }
-        ScreenVertex* sv = scratch.screen;
-        for (int k = 0; k < n; ++k) {
-          sv[k].x = cv[k].x;
-          sv[k].y = cv[k].y;
-          sv[k].q = cv[k].q;
-          attributes(m, idx[k], k, sv[k].a);
-        }
-        draw(band, mat, sv, n, g, false);
-        continue;
+        if (misses(lo, hi)) return;
       }
-      ++r.stats_.clipped;
-      ClipVertex in[kMaxFaceCorners], out[kMaxPolyVerts];
-      for (int k = 0; k < n; ++k) {
-        in[k] = camera_vertex(idx[k]);
-        attributes(m, idx[k], k, in[k].a);
-      }
-      const int nc = clip_polygon(fc, static_cast<uint8_t>(any & kOutAll), in, n, out, scratch.clip, mat.num_attribs);
-      if (nc < 3) {
-        if (g < r.cfg_.triangle_cache) set_triangle_rows(g, 0, 0);  // nothing left in any band
-        continue;
+    }
+    // The clipper's scratch array is free once it has run, and the direct
+    // path needs no clipping: one store serves both (a small stack).
+    union Scratch {
+      ClipVertex clip[kMaxPolyVerts];
+      ScreenVertex screen[kMaxPolyVerts];
+    } scratch;
+    if (any == 0) {
+      // Off screen sideways, facing and zero area first, as
+      // prepare_polygon decides them (the same products): a rejected
+      // face costs no vertex copies, no set-up and no set-up cache
+      // slot. It counts as culled where prepare_polygon would count it.
+      // (Faces in the triangle cache were tested once per frame.)
+      if (!drawable<N>(m, cv)) {
+        if (on_screen_x<N>(cv)) ++r.stats_.culled;  // then it faces away or has no area
+        return;
       }
       ScreenVertex* sv = scratch.screen;
-      bool ok = true;
-      for (int k = 0; k < nc && ok; ++k) {
-        const Vec3<Q16_16> p{Q16_16::from_raw(out[k].x), Q16_16::from_raw(out[k].y), Q16_16::from_raw(out[k].z)};
-        ok = camera_project(*fc.cam, p, &sv[k].x, &sv[k].y);
-        sv[k].q = depth_q(fc, out[k].z);
-        for (int j = 0; j < kMaxAttribs; ++j) sv[k].a[j] = out[k].a[j];
+#pragma GCC unroll 4
+      for (int k = 0; k < N; ++k) {
+        sv[k].x = cv[k].x;
+        sv[k].y = cv[k].y;
+        sv[k].q = cv[k].q;
+        attributes(m, idx[k], k, sv[k].a);
       }
-      if (ok) {
-        draw(band, mat, sv, nc, g, true);
-      } else if (g < r.cfg_.triangle_cache) {
-        set_triangle_rows(g, 0, 0);
-      }
+      draw(band, mat, sv, N, g, false);
+      return;
+    }
+    ++r.stats_.clipped;
+    ClipVertex in[N], out[kMaxPolyVerts];
+    for (int k = 0; k < N; ++k) {
+      in[k] = camera_vertex(idx[k]);
+      attributes(m, idx[k], k, in[k].a);
+    }
+    const int nc = clip_polygon(fc, static_cast<uint8_t>(any & kOutAll), in, N, out, scratch.clip, mat.num_attribs);
+    if (nc < 3) {
+      if (g < r.cfg_.triangle_cache) set_triangle_rows(g, 0, 0);  // nothing left in any band
+      return;
+    }
+    ScreenVertex* sv = scratch.screen;
+    bool ok = true;
+    for (int k = 0; k < nc && ok; ++k) {
+      const Vec3<Q16_16> p{Q16_16::from_raw(out[k].x), Q16_16::from_raw(out[k].y), Q16_16::from_raw(out[k].z)};
+      ok = camera_project(*fc.cam, p, &sv[k].x, &sv[k].y);
+      sv[k].q = depth_q(fc, out[k].z);
+      for (int j = 0; j < kMaxAttribs; ++j) sv[k].a[j] = out[k].a[j];
+    }
+    if (ok) {
+      draw(band, mat, sv, nc, g, true);
+    } else if (g < r.cfg_.triangle_cache) {
+      set_triangle_rows(g, 0, 0);
     }
   }
 };

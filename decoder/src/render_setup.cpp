@@ -103,8 +103,8 @@ int32_t floor_div32(int32_t a, int32_t b) {  // b > 0; a hardware division on Co
 struct PreparedPolygon {
   PolySetup s;
   SpanFn fn;                        // nullptr: nothing to draw (culled, off screen, compiled out)
-  int32_t row_begin, row_end;       // rows [row_begin, row_end) the polygon can cover
-  int32_t n;                        // outline vertices
+  int16_t row_begin, row_end;       // rows [row_begin, row_end) the polygon can cover (|row| <= 2^13: kRasterCoordLimit)
+  uint8_t n;                        // outline vertices
   bool culled;                      // facing or zero area (counted per band it touches)
   bool set_up;                      // planes computed (counted per band it touches)
   bool whole;                       // rasterised as one convex polygon (a face of more than 3 corners), else as a fan
@@ -128,13 +128,14 @@ bool place(const PolygonTarget& target, const ScreenVertex* v, int n, PreparedPo
     ymin = v[i].y < ymin ? v[i].y : ymin;
     ymax = v[i].y > ymax ? v[i].y : ymax;
   }
-  pp->row_begin = raster_row(ymin);
-  pp->row_end = raster_row(ymax);
   *x_min = xmin;
   *x_max = xmax;
   if (xmin < -kRasterCoordLimit || xmax > kRasterCoordLimit || ymin < -kRasterCoordLimit || ymax > kRasterCoordLimit) {
+    pp->row_begin = pp->row_end = 0;
     return false;  // cannot happen after guard-band clipping; kept as a hard limit
   }
+  pp->row_begin = static_cast<int16_t>(raster_row(ymin));
+  pp->row_end = static_cast<int16_t>(raster_row(ymax));
   if (raster_row(xmax) <= 0 || raster_row(xmin) >= target.width) return false;
   for (int i = 0; i < n; ++i) pp->outline[i] = {v[i].x, v[i].y};
   return true;
@@ -430,7 +431,7 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   pp->culled = false;
   pp->set_up = false;
   pp->whole = mat.corners > 3;
-  pp->n = n;
+  pp->n = static_cast<uint8_t>(n);
   int32_t xmin, xmax;
   if (!place(target, v, n, pp, &xmin, &xmax)) return;
   const Fan fan = fan_triangle(v, n);
