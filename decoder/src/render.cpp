@@ -74,6 +74,14 @@ Status check_texture(const Texture* t) {
   return Status::ok;
 }
 
+// The corners of all of m's faces (below 2^31: check_list bounds the faces).
+uint32_t mesh_corners(const Mesh& m) {
+  if (!m.corners) return 3 * m.num_triangles;
+  uint32_t n = 0;
+  for (uint32_t t = 0; t < m.num_triangles; ++t) n += m.corners[t];
+  return n;
+}
+
 Status check_list(const DrawList& list) {
   if (list.num_positions > 65536) return Status::malformed;
   if (list.num_positions && (list.positions == nullptr) == (list.grid == nullptr)) return Status::invalid_argument;
@@ -87,14 +95,10 @@ Status check_list(const DrawList& list) {
     if (m.num_triangles == 0) continue;
     if (!m.indices || m.num_triangles > 0x7FFFFFFFu / kMaxFaceCorners) return Status::malformed;
     if (m.corners && m.shading == Shading::mesh_colors) return Status::invalid_argument;
-    uint32_t count = m.num_triangles * 3;
-    if (m.corners) {
-      count = 0;
-      for (uint32_t t = 0; t < m.num_triangles; ++t) {
+    if (m.corners)
+      for (uint32_t t = 0; t < m.num_triangles; ++t)
         if (m.corners[t] < 3 || m.corners[t] > kMaxFaceCorners) return Status::malformed;
-        count += m.corners[t];
-      }
-    }
+    const uint32_t count = mesh_corners(m);
     for (uint32_t k = 0; k < count; ++k) {
       if (m.indices[k] >= list.num_positions) return Status::malformed;
     }
@@ -110,14 +114,6 @@ Status check_list(const DrawList& list) {
     }
   }
   return Status::ok;
-}
-
-// The corners of all of m's faces.
-uint64_t mesh_corners(const Mesh& m) {
-  if (!m.corners) return 3 * uint64_t{m.num_triangles};
-  uint64_t n = 0;
-  for (uint32_t t = 0; t < m.num_triangles; ++t) n += m.corners[t];
-  return n;
 }
 
 int num_attribs(Shading s) {
@@ -284,8 +280,8 @@ struct RenderFrame {
     for (uint32_t i = 0; i < n; ++i) oc[i] = kUnprojected;
     for (uint32_t mi = 0; mi < list.num_meshes; ++mi) {
       const Mesh& m = list.meshes[mi];
-      const uint64_t count = mesh_corners(m);
-      for (uint64_t k = 0; k < count; ++k) {
+      const uint32_t count = mesh_corners(m);
+      for (uint32_t k = 0; k < count; ++k) {
         const uint32_t i = m.indices[k];
         if (i < n && oc[i] == kUnprojected) oc[i] = project(i, &r.cache_[i]);
       }
@@ -312,6 +308,19 @@ struct RenderFrame {
       }
     }
   }
+  // The least and greatest of field F (x or y) over N vertices.
+  template <int N, int32_t CachedVertex::*F>
+  static void extent(const CachedVertex* v, int32_t* lo, int32_t* hi) {
+    int32_t l = v[0].*F, h = l;
+#pragma GCC unroll 4
+    for (int k = 1; k < N; ++k) {
+      l = v[k].*F < l ? v[k].*F : l;
+      h = v[k].*F > h ? v[k].*F : h;
+    }
+    *lo = l;
+    *hi = h;
+  }
+
   // Triangle cache entry g: the bands of the face of N corners idx[0..N).
   // (Each per-corner loop below has a constant count, unrolled: set-up
   // bound scenes visit many faces.)
@@ -333,12 +342,8 @@ struct RenderFrame {
       first = 1;
       last = 0;
     } else if (!(any & kNoProjection)) {
-      int32_t lo = cv[0].y, hi = cv[0].y;
-#pragma GCC unroll 4
-      for (int k = 1; k < N; ++k) {
-        lo = cv[k].y < lo ? cv[k].y : lo;
-        hi = cv[k].y > hi ? cv[k].y : hi;
-      }
+      int32_t lo, hi;
+      extent<N, &CachedVertex::y>(cv, &lo, &hi);
       const int32_t margin = any ? 256 : 0;
       lo -= margin;
       hi += margin;
@@ -372,12 +377,8 @@ struct RenderFrame {
   // as prepare_polygon tests them (pixel centres inside its box).
   template <int N>
   bool on_screen_x(const CachedVertex* v) const {
-    int32_t xlo = v[0].x, xhi = v[0].x;
-#pragma GCC unroll 4
-    for (int k = 1; k < N; ++k) {
-      xlo = v[k].x < xlo ? v[k].x : xlo;
-      xhi = v[k].x > xhi ? v[k].x : xhi;
-    }
+    int32_t xlo, xhi;
+    extent<N, &CachedVertex::x>(v, &xlo, &xhi);
     return raster_row(xhi) > 0 && raster_row(xlo) < r.cfg_.width;
   }
 
@@ -643,12 +644,8 @@ struct RenderFrame {
       }
       if (all & kOutAll) return;
       if (!(any & kNoProjection)) {
-        int32_t lo = cv[0].y, hi = lo;
-#pragma GCC unroll 4
-        for (int k = 1; k < N; ++k) {
-          lo = cv[k].y < lo ? cv[k].y : lo;
-          hi = cv[k].y > hi ? cv[k].y : hi;
-        }
+        int32_t lo, hi;
+        extent<N, &CachedVertex::y>(cv, &lo, &hi);
         if (misses(lo, hi)) return;
       }
     }

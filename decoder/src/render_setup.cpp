@@ -526,21 +526,18 @@ void draw_prepared(const BandTarget& band, const PreparedPolygon& pp, RenderStat
   if (!fn) return;
   const PolySetup& s = pp.s;
   const RasterVertex* o = pp.outline;
+  const auto span = [&](int32_t y, int32_t xa, int32_t xb) {
+    fn(band, s, y, xa, xb);
+    ++stats.spans;
+    stats.pixels += static_cast<uint32_t>(xb - xa);
+  };
   if (pp.whole) {
-    raster_convex(o, pp.n, band.y0, band.y1, band.width, [&](int32_t y, int32_t xa, int32_t xb) {
-      fn(band, s, y, xa, xb);
-      ++stats.spans;
-      stats.pixels += static_cast<uint32_t>(xb - xa);
-    });
+    raster_convex(o, pp.n, band.y0, band.y1, band.width, span);
     return;
   }
   for (int i = 1; i + 1 < pp.n; ++i) {
     const RasterVertex rv[3] = {o[0], o[i], o[i + 1]};
-    raster_triangle(rv, band.y0, band.y1, band.width, [&](int32_t y, int32_t xa, int32_t xb) {
-      fn(band, s, y, xa, xb);
-      ++stats.spans;
-      stats.pixels += static_cast<uint32_t>(xb - xa);
-    });
+    raster_triangle(rv, band.y0, band.y1, band.width, span);
   }
 }
 

@@ -770,14 +770,28 @@ TEST(RenderApi, AViewPerTriangleFromASourceDrawsWhatAMeshPerTriangleDraws) {
   EXPECT_EQ(status, Status::malformed);
 }
 
-// A band sink appending an RGB565 band's rows to a std::vector<uint16_t>.
-bool append_rgb565_band(void* ctx, const Band& b) {
-  auto* f = static_cast<std::vector<uint16_t>*>(ctx);
-  for (int y = 0; y < b.height; ++y) {
-    const auto* row = reinterpret_cast<const uint16_t*>(b.pixels + y * b.stride);
-    f->insert(f->end(), row, row + b.width);
-  }
-  return true;
+// The RGB565 frame a renderer of `cfg` (its own workspace) draws of
+// `list`, its status in *st and, if asked, its statistics in *stats.
+std::vector<uint16_t> render_rgb565(const RenderConfig& cfg, const Camera& cam, const DrawList& list, Status* st,
+                                    RenderStats* stats = nullptr) {
+  std::vector<uint8_t> ws(render_workspace_size(cfg));
+  Arena arena(ws.data(), ws.size());
+  Renderer r;
+  EXPECT_EQ(r.init(cfg, arena), Status::ok);
+  std::vector<uint16_t> frame;
+  *st = r.render(
+      cam, list, 0,
+      [](void* ctx, const Band& b) {
+        auto* f = static_cast<std::vector<uint16_t>*>(ctx);
+        for (int y = 0; y < b.height; ++y) {
+          const auto* row = reinterpret_cast<const uint16_t*>(b.pixels + y * b.stride);
+          f->insert(f->end(), row, row + b.width);
+        }
+        return true;
+      },
+      &frame);
+  if (stats) *stats = r.stats();
+  return frame;
 }
 
 // Grid positions ((g << grid_shift) + grid_origin) draw exactly what the
@@ -828,17 +842,10 @@ TEST(RenderApi, GridPositionsDrawWhatTheirWorldPositionsDraw) {
       cfg.band_height = 8;
       cfg.vertex_cache = cache;
       cfg.triangle_cache = cache;
-      std::vector<uint8_t> ws(render_workspace_size(cfg));
       auto draw = [&](const DrawList& list) {
-        Arena arena(ws.data(), ws.size());
-        Renderer r;
-        EXPECT_EQ(r.init(cfg, arena), Status::ok);
-        std::vector<uint16_t> frame;
-        EXPECT_EQ(r.render(
-                      cam, list, 0,
-                      append_rgb565_band,
-                      &frame),
-                  Status::ok);
+        Status st = Status::ok;
+        std::vector<uint16_t> frame = render_rgb565(cfg, cam, list, &st);
+        EXPECT_EQ(st, Status::ok);
         return frame;
       };
       const std::vector<uint16_t> a = draw(by_world), b = draw(by_grid);
@@ -893,7 +900,7 @@ TEST(RenderApi, QuadFacesCoverWhatTheirTrianglePairsCover) {
   const Mesh t[2] = {mesh(pairs[0], false, 0xE0A020), mesh(pairs[1], false, 0x2040C0)};
   const DrawList by_quads{pos.data(), static_cast<uint32_t>(pos.size()), q, 2};
   const DrawList by_pairs{pos.data(), static_cast<uint32_t>(pos.size()), t, 2};
-  uint32_t clipped = 0;  // of the last frame drawn
+  RenderStats stats;  // of the last frame drawn
   const auto draw = [&](const Camera& cam, const DrawList& list, uint32_t vc, uint32_t tc, uint32_t sc, Status* st) {
     RenderConfig cfg;
     cfg.width = 96;
@@ -902,17 +909,7 @@ TEST(RenderApi, QuadFacesCoverWhatTheirTrianglePairsCover) {
     cfg.vertex_cache = vc;
     cfg.triangle_cache = tc;
     cfg.setup_cache = sc;
-    std::vector<uint8_t> ws(render_workspace_size(cfg));
-    Arena arena(ws.data(), ws.size());
-    Renderer r;
-    EXPECT_EQ(r.init(cfg, arena), Status::ok);
-    std::vector<uint16_t> frame;
-    *st = r.render(
-        cam, list, 0,
-        append_rgb565_band,
-        &frame);
-    clipped = r.stats().clipped;
-    return frame;
+    return render_rgb565(cfg, cam, list, st, &stats);
   };
   Status st = Status::ok;
   const Camera above = ref::to_client(ref::CameraD::look_at({0.3, 3.2, -2.9}, {0, 0, 0.2}, {0, 1, 0}, 96, 72, 60, 0.1, 20));
@@ -920,7 +917,7 @@ TEST(RenderApi, QuadFacesCoverWhatTheirTrianglePairsCover) {
   for (const Camera* cam : {&above, &inside}) {
     const std::vector<uint16_t> want = draw(*cam, by_pairs, 1000, 1000, 8, &st);
     ASSERT_EQ(st, Status::ok);
-    if (cam == &inside) EXPECT_GT(clipped, 4u) << "the near plane cuts quads";
+    if (cam == &inside) EXPECT_GT(stats.clipped, 4u) << "the near plane cuts quads";
     EXPECT_GT(std::count_if(want.begin(), want.end(), [](uint16_t p) { return p != 0; }), 96 * 72 / 3);
     for (const auto& [vc, tc, sc] : {std::tuple{1000u, 1000u, 8u}, std::tuple{40u, 1000u, 2u}, std::tuple{40u, 30u, 0u},
                                      std::tuple{0u, 0u, 0u}, std::tuple{1000u, 1000u, 200u}}) {

@@ -242,8 +242,9 @@ DrawList draw_list(const WalkPlay& w, const Mesh* mesh) {
   return list;
 }
 
-void put_indices(WalkPlay& w, uint32_t i, uint32_t slot) {
-  for (uint32_t k = 0; k < 3; ++k) w.indices[3 * i + k] = static_cast<uint16_t>(3 * slot + k);
+// The slot's triangle at w.indices[at].
+void put_triangle(WalkPlay& w, uint32_t at, uint32_t slot) {
+  for (uint32_t k = 0; k < 3; ++k) w.indices[at + k] = static_cast<uint16_t>(3 * slot + k);
 }
 // The quad of slot and slot + 1 (outline code q of joins_next: the next
 // slot's corner j between the slot's corners i and i + 1) at w.indices[at].
@@ -255,8 +256,8 @@ void put_quad(WalkPlay& w, uint32_t at, uint32_t slot, uint8_t q) {
   w.indices[at + 3] = static_cast<uint16_t>(3 * slot + (i + 2) % 3);
 }
 
-// Sort key i of a frame, in the front of w.indices (whose 6 bytes a
-// triangle hold 4 bytes of key).
+// Sort key i of a frame, in the front of w.indices (whose 6 bytes a hot
+// slot hold a face's 4 bytes of key).
 uint32_t key_at(const WalkPlay& w, uint32_t i) {
   uint32_t k;
   __builtin_memcpy(&k, reinterpret_cast<const uint8_t*>(w.indices) + 4 * size_t{i}, 4);
@@ -334,7 +335,7 @@ uint32_t put_nearest_first(WalkPlay& w, const WalkGeometry& g, const Vec3<Q16_16
       w.corners[i] = 4;
     } else {
       at -= 3;
-      for (uint32_t k = 0; k < 3; ++k) w.indices[at + k] = static_cast<uint16_t>(3 * slot + k);
+      put_triangle(w, at, slot);
       w.corners[i] = 3;
     }
   }
@@ -476,7 +477,7 @@ Status predict_view(Player& p, WalkPlay& w, int slot, bool* predicted) {
   if (other < 0) return Status::ok;
   uint32_t n = 0;
   for (uint32_t slot_i = 0; slot_i < w.params.slots; ++slot_i)
-    if (p.walk_geometry.triangle(slot_i) != nullptr) put_indices(w, n++, slot_i);
+    if (p.walk_geometry.triangle(slot_i) != nullptr) put_triangle(w, 3 * n++, slot_i);
   PredictCtx ctx{&w, slot};
   const ViewMapSource source{predict_map, &ctx};
   const Mesh mesh = one_mesh(w, n, nullptr, &w.bordered[other], &source);
