@@ -18,8 +18,6 @@ namespace {
 
 constexpr int kNormBits = 30;  // entries normalised below 2^30
 
-int bitlen64(uint64_t v) { return 64 - clz64(v); }
-uint64_t abs64(int64_t v) { return v < 0 ? 0 - static_cast<uint64_t>(v) : static_cast<uint64_t>(v); }
 
 // v * 2^-s for s >= 0 rounded to nearest, v * 2^|s| for s < 0 (caller keeps
 // the result in range).

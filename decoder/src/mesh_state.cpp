@@ -5,6 +5,7 @@
 // (docs/mesh-codec.md). Integer only; shared with the encoder.
 #include <cstring>
 
+#include "vds/fixed.h"
 #include "vds/mesh.h"
 
 namespace vds {
@@ -18,8 +19,6 @@ int64_t div_floor(int64_t n, int64_t d) {
 
 // round(n / d), halves toward +infinity, for d > 0.
 int64_t div_round(int64_t n, int64_t d) { return div_floor(2 * n + d, 2 * d); }
-
-int64_t abs64(int64_t v) { return v < 0 ? -v : v; }
 
 size_t aligned(size_t bytes) { return bytes + alignof(uint32_t); }
 

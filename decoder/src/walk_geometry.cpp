@@ -45,8 +45,6 @@ uint32_t walk_get_ring_index(ArithDecoder& d, ArithContext* ring_bucket) {
 }
 
 namespace {
-int bitlen(uint64_t v) { return v == 0 ? 0 : 64 - clz64(v); }
-uint64_t mag(int64_t v) { return v < 0 ? 0 - static_cast<uint64_t>(v) : static_cast<uint64_t>(v); }
 bool same_point(const Vec3<Q16_16>& p, const Vec3<Q16_16>& q) {
   return p.x.raw() == q.x.raw() && p.y.raw() == q.y.raw() && p.z.raw() == q.z.raw();
 }
@@ -77,24 +75,24 @@ uint8_t walk_quad(const Vec3<Q16_16>* a, const Vec3<Q16_16>* b, int32_t toleranc
   for (int k = 1; k < 4; ++k)
     for (int c = 0; c < 3; ++c) {
       d[k][c] = int64_t{(&p[k]->x)[c].raw()} - (&p[0]->x)[c].raw();
-      most = mag(d[k][c]) > most ? mag(d[k][c]) : most;
+      most = abs64(d[k][c]) > most ? abs64(d[k][c]) : most;
     }
-  const int s = bitlen(most) > 20 ? bitlen(most) - 20 : 0;
+  const int s = bitlen64(most) > 20 ? bitlen64(most) - 20 : 0;
   for (int k = 1; k < 4; ++k)
     for (int c = 0; c < 3; ++c) d[k][c] >>= s;
   // a's normal from p0: (p2 - p0) x (p3 - p0), each entry below 2^41.
   const int64_t n[3] = {d[2][1] * d[3][2] - d[2][2] * d[3][1], d[2][2] * d[3][0] - d[2][0] * d[3][2],
                         d[2][0] * d[3][1] - d[2][1] * d[3][0]};
   int axis = 0;
-  for (int c = 1; c < 3; ++c) axis = mag(n[c]) > mag(n[axis]) ? c : axis;
-  const uint64_t nmax = mag(n[axis]);
+  for (int c = 1; c < 3; ++c) axis = abs64(n[c]) > abs64(n[axis]) ? c : axis;
+  const uint64_t nmax = abs64(n[axis]);
   if (nmax == 0) return 0;
   // b's third corner within the tolerance of the plane: |n . d1| / |n| <=
   // tol, tested as |n . d1| <= tol max|n_c| (|n| >= max|n_c|).
   int64_t tol = tolerance >> s;
   tol = tol < 2 ? 2 : (tol > (int64_t{1} << 20) ? (int64_t{1} << 20) : tol);
   const int64_t off = n[0] * d[1][0] + n[1] * d[1][1] + n[2] * d[1][2];  // < 3 * 2^61
-  if (mag(off) > static_cast<uint64_t>(tol) * nmax) return 0;
+  if (abs64(off) > static_cast<uint64_t>(tol) * nmax) return 0;
   // Convex: the turns at the four corners all one way, in the plane of the
   // two axes other than the normal's largest.
   const int u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;

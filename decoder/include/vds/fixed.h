@@ -46,6 +46,11 @@ constexpr int clz64(uint64_t x) {
   return hi ? clz32(hi) : 32 + clz32(static_cast<uint32_t>(x));
 }
 
+// Bits needed for v (0 for zero).
+constexpr int bitlen64(uint64_t v) { return 64 - clz64(v); }
+// |v| as an unsigned value (exact for INT64_MIN too).
+constexpr uint64_t abs64(int64_t v) { return v < 0 ? 0 - static_cast<uint64_t>(v) : static_cast<uint64_t>(v); }
+
 // floor(log2(x)); -1 for zero.
 constexpr int ilog2(uint32_t x) { return 31 - clz32(x); }
 constexpr int ilog2_64(uint64_t x) { return 63 - clz64(x); }
