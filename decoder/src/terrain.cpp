@@ -70,31 +70,27 @@ int16_t dequantise(int level, int natural_index, int quantiser) {
   return static_cast<int16_t>(c);
 }
 
-uint32_t BlockGrid::first(int level, int comp) const {
-  // Level 1 (Y', Cb, Cr), then level 0.
-  uint32_t at = 0;
-  for (int l = 1; l >= 0; --l)
-    for (int c = 0; c < 3; ++c) {
-      if (l == level && c == comp) return at;
-      at += plane_blocks(l, c);
-    }
-  return at;
-}
-
 BlockPlace BlockGrid::place(uint32_t id) const {
   BlockPlace p;
-  for (int l = 1; l >= 0; --l)
-    for (int c = 0; c < 3; ++c) {
-      const uint32_t n = plane_blocks(l, c);
-      if (id < n) {
-        p.level = static_cast<uint8_t>(l);
-        p.comp = static_cast<uint8_t>(c);
-        p.bx = static_cast<uint16_t>(id % plane_w(l, c));
-        p.by = static_cast<uint16_t>(id / plane_w(l, c));
-        return p;
+  for (int l = 1; l >= 0; --l) {
+    const uint32_t ny = plane_blocks(l, 0), nc = plane_blocks(l, 1);
+    int c = 0;
+    if (id >= ny) {
+      id -= ny;
+      c = 1 + (id >= nc);
+      if (c == 2) id -= nc;
+      if (id >= nc) {
+        id -= nc;
+        continue;
       }
-      id -= n;
     }
+    const uint32_t w = plane_w(l, c);
+    p.level = static_cast<uint8_t>(l);
+    p.comp = static_cast<uint8_t>(c);
+    p.bx = static_cast<uint16_t>(id % w);
+    p.by = static_cast<uint16_t>(id / w);
+    return p;
+  }
   return p;
 }
 
@@ -177,6 +173,47 @@ void fill_from_coarse(int w, int h, uint16_t* out) {
       out[static_cast<size_t>(y) * w + x] = static_cast<uint16_t>((num + den / 2) / den);
     }
   }
+}
+
+namespace {
+// step_error in T: int32_t when every product fits (W H <= 2^12, heights
+// below 2^16: each term below 2^28), else int64_t.
+template <class T>
+uint16_t step_error_in(const uint16_t* heights, int w, int i0, int j0, int ni, int nj, int s) {
+  auto h = [&](int i, int j) { return T{heights[static_cast<size_t>(j) * static_cast<size_t>(w) + static_cast<size_t>(i)]}; };
+  T worst = 0;
+  for (int ja = j0; ja < j0 + nj; ja += s) {
+    const int jc = ja + s < j0 + nj ? ja + s : j0 + nj;
+    const T H = jc - ja;
+    const int j_last = H < s ? jc : jc - 1;
+    for (int ia = i0; ia < i0 + ni; ia += s) {
+      const int ib = ia + s < i0 + ni ? ia + s : i0 + ni;
+      const T W = ib - ia, WH = W * H;
+      const int i_last = W < s ? ib : ib - 1;
+      const T a = h(ia, ja), b = h(ib, ja), c = h(ia, jc), d = h(ib, jc);
+      for (int j = ja; j <= j_last; ++j)
+        for (int i = ia; i <= i_last; ++i) {
+          const T U = i - ia, V = j - ja;
+          // The coarse surface at (i, j), times W H.
+          const T at = U * H + V * W <= WH ? a * WH + U * H * (b - a) + V * W * (c - a)
+                                           : d * WH + (W - U) * H * (c - d) + (H - V) * W * (b - d);
+          T e = h(i, j) * WH - at;
+          if (e < 0) e = -e;
+          // Divided only when it is the largest yet (e / WH > worst exactly
+          // when e > worst WH).
+          if (e > worst * WH) worst = (e + WH - 1) / WH;
+        }
+    }
+  }
+  return static_cast<uint16_t>(worst > 65535 ? 65535 : worst);
+}
+}  // namespace
+
+uint16_t step_error(const uint16_t* heights, int w, int i0, int j0, int ni, int nj, int s) {
+  if (heights == nullptr || s < 1 || ni < 1 || nj < 1) return 0;
+  const int quad = s < (ni > nj ? ni : nj) ? s : (ni > nj ? ni : nj);  // the widest quad's side
+  return quad <= 64 ? step_error_in<int32_t>(heights, w, i0, j0, ni, nj, s)
+                    : step_error_in<int64_t>(heights, w, i0, j0, ni, nj, s);
 }
 
 // --- Texture updates ---------------------------------------------------------------

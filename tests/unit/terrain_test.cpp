@@ -285,6 +285,58 @@ double boundary_distance(int u, int v, double kd, double cos_a, double beta_s) {
   return d;
 }
 
+// The level of detail's measure in doubles: the largest distance, rounded
+// up, between a grid point and the coarse surface over it. A coarse quad
+// from (ia, ja) to (ib, jc) is split along its b-c diagonal; points on a
+// coarse line are measured in the quad right of and below it, and the
+// patch's last column (row) only where a quad narrower (lower) than s ends
+// there.
+int reference_step_error(const std::vector<uint16_t>& h, int w, int i0, int j0, int ni, int nj, int s) {
+  double worst = 0;
+  for (int j = j0; j <= j0 + nj; ++j)
+    for (int i = i0; i <= i0 + ni; ++i) {
+      const int ia = i0 + std::min((i - i0) / s * s, ni), ja = j0 + std::min((j - j0) / s * s, nj);
+      const int ib = std::min(ia + s, i0 + ni), jc = std::min(ja + s, j0 + nj);
+      if (ia == ib || ja == jc) continue;  // the last column or row after a whole quad
+      const double W = ib - ia, H = jc - ja, U = (i - ia) / W, V = (j - ja) / H;
+      auto at = [&](int x, int y) { return static_cast<double>(h[static_cast<size_t>(y) * w + x]); };
+      const double surface = U + V <= 1 ? at(ia, ja) + U * (at(ib, ja) - at(ia, ja)) + V * (at(ia, jc) - at(ia, ja))
+                                        : at(ib, jc) + (1 - U) * (at(ia, jc) - at(ib, jc)) + (1 - V) * (at(ib, ja) - at(ib, jc));
+      worst = std::max(worst, std::fabs(at(i, j) - surface));
+    }
+  return std::min(65535, static_cast<int>(std::ceil(worst - 1e-7)));
+}
+
+TEST(TerrainElevation, StepErrorIsTheLargestDistanceToTheCoarseSurface) {
+  vds::test::Xorshift32 rng{5};
+  constexpr int kW = 300;
+  std::vector<uint16_t> rough(kW * kW), smooth(kW * kW), flat(kW * kW, 700);
+  for (int j = 0; j < kW; ++j)
+    for (int i = 0; i < kW; ++i) {
+      rough[static_cast<size_t>(j) * kW + i] = static_cast<uint16_t>(rng.next());
+      smooth[static_cast<size_t>(j) * kW + i] =
+          static_cast<uint16_t>(30000 + 20000 * std::sin(i * 0.05) * std::cos(j * 0.07) + rng.next() % 64);
+    }
+  // A plane: no step has an error.
+  for (int j = 0; j < kW; ++j)
+    for (int i = 0; i < kW; ++i) flat[static_cast<size_t>(j) * kW + i] = static_cast<uint16_t>(100 + 3 * i + 7 * j);
+  int nonzero = 0;
+  for (int n = 0; n < 600; ++n) {
+    const std::vector<uint16_t>& h = n % 3 == 0 ? rough : (n % 3 == 1 ? smooth : flat);
+    const int s = 1 << (1 + rng.next() % 7);                       // 2 .. 128
+    const int ni = 1 + static_cast<int>(rng.next() % 160), nj = 1 + static_cast<int>(rng.next() % 160);
+    const int i0 = static_cast<int>(rng.next() % (kW - ni)), j0 = static_cast<int>(rng.next() % (kW - nj));
+    const int got = terrain::step_error(h.data(), kW, i0, j0, ni, nj, s);
+    ASSERT_EQ(got, reference_step_error(h, kW, i0, j0, ni, nj, s))
+        << "patch " << ni << "x" << nj << " at " << i0 << "," << j0 << " step " << s << " map " << n % 3;
+    if (&h == &flat) EXPECT_EQ(got, 0);
+    nonzero += got > 0;
+  }
+  EXPECT_GT(nonzero, 300);
+  // The step of a single cell draws every point: no error.
+  EXPECT_EQ(terrain::step_error(rough.data(), kW, 10, 10, 16, 16, 1), 0);
+}
+
 TEST(TerrainMask, MatchesTheDoubleReferenceOfThePapersRule) {
   vds::test::Xorshift32 rng{11};
   int compared = 0;

@@ -83,7 +83,11 @@ struct BlockGrid {
   }
   uint32_t plane_blocks(int level, int comp) const { return uint32_t{plane_w(level, comp)} * plane_h(level, comp); }
   // The id of a plane's first block.
-  uint32_t first(int level, int comp) const;
+  // (Level 1's Y', Cb, Cr, then level 0's; Cb and Cr planes have one size.)
+  uint32_t first(int level, int comp) const {
+    const uint32_t at = level == 1 ? 0 : plane_blocks(1, 0) + 2 * plane_blocks(1, 1);
+    return comp == 0 ? at : at + plane_blocks(level, 0) + static_cast<uint32_t>(comp - 1) * plane_blocks(level, 1);
+  }
   uint32_t id(int level, int comp, int bx, int by) const {
     return first(level, comp) + static_cast<uint32_t>(by) * plane_w(level, comp) + static_cast<uint32_t>(bx);
   }
@@ -142,6 +146,15 @@ Status decode_elevation(const uint8_t* data, size_t size, int w, int h, Elevatio
 // The points the fine pass will send, interpolated (bilinear) from the
 // coarse ones: what the client draws until then.
 void fill_from_coarse(int w, int h, uint16_t* out);
+// The client's level of detail (docs/terrain.md, "The client"): the
+// largest height error, in height steps rounded up (at most 65535), of
+// drawing the ni x nj cells from grid point (i0, j0) of a w-point-wide
+// elevation at step s (a power of two): every grid point against the
+// coarse triangles over it, a coarse quad a b / c d split along b-c. A
+// point on a coarse line belongs to the quad right of it and below it; the
+// last column (row) counts only where a quad narrower (lower) than s ends
+// there.
+uint16_t step_error(const uint16_t* heights, int w, int i0, int j0, int ni, int nj, int s);
 constexpr bool elevation_coarse(int x, int y, int w, int h) {
   return (x % kCoarseStep == 0 || x == w - 1) && (y % kCoarseStep == 0 || y == h - 1);
 }

@@ -315,7 +315,8 @@ void refresh(TerrainPlay& w, uint32_t id) {
         const int bx = pl.bx * 8 + x, by = pl.by * 8 + y;
         if (bx >= pw || by >= ph) continue;
         const uint32_t id0 = w.grid.id(0, pl.comp, bx, by);
-        if (w.store.held(id0) == 0) *dc_texel(w, w.grid.place(id0)) = to_texel(plane[8 * y + x]);
+        const terrain::BlockPlace p0{0, pl.comp, static_cast<uint16_t>(bx), static_cast<uint16_t>(by)};
+        if (w.store.held(id0) == 0) *dc_texel(w, p0) = to_texel(plane[8 * y + x]);
       }
     return;
   }
@@ -442,32 +443,6 @@ Status apply_update(TerrainPlay& w, const uint8_t* payload, uint32_t size) {
   return s == Status::more_input && r.done() ? Status::ok : (s == Status::more_input ? Status::malformed : s);
 }
 
-// The largest height error of drawing the patch whose first cell is
-// (i0, j0), ni x nj cells, at step s: every grid point against the coarse
-// triangles over it (a coarse quad a b / c d split along b-c, as drawn).
-uint16_t step_error(const TerrainPlay& w, int i0, int j0, int ni, int nj, int s) {
-  auto h = [&](int i, int j) { return int64_t{w.heights[static_cast<size_t>(j) * w.pw + i]}; };
-  auto gi = [&](int c) { return i0 + (c * s < ni ? c * s : ni); };
-  auto gj = [&](int r) { return j0 + (r * s < nj ? r * s : nj); };
-  int64_t worst = 0;
-  for (int j = j0; j <= j0 + nj; ++j)
-    for (int i = i0; i <= i0 + ni; ++i) {
-      const int c = (i - i0) / s, r = (j - j0) / s;
-      const int ia = gi(c), ib = gi(c + 1), ja = gj(r), jc = gj(r + 1);
-      const int64_t W = ib - ia, H = jc - ja, U = i - ia, V = j - ja;
-      if (W == 0 || H == 0) continue;  // on the patch's last row or column of vertices
-      const int64_t a = h(ia, ja), b = h(ib, ja), cc = h(ia, jc), d = h(ib, jc);
-      // The coarse surface at (i, j), times W H.
-      const int64_t at = U * H + V * W <= W * H ? a * W * H + U * H * (b - a) + V * W * (cc - a)
-                                                : d * W * H + (W - U) * H * (cc - d) + (H - V) * W * (b - d);
-      int64_t e = h(i, j) * W * H - at;
-      if (e < 0) e = -e;
-      e = (e + W * H - 1) / (W * H);
-      if (e > worst) worst = e;
-    }
-  return static_cast<uint16_t>(worst > 65535 ? 65535 : worst);
-}
-
 void patch_bounds(TerrainPlay& w, int row0, int row1) {
   for (int py = 0; py < w.patches_y; ++py) {
     const int j0 = py * w.patch, j1 = j0 + w.patch < w.ph - 1 ? j0 + w.patch : w.ph - 1;
@@ -487,7 +462,7 @@ void patch_bounds(TerrainPlay& w, int row0, int row1) {
       uint16_t* err = w.patch_err + k * (kMaxStepLog2 + 1);
       err[0] = 0;
       for (int l = 1; l <= kMaxStepLog2; ++l)
-        err[l] = (1 << l) <= w.patch ? step_error(w, i0, j0, i1 - i0, j1 - j0, 1 << l) : 65535;
+        err[l] = (1 << l) <= w.patch ? terrain::step_error(w.heights, w.pw, i0, j0, i1 - i0, j1 - j0, 1 << l) : 65535;
     }
   }
 }
