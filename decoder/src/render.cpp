@@ -536,7 +536,7 @@ struct RenderFrame {
 
   template <bool kFaces>
   void draw_faces(const BandTarget& band, const Mesh& m, uint32_t first_tri, uint16_t band_index) {
-    MaterialCtx mat{&m, num_attribs(m.shading), 0, 0, 3};
+    MaterialCtx mat{&m, num_attribs(m.shading), 0, 0, 3, r.cfg_.point_face_span};
     const uint32_t tcap = r.cfg_.triangle_cache;
     const uint16_t* const tb = r.tri_bands_;
     const uint32_t nt = m.num_triangles;

@@ -76,6 +76,7 @@ struct MaterialCtx {
   uint32_t tri;     // the face's number in the mesh (mesh_colors, Mesh::views)
   uint32_t first;   // its first corner's vertex (Mesh::views)
   int corners;      // its corners (Mesh::corners): more than 3, rasterised as one polygon
+  int point_span = 0;  // RenderConfig::point_face_span
 };
 
 // The band being drawn.

@@ -424,6 +424,15 @@ bool same_form(const Texture& a, const Texture& b) {
          a.texels != nullptr && (a.format != TexFormat::ycbcr420 || (a.cb != nullptr && a.cr != nullptr));
 }
 
+// Whether a face is drawn from one point of its view (ViewMapSource::point):
+// its outline spans at most RenderConfig::point_face_span pixel columns and rows.
+bool point_face(const MaterialCtx& mat, const PreparedPolygon& pp, int32_t xmin, int32_t xmax) {
+  const Mesh& m = *mat.mesh;
+  return mat.point_span > 0 && m.shading == Shading::view_mapped && m.views != nullptr && m.views->point != nullptr &&
+         point_samples(*m.texture) && pp.row_end - pp.row_begin <= mat.point_span &&
+         raster_row(xmax) - raster_row(xmin) <= mat.point_span;
+}
+
 }  // namespace
 
 void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const ScreenVertex* v, int n, PreparedPolygon* pp) {
@@ -464,6 +473,8 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   bool repeat = false;
   // The homography rows and nref are set before any use: no zeroing, which
   // costs a memset call per polygon.
+  const Texture* point_tex = nullptr;
+  int32_t point_u = 0, point_v = 0;
   VertexValues vv;
   vv.ref[0] = 0;
   vv.ref[1] = fan.bi;
@@ -482,7 +493,13 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
     s.lat.res = int32_t{1} << s.lat.face.res_log2;
     s.nn = 2;
     lattice_values(s.lat.face.res_log2, m.filter == Filter::nearest ? 0 : kLatticeFracBits, v, n, vv);
+  } else if (point_face(mat, *pp, xmin, xmax) &&
+             m.views->point(m.views->ctx, mat.tri, mat.first, &point_tex, &point_u, &point_v)) {
+    // A small face in one colour: the view's sample at the point given.
+    if (point_tex == nullptr || !same_form(*point_tex, *m.texture)) return;
+    s.flat = point_colour(target, m, *point_tex, point_u, point_v);
   } else {
+    point_tex = nullptr;
     const Texture* tex = m.texture;
     const Homography* map = &m.view_map;
     Homography asked;
@@ -514,7 +531,7 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
   // (View-mapped polygons only: on the other materials' larger polygons the
   // check at set-up cost more than the spans saved, bench/results/render.md.)
   s.fast_safe = s.fast && s.proj && fast_safe(target, s, xmin, xmax, pp->row_begin, pp->row_end);
-  pp->fn = select_span(target, m, repeat);
+  pp->fn = point_tex != nullptr ? select_flat_span(target) : select_span(target, m, repeat);
 }
 
 int32_t prepared_row_end(const PreparedPolygon& pp) { return pp.row_end; }

@@ -95,6 +95,13 @@ inline int32_t step16(int64_t gx) {
 
 // The span loop for a material on a target (nullptr: a format compiled out).
 SpanFn select_span(const PolygonTarget& target, const Mesh& m, bool repeat);
+// The span loop of a face drawn in one colour (ViewMapSource::point).
+SpanFn select_flat_span(const PolygonTarget& target);
+// Whether point_colour samples this texture form (Y'CbCr 4:2:0, clamp).
+bool point_samples(const Texture& t);
+// The colour in the target's format of the sample at texel position
+// (u, v) (Q24.8, a texel's centre at +0.5), as the mesh's filter draws it.
+uint32_t point_colour(const PolygonTarget& target, const Mesh& m, const Texture& t, int32_t u_q8, int32_t v_q8);
 // The texture as the span loops address it.
 TexCtx make_tex_ctx(const Texture& t, bool repeat);
 // Fraction bits of the texture coordinates: 0 for nearest sampling.

@@ -203,6 +203,45 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (s3 != s2) __builtin_trap();
   if (s3 == vds::Status::ok && c != b) __builtin_trap();
 
+  // Small faces drawn in one colour from a point of their view
+  // (RenderConfig::point_face_span; the point anywhere, far outside the
+  // view too, or refused): the same status, and the same frame in one-row
+  // bands as whole.
+  struct Point {
+    const vds::Mesh* mesh;
+    int32_t u, v;
+    uint8_t mode;  // bit 0: refuse (map is asked), bit 1: a face's own offset
+    static bool map(void* ctx, uint32_t t, uint32_t first, const vds::Texture** tex, vds::Homography* h) {
+      Own own{static_cast<const Point*>(ctx)->mesh};
+      return Own::map(&own, t, first, tex, h);
+    }
+    static bool point(void* ctx, uint32_t t, uint32_t, const vds::Texture** tex, int32_t* u, int32_t* v) {
+      const Point& p = *static_cast<const Point*>(ctx);
+      if (p.mode & 1) return false;
+      *tex = p.mesh->texture;
+      *u = p.u + ((p.mode & 2) ? static_cast<int32_t>(t * 97) : 0);
+      *v = p.v - ((p.mode & 2) ? static_cast<int32_t>(t * 61) : 0);
+      return true;
+    }
+  };
+  const uint8_t span = in.u8();
+  std::vector<Point> points(nm);
+  std::vector<vds::ViewMapSource> point_sources(nm);
+  std::vector<vds::Mesh> pointing = meshes;
+  for (uint32_t m = 0; m < nm; ++m) {
+    points[m] = {&meshes[m], in.i32() >> (in.u8() % 32), in.i32() >> (in.u8() % 32), in.u8()};
+    point_sources[m] = {&Point::map, &points[m], &Point::point};
+    if (pointing[m].shading == vds::Shading::view_mapped) pointing[m].views = &point_sources[m];
+  }
+  vds::RenderConfig pointed = banded, pointed_whole = cfg;
+  pointed.point_face_span = pointed_whole.point_face_span = span;
+  vds::Status s4, s5;
+  const vds::DrawList point_list{pos.data(), np, pointing.data(), nm};
+  const std::vector<uint8_t> d = render(pointed, 1, cam, point_list, &s4);
+  const std::vector<uint8_t> e = render(pointed_whole, cfg.height, cam, point_list, &s5);
+  if (s4 != s2 || s5 != s2) __builtin_trap();
+  if (s4 == vds::Status::ok && d != e) __builtin_trap();
+
   // Grid positions ((g << shift) + origin) against the Q16.16 positions
   // they stand for, saturated as the renderer saturates them: the same
   // status and frame; a shift above 15 is refused.

@@ -794,6 +794,119 @@ std::vector<uint16_t> render_rgb565(const RenderConfig& cfg, const Camera& cam, 
   return frame;
 }
 
+// RenderConfig::point_face_span: view-mapped faces spanning at most that
+// many pixel columns and rows are drawn in one colour, the view's sample at
+// the point ViewMapSource::point gives (clamped to the view); larger faces,
+// faces whose point is refused and renderers without the span draw as
+// before. A plane of small triangles (left) and narrow or flat ones (right)
+// facing the screen, mapped from a grey view of the screen's size (its
+// homography the identity).
+TEST(RenderApi, SmallViewMappedFacesAreDrawnInTheColourOfTheirPoint) {
+  constexpr int kW = 96, kH = 72;
+  const Camera screen = ref::to_client(ref::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, kW, kH, 60, 0.1, 60));
+  std::mt19937 rng(77);
+  std::vector<uint8_t> ty(kW * kH), tc((kW / 2) * (kH / 2), 128);
+  for (auto& b : ty) b = static_cast<uint8_t>(rng());
+  Texture view;
+  view.format = TexFormat::ycbcr420;
+  view.address = TexAddress::clamp;
+  view.width = kW;
+  view.height = kH;
+  view.stride = kW;
+  view.texels = ty.data();
+  view.cb = view.cr = tc.data();
+  view.chroma_stride = kW / 2;
+  const auto q = [](double x) { return Q16_16::from_raw(static_cast<int32_t>(std::lround(x * 65536))); };
+  std::vector<Vec3<Q16_16>> pos;
+  std::vector<uint16_t> idx;
+  const auto grid = [&](double x0, double x1, double y0, double y1, double sx, double sy) {
+    const int nx = static_cast<int>(std::lround((x1 - x0) / sx)), ny = static_cast<int>(std::lround((y1 - y0) / sy));
+    const uint16_t first = static_cast<uint16_t>(pos.size());
+    for (int j = 0; j <= ny; ++j)
+      for (int i = 0; i <= nx; ++i) pos.push_back({q(x0 + i * sx), q(y0 + j * sy), q(4)});
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const uint16_t a = static_cast<uint16_t>(first + j * (nx + 1) + i), b = static_cast<uint16_t>(a + 1);
+        const uint16_t c = static_cast<uint16_t>(a + nx + 1), d = static_cast<uint16_t>(c + 1);
+        idx.insert(idx.end(), {a, b, c, b, d, c});
+      }
+  };
+  grid(0, 3.2, -2.4, 2.4, 0.2, 0.2);  // about 3 pixels a cell, the screen's left (x to the left)
+  grid(-1.6, 0, -3, 3, 0.2, 1);       // 3 wide and 16 high, its right
+  grid(-4, -1.6, -3, 3, 0.6, 0.2);    // 9 wide and 3 high
+  Homography identity;
+  const Vec3<Q16_16> plane[3] = {{q(0), q(0), q(4)}, {q(1), q(0), q(4)}, {q(0), q(1), q(4)}};
+  ASSERT_EQ(plane_homography(screen, screen, plane, &identity), Status::ok);
+  struct Source {
+    const Texture* view;
+    Homography h;
+    int32_t u, v;
+    bool refuse;
+    static bool map(void* ctx, uint32_t, uint32_t, const Texture** tex, Homography* out) {
+      const Source& s = *static_cast<const Source*>(ctx);
+      *tex = s.view;
+      *out = s.h;
+      return true;
+    }
+    static bool point(void* ctx, uint32_t, uint32_t, const Texture** tex, int32_t* u, int32_t* v) {
+      const Source& s = *static_cast<const Source*>(ctx);
+      if (s.refuse) return false;
+      *tex = s.view;
+      *u = s.u;
+      *v = s.v;
+      return true;
+    }
+  };
+  Source src{&view, identity, 10 * 256 + 128, 20 * 256 + 128, false};
+  const ViewMapSource source{&Source::map, &src, &Source::point};
+  Mesh m;
+  m.shading = Shading::view_mapped;
+  m.filter = Filter::nearest;
+  m.cull = Cull::none;
+  m.texture = &view;
+  m.views = &source;
+  m.indices = idx.data();
+  m.num_triangles = static_cast<uint32_t>(idx.size() / 3);
+  const DrawList list{pos.data(), static_cast<uint32_t>(pos.size()), &m, 1};
+  const auto frame = [&](uint8_t span) {
+    RenderConfig cfg;
+    cfg.width = kW;
+    cfg.height = kH;
+    cfg.band_height = 16;
+    cfg.setup_cache = 8;
+    cfg.vertex_cache = 4096;
+    cfg.point_face_span = span;
+    Status st = Status::ok;
+    std::vector<uint16_t> f = render_rgb565(cfg, screen, list, &st);
+    EXPECT_EQ(st, Status::ok);
+    return f;
+  };
+  const std::vector<uint16_t> mapped = frame(0);
+  ASSERT_EQ(mapped.size(), size_t{kW * kH});
+  // The identity map shows texel (10, 20) at pixel (10, 20): the point's colour.
+  const uint16_t colour = mapped[20 * kW + 10];
+  const auto uniform_left = [&](const std::vector<uint16_t>& f, uint16_t c) {
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW / 2 - 2; ++x)
+        if (f[static_cast<size_t>(y * kW + x)] != c) return false;
+    return true;
+  };
+  ASSERT_FALSE(uniform_left(mapped, colour)) << "the view's texels show";
+  const std::vector<uint16_t> small = frame(6);
+  EXPECT_TRUE(uniform_left(small, colour));
+  for (int y = 0; y < kH; ++y)
+    for (int x = kW / 2 + 1; x < kW; ++x)
+      ASSERT_EQ(small[static_cast<size_t>(y * kW + x)], mapped[static_cast<size_t>(y * kW + x)]) << x << "," << y;
+  // Every face at a span of 255; none where the point is refused.
+  const std::vector<uint16_t> all = frame(255);
+  EXPECT_TRUE(std::all_of(all.begin(), all.end(), [&](uint16_t c) { return c == colour; }));
+  src.refuse = true;
+  EXPECT_EQ(frame(6), mapped);
+  // A point far outside the view takes its nearest edge texel (column 0, row 71).
+  src = Source{&view, identity, -5000 * 256, 99999 * 256, false};
+  EXPECT_TRUE(uniform_left(frame(6), mapped[(kH - 1) * kW + 0]));
+}
+
 // Grid positions ((g << grid_shift) + grid_origin) draw exactly what the
 // same positions as Q16.16 vectors draw, with and without the vertex cache.
 TEST(RenderApi, GridPositionsDrawWhatTheirWorldPositionsDraw) {

@@ -170,9 +170,19 @@ struct LatticeFace {
 // false leaves the face undrawn. Every texture it gives has
 // Mesh::texture's format, address mode, apron, size and strides (a
 // texture that differs is not drawn).
+//
+// Optional `point`, for a renderer with RenderConfig::point_face_span: a
+// small face is drawn in one colour, the texture's sample at texel
+// position (*u_q8, *v_q8) (Q24.8, the homography's pixel positions: a
+// texel's centre at +0.5; sampled as the mesh's filter samples) that
+// `point` gives for it, so it costs no homography and no texture set-up.
+// Asked once per polygon set-up, with the same answer each time in a
+// frame; false asks `map` instead. Y'CbCr 4:2:0 textures with clamp
+// addressing only (for any other form `map` is asked).
 struct ViewMapSource {
   bool (*map)(void* ctx, uint32_t t, uint32_t first, const Texture** tex, Homography* out) = nullptr;
   void* ctx = nullptr;
+  bool (*point)(void* ctx, uint32_t t, uint32_t first, const Texture** tex, int32_t* u_q8, int32_t* v_q8) = nullptr;
 };
 
 struct MeshColorsSurface {
@@ -248,6 +258,11 @@ struct RenderConfig {
   // and set up once per frame instead of once per band. 0..4096; a RAM/time
   // trade-off, same picture.
   uint32_t setup_cache = 0;
+  // Small view-mapped faces in one colour (ViewMapSource::point): a face
+  // whose outline spans at most this many pixel columns and rows. 0: none.
+  // A time/picture trade-off (a face of a few pixels from a view's few
+  // texels looks the same flat).
+  uint8_t point_face_span = 0;
   // Optional caller-owned whole-frame colour buffer (height rows of
   // target_stride bytes). When set, bands are drawn straight into it and the
   // workspace holds no colour band. When null, the band lives in the workspace.
