@@ -424,13 +424,28 @@ bool same_form(const Texture& a, const Texture& b) {
          a.texels != nullptr && (a.format != TexFormat::ycbcr420 || (a.cb != nullptr && a.cr != nullptr));
 }
 
-// Whether a face is drawn from one point of its view (ViewMapSource::point):
-// its outline spans at most RenderConfig::point_face_span pixel columns and rows.
+// Whether a face is drawn in one colour, its texture's at one point (a
+// textured face's centre, a view-mapped face's ViewMapSource::point): its
+// outline spans at most RenderConfig::point_face_span pixel columns and rows.
 bool point_face(const MaterialCtx& mat, const PreparedPolygon& pp, int32_t xmin, int32_t xmax) {
   const Mesh& m = *mat.mesh;
-  return mat.point_span > 0 && m.shading == Shading::view_mapped && m.views != nullptr && m.views->point != nullptr &&
-         point_samples(*m.texture) && pp.row_end - pp.row_begin <= mat.point_span &&
-         raster_row(xmax) - raster_row(xmin) <= mat.point_span;
+  return mat.point_span > 0 && pp.row_end - pp.row_begin <= mat.point_span &&
+         raster_row(xmax) - raster_row(xmin) <= mat.point_span &&
+         (m.shading == Shading::texture || (m.shading == Shading::view_mapped && m.views != nullptr && m.views->point != nullptr)) &&
+         point_samples(*m.texture);
+}
+// That point, a Q24.8 texel position: a view-mapped face's from its
+// source (false: not given), a textured face's the mean of its corners'
+// texture coordinates (Q16.16 texels).
+bool face_point(const MaterialCtx& mat, const ScreenVertex* v, int n, const Texture** tex, int32_t* u_q8, int32_t* v_q8) {
+  const Mesh& m = *mat.mesh;
+  if (m.shading == Shading::view_mapped) return m.views->point(m.views->ctx, mat.tri, mat.first, tex, u_q8, v_q8);
+  int64_t su = 0, sv = 0;
+  for (int i = 0; i < n; ++i) su += v[i].a[0], sv += v[i].a[1];
+  *tex = m.texture;
+  *u_q8 = static_cast<int32_t>((su / n) >> 8);
+  *v_q8 = static_cast<int32_t>((sv / n) >> 8);
+  return true;
 }
 
 }  // namespace
@@ -493,9 +508,8 @@ void prepare_polygon(const PolygonTarget& target, const MaterialCtx& mat, const 
     s.lat.res = int32_t{1} << s.lat.face.res_log2;
     s.nn = 2;
     lattice_values(s.lat.face.res_log2, m.filter == Filter::nearest ? 0 : kLatticeFracBits, v, n, vv);
-  } else if (point_face(mat, *pp, xmin, xmax) &&
-             m.views->point(m.views->ctx, mat.tri, mat.first, &point_tex, &point_u, &point_v)) {
-    // A small face in one colour: the view's sample at the point given.
+  } else if (point_face(mat, *pp, xmin, xmax) && face_point(mat, v, n, &point_tex, &point_u, &point_v)) {
+    // A small face in one colour: its texture's sample at the point.
     if (point_tex == nullptr || !same_form(*point_tex, *m.texture)) return;
     s.flat = point_colour(target, m, *point_tex, point_u, point_v);
   } else {

@@ -1362,27 +1362,34 @@ SpanFn select_flat_span(const PolygonTarget& b) {
 
 bool point_samples(const Texture& t) {
   return (VDS_CONFIG_RENDER_TEXTURE_FORMATS & (1 << static_cast<int>(TexFormat::ycbcr420))) != 0 &&
-         t.format == TexFormat::ycbcr420 && t.address == TexAddress::clamp;
+         t.format == TexFormat::ycbcr420;
 }
 
 namespace {
-template <PixelFormat O>
+template <PixelFormat O, Addr A>
 OutColor<O> point_sample(const Mesh& m, const TexCtx& c, int32_t u_q8, int32_t v_q8) {
   constexpr TexFormat TF = TexFormat::ycbcr420;
   // The texel containing the point (nearest), or the point less half a
   // texel with 8 fraction bits (the bilinear samplers' coordinates).
-  if (m.filter == Filter::nearest) return NearestSampler<TF, Addr::clamp, O>::sample(c, u_q8 >> 8, v_q8 >> 8);
-  if (m.filter == Filter::bilinear_luma) return LumaBilinearSampler<TF, Addr::clamp, O>::sample(c, u_q8 - 128, v_q8 - 128);
-  return BilinearSampler<TF, Addr::clamp, O>::sample(c, u_q8 - 128, v_q8 - 128);
+  if (m.filter == Filter::nearest) return NearestSampler<TF, A, O>::sample(c, u_q8 >> 8, v_q8 >> 8);
+  if (m.filter == Filter::bilinear_luma) return LumaBilinearSampler<TF, A, O>::sample(c, u_q8 - 128, v_q8 - 128);
+  return BilinearSampler<TF, A, O>::sample(c, u_q8 - 128, v_q8 - 128);
 }
 }  // namespace
 
 uint32_t point_colour(const PolygonTarget& b, const Mesh& m, const Texture& t, int32_t u_q8, int32_t v_q8) {
   // Far outside the texture the clamps give its edge; keep the arithmetic in range.
   const auto hold = [](int32_t x) { return x < -(int32_t{1} << 28) ? -(int32_t{1} << 28) : (x > (int32_t{1} << 28) ? int32_t{1} << 28 : x); };
-  const TexCtx c = make_tex_ctx(t, false);
-  if (b.format == PixelFormat::rgb565) return point_sample<PixelFormat::rgb565>(m, c, hold(u_q8), hold(v_q8));
-  return point_sample<PixelFormat::rgb888>(m, c, hold(u_q8), hold(v_q8));
+  u_q8 = hold(u_q8);
+  v_q8 = hold(v_q8);
+  const bool repeat = texture_repeats(t);
+  const TexCtx c = make_tex_ctx(t, repeat);
+  if (b.format == PixelFormat::rgb565) {
+    return repeat ? point_sample<PixelFormat::rgb565, Addr::repeat>(m, c, u_q8, v_q8)
+                  : point_sample<PixelFormat::rgb565, Addr::clamp>(m, c, u_q8, v_q8);
+  }
+  return repeat ? point_sample<PixelFormat::rgb888, Addr::repeat>(m, c, u_q8, v_q8)
+                : point_sample<PixelFormat::rgb888, Addr::clamp>(m, c, u_q8, v_q8);
 }
 
 TexCtx make_tex_ctx(const Texture& t, bool repeat) {

@@ -97,7 +97,7 @@ inline int32_t step16(int64_t gx) {
 SpanFn select_span(const PolygonTarget& target, const Mesh& m, bool repeat);
 // The span loop of a face drawn in one colour (ViewMapSource::point).
 SpanFn select_flat_span(const PolygonTarget& target);
-// Whether point_colour samples this texture form (Y'CbCr 4:2:0, clamp).
+// Whether point_colour samples this texture form (Y'CbCr 4:2:0).
 bool point_samples(const Texture& t);
 // The colour in the target's format of the sample at texel position
 // (u, v) (Q24.8, a texel's centre at +0.5), as the mesh's filter draws it.

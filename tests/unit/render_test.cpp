@@ -794,49 +794,102 @@ std::vector<uint16_t> render_rgb565(const RenderConfig& cfg, const Camera& cam, 
   return frame;
 }
 
-// RenderConfig::point_face_span: view-mapped faces spanning at most that
-// many pixel columns and rows are drawn in one colour, the view's sample at
-// the point ViewMapSource::point gives (clamped to the view); larger faces,
-// faces whose point is refused and renderers without the span draw as
-// before. A plane of small triangles (left) and narrow or flat ones (right)
-// facing the screen, mapped from a grey view of the screen's size (its
-// homography the identity).
-TEST(RenderApi, SmallViewMappedFacesAreDrawnInTheColourOfTheirPoint) {
-  constexpr int kW = 96, kH = 72;
-  const Camera screen = ref::to_client(ref::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, kW, kH, 60, 0.1, 60));
-  std::mt19937 rng(77);
-  std::vector<uint8_t> ty(kW * kH), tc((kW / 2) * (kH / 2), 128);
-  for (auto& b : ty) b = static_cast<uint8_t>(rng());
+// RenderConfig::point_face_span's scene: a plane 4 units in front of a
+// 96x72 screen, of small triangles (its left: about 3 pixels a cell) and
+// of narrow or flat ones (its right: 3 x 16 and 9 x 3 pixels), and a grey
+// Y'CbCr view of the screen's size.
+struct SmallFaceScene {
+  static constexpr int kW = 96, kH = 72;
+  Camera screen = ref::to_client(ref::CameraD::look_at({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, kW, kH, 60, 0.1, 60));
+  std::vector<uint8_t> ty = std::vector<uint8_t>(kW * kH), tc = std::vector<uint8_t>((kW / 2) * (kH / 2), 128);
   Texture view;
-  view.format = TexFormat::ycbcr420;
-  view.address = TexAddress::clamp;
-  view.width = kW;
-  view.height = kH;
-  view.stride = kW;
-  view.texels = ty.data();
-  view.cb = view.cr = tc.data();
-  view.chroma_stride = kW / 2;
-  const auto q = [](double x) { return Q16_16::from_raw(static_cast<int32_t>(std::lround(x * 65536))); };
   std::vector<Vec3<Q16_16>> pos;
+  std::vector<TexCoord> uvs;  // each vertex's own pixel position: the texture drawn 1:1
   std::vector<uint16_t> idx;
-  const auto grid = [&](double x0, double x1, double y0, double y1, double sx, double sy) {
+  SmallFaceScene() {
+    std::mt19937 rng(77);
+    for (auto& b : ty) b = static_cast<uint8_t>(rng());
+    view.format = TexFormat::ycbcr420;
+    view.address = TexAddress::clamp;
+    view.width = kW;
+    view.height = kH;
+    view.stride = kW;
+    view.texels = ty.data();
+    view.cb = view.cr = tc.data();
+    view.chroma_stride = kW / 2;
+    grid(0, 3.2, -2.4, 2.4, 0.2, 0.2);  // the screen's left (x to the left)
+    grid(-1.6, 0, -3, 3, 0.2, 1);
+    grid(-4, -1.6, -3, 3, 0.6, 0.2);
+  }
+  static Q16_16 q(double x) { return Q16_16::from_raw(static_cast<int32_t>(std::lround(x * 65536))); }
+  void grid(double x0, double x1, double y0, double y1, double sx, double sy) {
     const int nx = static_cast<int>(std::lround((x1 - x0) / sx)), ny = static_cast<int>(std::lround((y1 - y0) / sy));
     const uint16_t first = static_cast<uint16_t>(pos.size());
     for (int j = 0; j <= ny; ++j)
-      for (int i = 0; i <= nx; ++i) pos.push_back({q(x0 + i * sx), q(y0 + j * sy), q(4)});
+      for (int i = 0; i <= nx; ++i) {
+        pos.push_back({q(x0 + i * sx), q(y0 + j * sy), q(4)});
+        int32_t px = 0, py = 0;
+        EXPECT_TRUE(camera_project(screen, camera_transform(screen, pos.back()), &px, &py));
+        uvs.push_back({Q16_16::from_raw(px * 256), Q16_16::from_raw(py * 256)});
+      }
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
         const uint16_t a = static_cast<uint16_t>(first + j * (nx + 1) + i), b = static_cast<uint16_t>(a + 1);
         const uint16_t c = static_cast<uint16_t>(a + nx + 1), d = static_cast<uint16_t>(c + 1);
         idx.insert(idx.end(), {a, b, c, b, d, c});
       }
-  };
-  grid(0, 3.2, -2.4, 2.4, 0.2, 0.2);  // about 3 pixels a cell, the screen's left (x to the left)
-  grid(-1.6, 0, -3, 3, 0.2, 1);       // 3 wide and 16 high, its right
-  grid(-4, -1.6, -3, 3, 0.6, 0.2);    // 9 wide and 3 high
+  }
+  Mesh mesh(Shading shading, const ViewMapSource* views) const {
+    Mesh m;
+    m.shading = shading;
+    m.filter = Filter::nearest;
+    m.cull = Cull::none;
+    m.texture = &view;
+    m.views = views;
+    m.uvs = uvs.data();
+    m.indices = idx.data();
+    m.num_triangles = static_cast<uint32_t>(idx.size() / 3);
+    return m;
+  }
+  std::vector<uint16_t> frame(const Mesh& m, uint8_t span) const {
+    RenderConfig cfg;
+    cfg.width = kW;
+    cfg.height = kH;
+    cfg.band_height = 16;
+    cfg.setup_cache = 8;
+    cfg.vertex_cache = 4096;
+    cfg.point_face_span = span;
+    Status st = Status::ok;
+    std::vector<uint16_t> f = render_rgb565(cfg, screen, DrawList{pos.data(), static_cast<uint32_t>(pos.size()), &m, 1}, &st);
+    EXPECT_EQ(st, Status::ok);
+    return f;
+  }
+  // Every pixel of the screen's left half (the small faces) is c.
+  static bool uniform_left(const std::vector<uint16_t>& f, uint16_t c) {
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW / 2 - 2; ++x)
+        if (f[static_cast<size_t>(y * kW + x)] != c) return false;
+    return true;
+  }
+  static bool same_right(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b) {
+    for (int y = 0; y < kH; ++y)
+      for (int x = kW / 2 + 1; x < kW; ++x)
+        if (a[static_cast<size_t>(y * kW + x)] != b[static_cast<size_t>(y * kW + x)]) return false;
+    return true;
+  }
+};
+
+// RenderConfig::point_face_span: view-mapped faces spanning at most that
+// many pixel columns and rows are drawn in one colour, the view's sample at
+// the point ViewMapSource::point gives (clamped to the view); larger faces,
+// faces whose point is refused and renderers without the span draw as
+// before. The view is the screen's own (the homography the identity).
+TEST(RenderApi, SmallViewMappedFacesAreDrawnInTheColourOfTheirPoint) {
+  const SmallFaceScene sc;
+  constexpr int kW = SmallFaceScene::kW, kH = SmallFaceScene::kH;
   Homography identity;
-  const Vec3<Q16_16> plane[3] = {{q(0), q(0), q(4)}, {q(1), q(0), q(4)}, {q(0), q(1), q(4)}};
-  ASSERT_EQ(plane_homography(screen, screen, plane, &identity), Status::ok);
+  const Vec3<Q16_16> plane[3] = {{sc.q(0), sc.q(0), sc.q(4)}, {sc.q(1), sc.q(0), sc.q(4)}, {sc.q(0), sc.q(1), sc.q(4)}};
+  ASSERT_EQ(plane_homography(sc.screen, sc.screen, plane, &identity), Status::ok);
   struct Source {
     const Texture* view;
     Homography h;
@@ -857,54 +910,65 @@ TEST(RenderApi, SmallViewMappedFacesAreDrawnInTheColourOfTheirPoint) {
       return true;
     }
   };
-  Source src{&view, identity, 10 * 256 + 128, 20 * 256 + 128, false};
+  Source src{&sc.view, identity, 10 * 256 + 128, 20 * 256 + 128, false};
   const ViewMapSource source{&Source::map, &src, &Source::point};
-  Mesh m;
-  m.shading = Shading::view_mapped;
-  m.filter = Filter::nearest;
-  m.cull = Cull::none;
-  m.texture = &view;
-  m.views = &source;
-  m.indices = idx.data();
-  m.num_triangles = static_cast<uint32_t>(idx.size() / 3);
-  const DrawList list{pos.data(), static_cast<uint32_t>(pos.size()), &m, 1};
-  const auto frame = [&](uint8_t span) {
-    RenderConfig cfg;
-    cfg.width = kW;
-    cfg.height = kH;
-    cfg.band_height = 16;
-    cfg.setup_cache = 8;
-    cfg.vertex_cache = 4096;
-    cfg.point_face_span = span;
-    Status st = Status::ok;
-    std::vector<uint16_t> f = render_rgb565(cfg, screen, list, &st);
-    EXPECT_EQ(st, Status::ok);
-    return f;
-  };
-  const std::vector<uint16_t> mapped = frame(0);
+  const Mesh m = sc.mesh(Shading::view_mapped, &source);
+  const std::vector<uint16_t> mapped = sc.frame(m, 0);
   ASSERT_EQ(mapped.size(), size_t{kW * kH});
   // The identity map shows texel (10, 20) at pixel (10, 20): the point's colour.
   const uint16_t colour = mapped[20 * kW + 10];
-  const auto uniform_left = [&](const std::vector<uint16_t>& f, uint16_t c) {
-    for (int y = 0; y < kH; ++y)
-      for (int x = 0; x < kW / 2 - 2; ++x)
-        if (f[static_cast<size_t>(y * kW + x)] != c) return false;
-    return true;
-  };
-  ASSERT_FALSE(uniform_left(mapped, colour)) << "the view's texels show";
-  const std::vector<uint16_t> small = frame(6);
-  EXPECT_TRUE(uniform_left(small, colour));
-  for (int y = 0; y < kH; ++y)
-    for (int x = kW / 2 + 1; x < kW; ++x)
-      ASSERT_EQ(small[static_cast<size_t>(y * kW + x)], mapped[static_cast<size_t>(y * kW + x)]) << x << "," << y;
+  ASSERT_FALSE(SmallFaceScene::uniform_left(mapped, colour)) << "the view's texels show";
+  const std::vector<uint16_t> small = sc.frame(m, 6);
+  EXPECT_TRUE(SmallFaceScene::uniform_left(small, colour));
+  EXPECT_TRUE(SmallFaceScene::same_right(small, mapped));
   // Every face at a span of 255; none where the point is refused.
-  const std::vector<uint16_t> all = frame(255);
+  const std::vector<uint16_t> all = sc.frame(m, 255);
   EXPECT_TRUE(std::all_of(all.begin(), all.end(), [&](uint16_t c) { return c == colour; }));
   src.refuse = true;
-  EXPECT_EQ(frame(6), mapped);
+  EXPECT_EQ(sc.frame(m, 6), mapped);
   // A point far outside the view takes its nearest edge texel (column 0, row 71).
-  src = Source{&view, identity, -5000 * 256, 99999 * 256, false};
-  EXPECT_TRUE(uniform_left(frame(6), mapped[(kH - 1) * kW + 0]));
+  src = Source{&sc.view, identity, -5000 * 256, 99999 * 256, false};
+  EXPECT_TRUE(SmallFaceScene::uniform_left(sc.frame(m, 6), mapped[(kH - 1) * kW + 0]));
+}
+
+// The same for textured faces: a small face takes the texel at the mean of
+// its corners' texture coordinates. The texture drawn 1:1 shows each small
+// face's texel at the face's centre pixel, so each small face is one
+// colour, the mapped frame's at its centre; the right half is as before.
+TEST(RenderApi, SmallTexturedFacesAreDrawnInTheColourOfTheirCentre) {
+  const SmallFaceScene sc;
+  constexpr int kW = SmallFaceScene::kW;
+  const Mesh m = sc.mesh(Shading::texture, nullptr);
+  const std::vector<uint16_t> mapped = sc.frame(m, 0), small = sc.frame(m, 6);
+  EXPECT_TRUE(SmallFaceScene::same_right(small, mapped));
+  // Each small triangle of the left half (the first grid's 16 x 24 cells).
+  int faces = 0, checked = 0;
+  for (size_t t = 0; t < 2 * 16 * 24; ++t) {
+    int64_t su = 0, sv = 0;
+    for (int k = 0; k < 3; ++k) su += sc.uvs[sc.idx[3 * t + k]].u.raw(), sv += sc.uvs[sc.idx[3 * t + k]].v.raw();
+    const int cu = static_cast<int>((su / 3) >> 16), cv = static_cast<int>((sv / 3) >> 16);
+    if (cu < 0 || cu >= kW / 2 - 2 || cv < 0 || cv >= SmallFaceScene::kH) continue;
+    const uint16_t colour = mapped[static_cast<size_t>(cv * kW + cu)];
+    // The pixels whose centres lie inside the triangle (screen positions = its uvs).
+    const auto at = [&](int k) { return std::pair<double, double>{sc.uvs[sc.idx[3 * t + k]].u.raw() / 65536.0, sc.uvs[sc.idx[3 * t + k]].v.raw() / 65536.0}; };
+    const auto [ax, ay] = at(0);
+    const auto [bx, by] = at(1);
+    const auto [qx, qy] = at(2);
+    const auto side = [](double x0, double y0, double x1, double y1, double x, double y) { return (x1 - x0) * (y - y0) - (y1 - y0) * (x - x0); };
+    ++faces;
+    for (int y = 0; y < SmallFaceScene::kH; ++y)
+      for (int x = 0; x < kW / 2 - 2; ++x) {
+        const double px = x + 0.5, py = y + 0.5, e = 1e-3;
+        const double s0 = side(ax, ay, bx, by, px, py), s1 = side(bx, by, qx, qy, px, py), s2 = side(qx, qy, ax, ay, px, py);
+        if ((s0 > e && s1 > e && s2 > e) || (s0 < -e && s1 < -e && s2 < -e)) {
+          ASSERT_EQ(small[static_cast<size_t>(y * kW + x)], colour) << "face " << t << " pixel " << x << "," << y;
+          ++checked;
+        }
+      }
+  }
+  EXPECT_GT(faces, 600);
+  EXPECT_GT(checked, 1000);
+  EXPECT_NE(mapped, small);
 }
 
 // Grid positions ((g << grid_shift) + grid_origin) draw exactly what the

@@ -258,10 +258,12 @@ struct RenderConfig {
   // and set up once per frame instead of once per band. 0..4096; a RAM/time
   // trade-off, same picture.
   uint32_t setup_cache = 0;
-  // Small view-mapped faces in one colour (ViewMapSource::point): a face
-  // whose outline spans at most this many pixel columns and rows. 0: none.
-  // A time/picture trade-off (a face of a few pixels from a view's few
-  // texels looks the same flat).
+  // Small faces in one colour: a textured or view-mapped face of a Y'CbCr
+  // 4:2:0 texture whose outline spans at most this many pixel columns and
+  // rows is drawn flat, in its texture's sample at one point (a textured
+  // face's: the mean of its corners' texture coordinates; a view-mapped
+  // face's: ViewMapSource::point's, if the source has one). 0: none. A
+  // time/picture trade-off (a face of a few pixels looks the same flat).
   uint8_t point_face_span = 0;
   // Optional caller-owned whole-frame colour buffer (height rows of
   // target_stride bytes). When set, bands are drawn straight into it and the

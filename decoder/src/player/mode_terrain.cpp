@@ -118,11 +118,19 @@ int patch_size(const terrain::Params& t) {
 
 uint32_t ground_vertices(const terrain::Params& t) { return 512u * t.frame_budget; }
 uint32_t ground_triangles(const terrain::Params& t) { return 512u * t.frame_budget; }
+// Faces spanning at most 8 pixel columns and rows are drawn in one colour
+// (RenderConfig::point_face_span): the client's frames within 0.05 dB of
+// every face mapped on the benchmark flights, 0.5 to 2.7 % fewer Cortex-M4
+// instructions a frame (16: 8 % fewer drawing, up to 0.29 dB less;
+// docs/terrain.md).
+constexpr uint8_t kTerrainPointFaceSpan = 8;
 uint32_t skirt_triangles(const terrain::Params& t) { return 256u * t.frame_budget; }
 
 RenderConfig render_config(const StreamHeader& h, const terrain::Params& t, const PlayerConfig& c) {
-  return detail::band_render_config(h, c, ground_vertices(t) + 4u * t.max_cells,
-                                    ground_triangles(t) + skirt_triangles(t) + 2u * t.max_cells);
+  RenderConfig rc = detail::band_render_config(h, c, ground_vertices(t) + 4u * t.max_cells,
+                                               ground_triangles(t) + skirt_triangles(t) + 2u * t.max_cells);
+  rc.point_face_span = kTerrainPointFaceSpan;
+  return rc;
 }
 
 uint32_t half_window(const terrain::Params& t) { return t.half_log2 == 0 ? 0u : 1u << t.half_log2; }
