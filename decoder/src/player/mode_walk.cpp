@@ -91,7 +91,7 @@ constexpr uint32_t kWalkSetupCacheMost = 48;
 // Faces spanning at most 8 pixel columns and rows are drawn in one colour,
 // their view's sample at their first triangle's centre (frame_point): on
 // the figure maps' tours at 16 and 32 kbit/s the same PSNR to 0.01 dB as
-// every face mapped (12: up to 0.02 dB less; 16: up to 0.06), for about 4 %
+// every face mapped (12: up to 0.03 dB less; 16: up to 0.10), for about 4 %
 // fewer Cortex-M4 instructions on oa_dm5's busiest stretch
 // (docs/walkthrough.md).
 constexpr uint8_t kWalkPointFaceSpan = 8;
